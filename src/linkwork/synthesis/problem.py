@@ -1,0 +1,63 @@
+"""A shape-change synthesis problem: the design profiles and the settings of the search (Shamsudin et al. 2013)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+ProfileKind = Literal["open", "closed", "fixed-end"]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Everything ``linkwork synth`` needs, in the API's units (lengths as given, angles in radians).
+
+    Attributes
+    ----------
+    profiles
+        The design curves, each a polyline of shape ``(N_j, 2)``. A closed profile's polyline returns to its
+        first point (its last row equals its first).
+    kind
+        ``"open"``, ``"closed"`` or ``"fixed-end"`` (both ends pinned to where profile 1 has them).
+    piece_length
+        The desired piece length ``s_d`` of the target profiles (Sec. 2 of the paper).
+    min_pieces
+        The fewest pieces any segment may span on any profile.
+    design
+        A design vector such as ``"MCMC"``, or ``None`` to search every design vector of ``segments`` segments.
+    segments
+        ``q``, the number of segments, when ``design`` is ``None``.
+    starts
+        How many initial segment matrices the search starts from (seeded, reproducible).
+    merge_below
+        Joint-range threshold (radians) below which adjacent segments are merged into a compound segment
+        (Sec. 6); ``0`` disables merging.
+    seed
+        Seed of the random generator of the initial segment matrices.
+    names
+        A name per profile (file stem by default).
+    source
+        The problem file this came from, if any (for messages and relative paths).
+    """
+
+    profiles: tuple[NDArray[np.float64], ...]
+    kind: ProfileKind = "open"
+    piece_length: float = 0.1
+    min_pieces: int = 2
+    design: str | None = None
+    segments: int | None = None
+    starts: int = 5
+    merge_below: float = 0.0
+    seed: int = 0
+    names: tuple[str, ...] = field(default=())
+    source: Path | None = None
+    mechanize: bool = False
+
+    @property
+    def count(self) -> int:
+        """``p``, the number of design profiles."""
+        return len(self.profiles)
