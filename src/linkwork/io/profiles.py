@@ -1,0 +1,684 @@
+"""Design-profile files: read a planar curve from CSV, Selig ``.dat``, SVG or DXF into an ``(N, 2)`` polyline,
+write one back, and write a synthesised chain's outline on every profile as SVG or DXF for CAD.
+
+Every reader goes through one registry of formats keyed by file suffix (:data:`FORMATS`) behind
+:func:`load_profile`, and every polyline it returns has passed :func:`check_profile`: at least two finite,
+distinct consecutive points on a curve that does not cross itself. Problems are reported as
+:class:`~linkwork.errors.SpecError` naming the file, the line or entity, and what was expected.
+
+Curved geometry (SVG arcs and Bézier curves, DXF bulges and splines) is flattened into straight pieces whose
+largest distance from the true curve (the sagitta) is at most ``tolerance`` times the size of the drawing, the
+diagonal of the bounding box of the shape's defining points (vertices and control points). The default,
+:data:`FLATTEN_TOLERANCE`, is ``1e-4``: a curve one unit across is followed to within 0.0001. Every vertex of the
+flattened polyline lies on the true curve (to rounding).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from linkwork.errors import SpecError
+
+if TYPE_CHECKING:
+    from linkwork.synthesis.result import SynthesisResult
+
+FLATTEN_TOLERANCE = 1e-4
+"""Largest distance of a flattened piece from the true curve, as a fraction of the drawing's size."""
+
+COINCIDENT = 1e-9
+"""Two consecutive points closer than this fraction of the curve's size count as one repeated point."""
+
+_MAX_DEPTH = 24  # recursion limit of the adaptive flattening: 2**24 pieces per curve segment at most
+
+Points = NDArray[np.float64]
+
+_CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier control points
+
+
+# ---------------------------------------------------------------------------------------------------- checks
+
+
+def _size(points: Points) -> float:
+    """The diagonal of the bounding box of ``points`` (1 for a degenerate box, so tolerances stay positive)."""
+    if len(points) == 0:
+        return 1.0
+    diagonal = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))
+    return diagonal if diagonal > 0.0 else 1.0
+
+
+def _fmt_point(point: Sequence[float] | Points) -> str:
+    return f"({float(point[0]):.6g}, {float(point[1]):.6g})"
+
+
+def is_closed(points: ArrayLike) -> bool:
+    """True when the polyline returns to its first point (to :data:`COINCIDENT` of its size).
+
+    Parameters
+    ----------
+    points
+        A polyline of shape ``(N, 2)``.
+    """
+    pts = np.asarray(points, dtype=float)
+    if len(pts) < 3:
+        return False
+    return bool(np.hypot(*(pts[-1] - pts[0])) <= COINCIDENT * _size(pts))
+
+
+def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
+    """The first pair of pieces of a polyline that meet other than at their shared point, or None.
+
+    Piece ``i`` joins points ``i`` and ``i + 1``. Neighbouring pieces may share their common point but must not
+    fold back onto each other; any other two pieces must not touch. For a closed polyline (last point equal to
+    the first) the first and last pieces share the closing point, which is not a crossing.
+
+    Parameters
+    ----------
+    points
+        A polyline of shape ``(N, 2)`` with distinct consecutive points.
+
+    Returns
+    -------
+    tuple of int or None
+        ``(i, j)`` with ``i < j``, the indices of two offending pieces, or ``None`` for a simple curve.
+    """
+    pts = np.asarray(points, dtype=float)
+    n_pieces = len(pts) - 1
+    if n_pieces < 2:
+        return None
+    closed = is_closed(pts)
+    length_tol = COINCIDENT * _size(pts)
+    a, b = pts[:-1], pts[1:]
+    direction = b - a
+    piece_length = np.hypot(direction[:, 0], direction[:, 1])
+
+    # Neighbours fold back when they are antiparallel and collinear (a turn of 180 degrees).
+    pairs = [(i, i + 1) for i in range(n_pieces - 1)]
+    if closed and n_pieces > 2:
+        pairs.append((0, n_pieces - 1))
+    for i, j in pairs:
+        cross = direction[i, 0] * direction[j, 1] - direction[i, 1] * direction[j, 0]
+        dot = direction[i] @ direction[j]
+        if abs(cross) <= length_tol * max(piece_length[i], piece_length[j]) and dot < 0.0:
+            return (i, j)
+
+    lo = np.minimum(a, b) - length_tol
+    hi = np.maximum(a, b) + length_tol
+
+    # Sweep along x: after sorting pieces by their left end, piece k can only meet the pieces that start before
+    # it ends, a contiguous run found by searchsorted; the run is short for any curve that is not a tangle.
+    order = np.argsort(lo[:, 0], kind="stable")
+    run_end = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
+    counts = np.maximum(run_end - np.arange(n_pieces) - 1, 0)
+    offsets = np.cumsum(counts) - counts
+    total = int(counts.sum())
+    batch = 1_000_000
+    for first in range(0, total, batch):
+        flat = np.arange(first, min(first + batch, total))
+        k = np.searchsorted(offsets, flat, side="right") - 1
+        i, j = order[k], order[k + 1 + flat - offsets[k]]
+        i, j = np.minimum(i, j), np.maximum(i, j)
+        keep = (j >= i + 2) & np.all(lo[i] <= hi[j], axis=1) & np.all(lo[j] <= hi[i], axis=1)
+        if closed:
+            keep &= ~((i == 0) & (j == n_pieces - 1))
+        i, j = i[keep], j[keep]
+        hit = _pieces_meet(a[i], b[i], a[j], b[j], length_tol)
+        if hit.any():
+            pick = np.lexsort((j[hit], i[hit]))[0]
+            return (int(i[hit][pick]), int(j[hit][pick]))
+    return None
+
+
+def _pieces_meet(a: Points, b: Points, c: Points, d: Points, length_tol: float) -> NDArray[np.bool_]:
+    """Whether pieces ``a-b`` and ``c-d`` (rows of ``(K, 2)`` arrays) touch, with bounding boxes known to overlap.
+
+    Each piece's end points must lie on opposite sides of (or on) the other piece's line; "on" means within
+    ``length_tol``. Collinear pieces pass both tests, and their overlapping boxes then mean they overlap.
+    """
+
+    def orient(p: Points, q: Points, r: Points) -> Points:
+        return (q[:, 0] - p[:, 0]) * (r[:, 1] - p[:, 1]) - (q[:, 1] - p[:, 1]) * (r[:, 0] - p[:, 0])
+
+    zero_ab = length_tol * np.hypot(*(b - a).T)
+    zero_cd = length_tol * np.hypot(*(d - c).T)
+    d1, d2 = orient(a, b, c), orient(a, b, d)
+    d3, d4 = orient(c, d, a), orient(c, d, b)
+    straddle_cd = ((d1 <= zero_ab) & (d2 >= -zero_ab)) | ((d1 >= -zero_ab) & (d2 <= zero_ab))
+    straddle_ab = ((d3 <= zero_cd) & (d4 >= -zero_cd)) | ((d3 >= -zero_cd) & (d4 <= zero_cd))
+    return np.asarray(straddle_ab & straddle_cd)
+
+
+def _meeting_point(points: Points, i: int, j: int) -> Points:
+    """Where pieces ``i`` and ``j`` of a polyline meet (their lines' intersection, or a shared end point)."""
+    a, b, c, d = points[i], points[i + 1], points[j], points[j + 1]
+    u, v = b - a, d - c
+    det = u[0] * v[1] - u[1] * v[0]
+    if abs(det) > 1e-300:
+        t = ((c[0] - a[0]) * v[1] - (c[1] - a[1]) * v[0]) / det
+        return a + min(max(t, 0.0), 1.0) * u
+    return c if np.dot(c - a, c - b) <= 0.0 else a
+
+
+def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points:
+    """Check that ``points`` is a usable design profile and return it as a float array of shape ``(N, 2)``.
+
+    A usable profile has at least two points, every coordinate finite, no point repeating the one before it,
+    and does not cross itself (a closed curve may return to its first point).
+
+    Parameters
+    ----------
+    points
+        The polyline, shape ``(N, 2)``.
+    source
+        The file it came from, named in the error message.
+
+    Raises
+    ------
+    SpecError
+        Naming ``source``, what is wrong (1-based point numbers) and what was expected.
+    """
+    where = str(source) if source is not None else None
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        if pts.size == 0:
+            raise SpecError("no points; expected a curve of at least 2 points (x, y)", source=where)
+        raise SpecError(f"expected points of shape (N, 2), got shape {pts.shape}", source=where)
+    if len(pts) == 0:
+        raise SpecError("no points; expected a curve of at least 2 points (x, y)", source=where)
+    if len(pts) == 1:
+        raise SpecError(
+            f"a single point {_fmt_point(pts[0])}; expected a curve of at least 2 points", source=where
+        )
+    bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
+    if len(bad):
+        raise SpecError(
+            f"point {bad[0] + 1} is {_fmt_point(pts[bad[0]])}; expected finite numbers", source=where
+        )
+    step = np.hypot(*np.diff(pts, axis=0).T)
+    repeated = np.flatnonzero(step <= COINCIDENT * _size(pts))
+    if len(repeated):
+        i = int(repeated[0])
+        raise SpecError(
+            f"points {i + 1} and {i + 2} repeat {_fmt_point(pts[i])}; expected distinct consecutive points",
+            source=where,
+        )
+    crossing = find_self_crossing(pts)
+    if crossing is not None:
+        i, j = crossing
+        raise SpecError(
+            f"the curve crosses itself: piece {i + 1}-{i + 2} meets piece {j + 1}-{j + 2} at "
+            f"{_fmt_point(_meeting_point(pts, i, j))}; expected a curve that does not overlap itself",
+            source=where,
+        )
+    return pts
+
+
+# ------------------------------------------------------------------------------------------- flattening
+
+
+def _flatten(
+    curve: Callable[[float], tuple[float, float]],
+    tolerance: float,
+    depth: int = 0,
+    t0: float = 0.0,
+    t1: float = 1.0,
+    p0: tuple[float, float] | None = None,
+    p1: tuple[float, float] | None = None,
+) -> list[tuple[float, float]]:
+    """Points of ``curve`` on ``(t0, t1]`` such that no chord strays more than ``tolerance`` from the curve.
+
+    The chord is checked against the curve at a quarter, half and three quarters of its parameter range, and
+    the first two levels always subdivide, so an S-shaped piece whose middle happens to lie on its chord is
+    still followed.
+    """
+    p0 = curve(t0) if p0 is None else p0
+    p1 = curve(t1) if p1 is None else p1
+    if depth >= 2 and depth < _MAX_DEPTH:
+        chord = np.subtract(p1, p0)
+        chord_length = float(np.hypot(*chord))
+        worst = 0.0
+        for s in (0.25, 0.5, 0.75):
+            q = np.subtract(curve(t0 + s * (t1 - t0)), p0)
+            if chord_length > 0.0:
+                along = min(max(float(q @ chord) / chord_length**2, 0.0), 1.0)
+                worst = max(worst, float(np.hypot(*(q - along * chord))))
+            else:
+                worst = max(worst, float(np.hypot(*q)))
+        if worst <= tolerance:
+            return [p1]
+    elif depth >= _MAX_DEPTH:
+        return [p1]
+    tm = 0.5 * (t0 + t1)
+    pm = curve(tm)
+    return _flatten(curve, tolerance, depth + 1, t0, tm, p0, pm) + _flatten(
+        curve, tolerance, depth + 1, tm, t1, pm, p1
+    )
+
+
+def _arc_points(
+    center: tuple[float, float], radius: float, start: float, sweep: float, tolerance: float
+) -> list[tuple[float, float]]:
+    """Points on a circular arc after its start, at equal angles, with sagitta at most ``tolerance``."""
+    if radius <= tolerance:
+        count = 1
+    else:
+        # sagitta r (1 - cos(dphi / 2)) <= tolerance
+        dphi = 2.0 * math.acos(max(-1.0, 1.0 - tolerance / radius))
+        count = max(1, math.ceil(abs(sweep) / dphi))
+    angles = start + sweep * np.arange(1, count + 1) / count
+    return [(center[0] + radius * math.cos(a), center[1] + radius * math.sin(a)) for a in angles]
+
+
+# ---------------------------------------------------------------------------------------------------- CSV
+
+
+def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> Points:
+    """Read a profile from a CSV file of ``x,y`` rows.
+
+    A header row is optional; when present it must name an ``x`` and a ``y`` column (any order, any other
+    columns ignored). Without a header the first two columns are x and y. Blank lines and lines starting with
+    ``#`` are skipped. ``tolerance`` is unused (the points are taken as they are).
+    """
+    path = Path(path)
+    lines = _read_lines(path)
+    x_col, y_col = 0, 1
+    rows: list[tuple[float, float]] = []
+    header_seen = False
+    for number, line in lines:
+        cells = [cell.strip() for cell in line.split(",")]
+        if not rows and not header_seen and not _is_number(cells[0]):
+            names = [cell.lower() for cell in cells]
+            if "x" not in names or "y" not in names:
+                raise SpecError(
+                    f"line {number}: header {line!r} names no x and y columns; expected e.g. 'x,y'",
+                    source=str(path),
+                )
+            x_col, y_col = names.index("x"), names.index("y")
+            header_seen = True
+            continue
+        try:
+            rows.append((float(cells[x_col]), float(cells[y_col])))
+        except (ValueError, IndexError):
+            raise SpecError(
+                f"line {number}: expected numbers in columns x and y, got {line!r}", source=str(path)
+            ) from None
+    return np.array(rows, dtype=float).reshape(-1, 2)
+
+
+def write_profile_csv(path: str | Path, points: ArrayLike) -> None:
+    """Write a profile as a CSV file with an ``x,y`` header (12 significant digits)."""
+    pts = np.asarray(points, dtype=float)
+    lines = ["x,y"] + [f"{x:.12g},{y:.12g}" for x, y in pts]
+    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+# ------------------------------------------------------------------------------------------- Selig .dat
+
+
+def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> Points:
+    """Read an airfoil in Selig format: a name line, then one ``x y`` pair per line.
+
+    The points run from the trailing edge over the upper surface to the leading edge and back along the lower
+    surface. A file without the name line is accepted. Lednicer files (upper and lower surfaces listed
+    separately after a line of point counts) are recognised and refused. ``tolerance`` is unused.
+    """
+    path = Path(path)
+    rows: list[tuple[float, float]] = []
+    for index, (number, line) in enumerate(_read_lines(path)):
+        cells = line.replace(",", " ").split()
+        values = [_to_float(cell) for cell in cells]
+        if index == 0 and (len(values) != 2 or None in values):
+            continue  # the airfoil's name
+        if len(values) != 2 or values[0] is None or values[1] is None:
+            raise SpecError(f"line {number}: expected two numbers 'x y', got {line!r}", source=str(path))
+        x, y = float(values[0]), float(values[1])
+        if not rows and x > 1.5 and y > 1.5 and x.is_integer() and y.is_integer():
+            raise SpecError(
+                f"line {number}: looks like a Lednicer point-count line {line!r}; expected Selig format "
+                "(one list from the trailing edge over the upper surface and back along the lower)",
+                source=str(path),
+            )
+        rows.append((x, y))
+    return np.array(rows, dtype=float).reshape(-1, 2)
+
+
+def write_profile_dat(path: str | Path, points: ArrayLike, name: str | None = None) -> None:
+    """Write a profile in Selig format: ``name`` (the file stem by default), then ``x y`` lines."""
+    pts = np.asarray(points, dtype=float)
+    title = name if name is not None else Path(path).stem
+    lines = [title] + [f"{x: .12g} {y: .12g}" for x, y in pts]
+    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+# ---------------------------------------------------------------------------------------------------- SVG
+
+
+def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> Points:
+    """Read a profile from an SVG drawing holding exactly one shape (a path, polyline, polygon, line, ...).
+
+    Coordinates are the drawing's user units (those of its ``viewBox``) with transforms applied and the y axis
+    turned to point up (SVG's points down), so the curve looks as it does in a browser. The shape must be one
+    continuous curve (one ``M`` command). Arcs and Bézier curves are flattened to ``tolerance`` times the
+    shape's size; a closing ``Z`` returns to the first point.
+    """
+    import svgelements as svg_lib
+
+    path = Path(path)
+    _check_readable(path)
+    try:
+        document = svg_lib.SVG.parse(str(path), reify=True)
+    except Exception as exc:  # svgelements raises bare parser errors of several kinds
+        raise SpecError(
+            f"not a readable SVG drawing ({exc}); expected an SVG file", source=str(path)
+        ) from None
+    shapes = [element for element in document.elements() if isinstance(element, svg_lib.Shape)]
+    shapes = [shape for shape in shapes if len(svg_lib.Path(shape)) > 0]
+    if len(shapes) != 1:
+        raise SpecError(
+            f"found {len(shapes)} shapes; expected exactly one path (or polyline, polygon, line)",
+            source=str(path),
+        )
+    outline = svg_lib.Path(shapes[0])
+    user_units = ~svg_lib.Matrix(document.viewbox_transform) if document.viewbox_transform else None
+    if user_units is not None:
+        outline = outline * user_units
+        outline.reify()
+    segments = [segment for segment in outline.segments() if not isinstance(segment, svg_lib.Move)]
+    moves = sum(isinstance(segment, svg_lib.Move) for segment in outline.segments())
+    if moves > 1:
+        raise SpecError(
+            f"the path has {moves} parts (M commands); expected one continuous curve", source=str(path)
+        )
+    if not segments:
+        raise SpecError("the shape has no points; expected a curve of at least 2 points", source=str(path))
+    defining: list[tuple[float, float]] = []
+    for segment in segments:
+        anchors = (segment.start, segment.end, *(getattr(segment, name, None) for name in _CONTROLS))
+        defining += [(float(point.x), float(point.y)) for point in anchors if point is not None]
+        if isinstance(segment, svg_lib.Arc):
+            box = segment.bbox()
+            defining += [(box[0], box[1]), (box[2], box[3])]
+    absolute = tolerance * _size(np.array(defining, dtype=float))
+    first = segments[0].start
+    points: list[tuple[float, float]] = [(float(first.x), float(first.y))]
+    for segment in segments:
+        if isinstance(segment, svg_lib.Close) and segment.start == segment.end:
+            continue  # "Z" after the curve already returned to its start adds nothing
+        if isinstance(segment, (svg_lib.Line, svg_lib.Close)):
+            points.append((float(segment.end.x), float(segment.end.y)))
+        else:
+
+            def curve(t: float, segment: Any = segment) -> tuple[float, float]:
+                point = segment.point(t)
+                return (float(point.x), float(point.y))
+
+            points += _flatten(curve, absolute)
+    pts = np.array(points, dtype=float)
+    return np.column_stack([pts[:, 0], -pts[:, 1]]) + 0.0  # + 0.0 turns -0.0 into 0.0
+
+
+def write_profile_svg(path: str | Path, points: ArrayLike) -> None:
+    """Write a profile as an SVG drawing with one path of straight pieces (y up, as :func:`read_profile_svg`)."""
+    pts = np.asarray(points, dtype=float)
+    d = "M " + " L ".join(f"{x:.12g},{-y:.12g}" for x, y in pts)
+    Path(path).write_text(_svg_document([_svg_path(d, "#1f77b4")], [pts]), encoding="utf-8")
+
+
+def _svg_path(d: str, colour: str, *, dashed: bool = False, label: str | None = None) -> str:
+    dash = ' stroke-dasharray="4 3"' if dashed else ""
+    title = f"<title>{_xml_escape(label)}</title>" if label else ""
+    return (
+        f'<path d="{d}" fill="none" stroke="{colour}" stroke-width="1.5" '
+        f'vector-effect="non-scaling-stroke"{dash}>{title}</path>'
+    )
+
+
+def _svg_document(body: Iterable[str], extents: Sequence[Points], pixels: float = 800.0) -> str:
+    """An SVG document whose viewBox holds every point of ``extents`` (profile coordinates, y up)."""
+    everything = np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents])
+    lo, hi = everything.min(axis=0), everything.max(axis=0)
+    margin = 0.05 * _size(everything)
+    x0, y0 = lo[0] - margin, -hi[1] - margin
+    width, height = hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin
+    scale = pixels / max(width, height)
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{width * scale:.1f}" height="{height * scale:.1f}" '
+        f'viewBox="{x0:.12g} {y0:.12g} {width:.12g} {height:.12g}">',
+        *body,
+        "</svg>",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _xml_escape(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
+
+
+# ---------------------------------------------------------------------------------------------------- DXF
+
+
+def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> Points:
+    """Read a profile from a DXF drawing whose model space holds exactly one LWPOLYLINE, POLYLINE or SPLINE.
+
+    Polyline bulges (arc pieces) are flattened exactly onto their arcs, splines with ezdxf's adaptive
+    flattening; both to ``tolerance`` times the size of the entity's vertices or control points. A polyline
+    flagged closed returns to its first point. Only x and y are read (the drawing is taken as planar).
+    """
+    import ezdxf
+
+    path = Path(path)
+    _check_readable(path)
+    try:
+        document = ezdxf.readfile(str(path))
+    except (OSError, ezdxf.DXFError) as exc:
+        raise SpecError(
+            f"not a readable DXF drawing ({exc}); expected a DXF file", source=str(path)
+        ) from None
+    entities = list(document.modelspace().query("LWPOLYLINE POLYLINE SPLINE"))
+    if len(entities) != 1:
+        raise SpecError(
+            f"found {len(entities)} LWPOLYLINE/POLYLINE/SPLINE entities in model space; expected exactly one",
+            source=str(path),
+        )
+    entity = entities[0]
+    kind = entity.dxftype()
+    if kind == "SPLINE":
+        spline = entity.construction_tool()
+        control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
+        absolute = tolerance * _size(control)
+        return np.array([(v.x, v.y) for v in spline.flattening(absolute, segments=8)], dtype=float)
+    if kind == "LWPOLYLINE":
+        vertices = [(float(x), float(y), float(bulge)) for x, y, bulge in entity.get_points("xyb")]
+        closed = bool(entity.closed)
+    else:
+        if not entity.is_2d_polyline and not entity.is_3d_polyline:
+            raise SpecError(
+                f"the POLYLINE is a {entity.get_mode()}; expected a 2-D or 3-D polyline", source=str(path)
+            )
+        vertices = [
+            (float(v.dxf.location.x), float(v.dxf.location.y), float(v.dxf.get("bulge", 0.0)))
+            for v in entity.vertices
+        ]
+        closed = bool(entity.is_closed)
+    return _bulge_polyline(vertices, closed, tolerance)
+
+
+def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, tolerance: float) -> Points:
+    """Flatten polyline vertices ``(x, y, bulge)`` whose bulge turns the piece after a vertex into an arc."""
+    from ezdxf.math import bulge_to_arc
+
+    if not vertices:
+        return np.empty((0, 2))
+    absolute = tolerance * _size(np.array([v[:2] for v in vertices], dtype=float))
+    chain = [*vertices, vertices[0]] if closed else vertices
+    points = [chain[0][:2]]
+    for (x0, y0, bulge), (x1, y1, _) in zip(chain[:-1], chain[1:], strict=True):
+        if bulge == 0.0 or (x0, y0) == (x1, y1):
+            points.append((x1, y1))
+            continue
+        center, _start, _end, radius = bulge_to_arc((x0, y0), (x1, y1), bulge)
+        sweep = 4.0 * math.atan(bulge)  # included angle; positive bulge turns counter-clockwise
+        begin = math.atan2(y0 - center.y, x0 - center.x)
+        arc = _arc_points((center.x, center.y), radius, begin, sweep, absolute)
+        arc[-1] = (x1, y1)  # land exactly on the next vertex
+        points += arc
+    return np.array(points, dtype=float)
+
+
+def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:
+    """Write a profile as a DXF drawing with one LWPOLYLINE (flagged closed, without the repeated point, when
+    the profile returns to its first point)."""
+    import ezdxf
+
+    pts = np.asarray(points, dtype=float)
+    closed = is_closed(pts)
+    document = ezdxf.new("R2010")
+    document.modelspace().add_lwpolyline(pts[:-1] if closed else pts, format="xy", close=closed)
+    document.saveas(str(path))
+
+
+# ------------------------------------------------------------------------------------------- registry
+
+
+@dataclass(frozen=True)
+class ProfileFormat:
+    """One profile file format: its suffixes, a one-line description, and its reader and writer."""
+
+    name: str
+    suffixes: tuple[str, ...]
+    description: str
+    read: Callable[[Path, float], Points]
+    write: Callable[[Path, Points], None]
+
+
+FORMATS: dict[str, ProfileFormat] = {}
+"""Every profile format by lower-case suffix (``".csv"``, ``".dat"``, ``".svg"``, ``".dxf"``)."""
+
+
+def register_format(fmt: ProfileFormat) -> None:
+    """Add a profile format to :data:`FORMATS` under each of its suffixes."""
+    for suffix in fmt.suffixes:
+        FORMATS[suffix.lower()] = fmt
+
+
+register_format(
+    ProfileFormat("CSV", (".csv",), "x,y columns, header optional", read_profile_csv, write_profile_csv)
+)
+register_format(
+    ProfileFormat(
+        "Selig", (".dat",), "Selig airfoil: name line, then x y pairs", read_profile_dat, write_profile_dat
+    )
+)
+register_format(
+    ProfileFormat(
+        "SVG", (".svg",), "one SVG path (y up, curves flattened)", read_profile_svg, write_profile_svg
+    )
+)
+register_format(
+    ProfileFormat(
+        "DXF", (".dxf",), "one DXF LWPOLYLINE, POLYLINE or SPLINE", read_profile_dxf, write_profile_dxf
+    )
+)
+
+
+def _format_for(path: Path) -> ProfileFormat:
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        known = ", ".join(sorted(FORMATS))
+        got = f"suffix {path.suffix!r}" if path.suffix else "no suffix"
+        raise SpecError(f"unknown profile format ({got}); expected one of {known}", source=str(path))
+    return fmt
+
+
+def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> Points:
+    """Read a design profile from a file, choosing the format by its suffix, and check it.
+
+    Parameters
+    ----------
+    path
+        A ``.csv``, ``.dat`` (Selig), ``.svg`` or ``.dxf`` file (see :data:`FORMATS`).
+    tolerance
+        Flattening tolerance of curved geometry, a fraction of the drawing's size.
+
+    Returns
+    -------
+    numpy.ndarray
+        The polyline, shape ``(N, 2)``, ``N >= 2``, checked by :func:`check_profile`.
+
+    Raises
+    ------
+    SpecError
+        For an unknown suffix, a missing or unreadable file, or a curve that fails :func:`check_profile`.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> save_profile(folder / "line.csv", [[0.0, 0.0], [1.0, 0.5]])
+    >>> load_profile(folder / "line.csv").tolist()
+    [[0.0, 0.0], [1.0, 0.5]]
+    >>> save_profile(folder / "dot.csv", [[0.0, 0.0]])
+    >>> load_profile(folder / "dot.csv")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    linkwork.errors.SpecError: .../dot.csv: a single point (0, 0); expected a curve of at least 2 points
+    """
+    path = Path(path)
+    fmt = _format_for(path)
+    _check_readable(path)
+    return check_profile(fmt.read(path, tolerance), source=path)
+
+
+def save_profile(path: str | Path, points: ArrayLike) -> None:
+    """Write a profile in the format its suffix names (the inverse of :func:`load_profile`)."""
+    path = Path(path)
+    _format_for(path).write(path, np.asarray(points, dtype=float))
+
+
+# --------------------------------------------------------------------------------------------- helpers
+
+
+def _check_readable(path: Path) -> None:
+    if not path.exists():
+        raise SpecError("file not found; expected a profile file", source=str(path))
+    if not path.is_file():
+        raise SpecError("is a folder; expected a profile file", source=str(path))
+    try:
+        with path.open("rb"):
+            pass
+    except OSError as exc:
+        raise SpecError(
+            f"cannot be read ({exc.strerror}); expected a readable file", source=str(path)
+        ) from None
+
+
+def _read_lines(path: Path) -> list[tuple[int, str]]:
+    """Numbered (1-based), stripped, non-blank lines that are not ``#`` comments."""
+    _check_readable(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError:
+        raise SpecError("is not a UTF-8 text file; expected text", source=str(path)) from None
+    return [
+        (number, line.strip())
+        for number, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+
+
+def _to_float(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def _is_number(text: str) -> bool:
+    return _to_float(text) is not None

@@ -1,0 +1,88 @@
+"""Hedgepeth's n-sided deployable hoops: n rods of two mirror types that fold into a bundle (Sec. 3).
+
+The rods are the paper's isosceles-triangle rods (Eqs. (7)-(9)), each described by the transform
+``[Rz(phi) Rx(omega) Rz(psi), v]`` with ``v = [cos a3, 0, sin a3]`` (unit rod length along the apex line), and the
+loop is ``T1 T_A T2 T_B ... = I`` (Eq. (12)) with joint angles zero in the folded bundle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from linkwork.errors import SpecError
+from linkwork.kinematics.chains import from_rods
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.linkages.registry import LinkageEntry, Param, register
+
+
+def hedgepeth_angles(n: int) -> dict[str, float]:
+    """The rod geometry of the n-sided hoop (radians): alpha1..3 and the type-1 Euler angles phi, omega, psi."""
+    alpha1 = 2.0 * np.pi / n  # Eq. (7)
+    alpha2 = np.pi / 2.0 - alpha1 / 2.0  # Eq. (8)
+    alpha3 = np.arctan(np.cos(alpha1 / 2.0) ** 2 / np.sin(alpha1 / 2.0))  # Eq. (9)
+    p = np.cos(alpha3) * np.tan(alpha3) - np.sin(alpha3) * np.cos(alpha1)
+    q = np.sin(alpha3) * np.tan(alpha3) + np.cos(alpha3) * np.cos(alpha1)
+    r = np.sin(alpha1)
+    phi = -np.arctan(np.tan(alpha1 / 2.0) * np.sin(alpha3))
+    omega = np.pi / 2.0 + np.arctan(q / np.sqrt(p * p + r * r))
+    psi = -np.pi - phi
+    return {"alpha1": alpha1, "alpha2": alpha2, "alpha3": alpha3, "phi": phi, "omega": omega, "psi": psi}
+
+
+def deployed_angle(n: int) -> float:
+    """Hinge angle theta_A of the deployed n-gon (radians), Eq. (10)."""
+    g = hedgepeth_angles(n)
+    a1, a3 = g["alpha1"], g["alpha3"]
+    inner = np.sin(np.pi / 2.0 - np.pi / n) + np.sin(a1 / 2.0) ** 2 * np.tan(a3)
+    return float(np.arccos(1.0 - 2.0 * np.cos(a3) ** 2 * inner**2))
+
+
+def rod_transforms(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The constant 4x4 transforms of rod types 1 and 2 (type 2 has the Euler angles negated)."""
+    from linkwork.kinematics.chains import rod_transform
+
+    g = hedgepeth_angles(n)
+    v = [np.cos(g["alpha3"]), 0.0, np.sin(g["alpha3"])]
+    return (
+        rod_transform(g["phi"], g["omega"], g["psi"], v),
+        rod_transform(-g["phi"], -g["omega"], -g["psi"], v),
+    )
+
+
+def hedgepeth(n: int = 6, couple: bool | None = None) -> Mechanism:
+    """Hedgepeth's n-rod hoop (n even, >= 4) in the folded bundle, joints ``A, B, C, ...`` at zero.
+
+    For n >= 8 the hoop has mobility n - 5 at the bundle, so, as the paper does for its 10-sided hoop (Fig. 2),
+    n/2-fold symmetry is imposed by default: ``A = C = E = ...`` and ``B = D = F = ...``. Pass ``couple=False`` to
+    get the free loop, or ``couple=True`` to impose the symmetry also for n = 4, 6.
+    """
+    if n < 4 or n % 2:
+        raise SpecError(f"hedgepeth: n must be an even number >= 4, got {n}")
+    g = hedgepeth_angles(n)
+    v = [float(np.cos(g["alpha3"])), 0.0, float(np.sin(g["alpha3"]))]
+    rods = []
+    for k in range(n):
+        sign = 1.0 if k % 2 == 0 else -1.0
+        rods.append({"phi": sign * g["phi"], "omega": sign * g["omega"], "psi": sign * g["psi"], "v": v})
+    names = [_joint_name(k) for k in range(n)]
+    meta = {"linkage": "hedgepeth", "n": n, "deployed_A": deployed_angle(n)}
+    mech, _ = from_rods(f"Hedgepeth hoop n={n}", rods, [0.0] * n, joint_names=names, meta=meta)
+    if couple if couple is not None else n >= 8:
+        mech = mech.with_couplings([names[0::2], names[1::2]])
+    return mech
+
+
+def _joint_name(k: int) -> str:
+    """A, B, ..., Z, then A1, B1, ...: short names for large hoops."""
+    letter = chr(ord("A") + k % 26)
+    return letter if k < 26 else f"{letter}{k // 26}"
+
+
+register(
+    LinkageEntry(
+        name="hedgepeth",
+        build=lambda n: hedgepeth(int(n)),
+        summary="Hedgepeth's n-sided deployable hoop, folded bundle (Gan & Pellegrino 2006, Sec. 3)",
+        params={"n": Param(6, "int", "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry")},
+    )
+)

@@ -1,0 +1,31 @@
+"""Planar rotations and the local frame of a segment (first point at the origin, chord along ``+x``)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Array = NDArray[np.float64]
+
+
+def rotation(angle: ArrayLike) -> Array:
+    """Rotation matrices ``(..., 2, 2)`` of angles ``(...)`` (radians, counter-clockwise), Eq. (13)."""
+    angle = np.asarray(angle, dtype=float)
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([np.stack([c, -s], axis=-1), np.stack([s, c], axis=-1)], axis=-2)
+
+
+def chord_angle(points: ArrayLike) -> Array:
+    """Angle ``(...)`` of the chord from the first to the last of ``(..., n, 2)`` points (0 if they coincide)."""
+    pts = np.asarray(points, dtype=float)
+    chord = pts[..., -1, :] - pts[..., 0, :]
+    return np.arctan2(chord[..., 1], chord[..., 0])
+
+
+def to_local_frame(points: ArrayLike) -> Array:
+    """Points ``(..., n, 2)`` moved so the first is at the origin and the chord lies along ``+x``."""
+    pts = np.asarray(points, dtype=float)
+    rel = pts - pts[..., :1, :]
+    c_s = -chord_angle(pts)
+    c, s = np.cos(c_s)[..., None], np.sin(c_s)[..., None]
+    return np.stack([c * rel[..., 0] - s * rel[..., 1], s * rel[..., 0] + c * rel[..., 1]], axis=-1)
