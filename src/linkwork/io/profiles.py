@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from linkwork.errors import SpecError
 
 if TYPE_CHECKING:
-    from linkwork.synthesis.result import SynthesisResult
+    from linkwork.synthesis.result import JoinedProfile, SynthesisResult
 
 FLATTEN_TOLERANCE = 1e-4
 """Largest distance of a flattened piece from the true curve, as a fraction of the drawing's size."""
@@ -426,8 +426,7 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 def write_profile_svg(path: str | Path, points: ArrayLike) -> None:
     """Write a profile as an SVG drawing with one path of straight pieces (y up, as :func:`read_profile_svg`)."""
     pts = np.asarray(points, dtype=float)
-    d = "M " + " L ".join(f"{x:.12g},{-y:.12g}" for x, y in pts)
-    Path(path).write_text(_svg_document([_svg_path(d, "#1f77b4")], [pts]), encoding="utf-8")
+    Path(path).write_text(_svg_document([_svg_path(_svg_d(pts), "#1f77b4")], [pts]), encoding="utf-8")
 
 
 def _svg_path(d: str, colour: str, *, dashed: bool = False, label: str | None = None) -> str:
@@ -542,6 +541,93 @@ def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:
     document = ezdxf.new("R2010")
     document.modelspace().add_lwpolyline(pts[:-1] if closed else pts, format="xy", close=closed)
     document.saveas(str(path))
+
+
+# --------------------------------------------------------------------------------------- chain outlines
+
+
+def final_chain(result: SynthesisResult) -> tuple[JoinedProfile, ...]:
+    """The chain as built, posed on every profile: after merging joints into compound segments when any were
+    merged (Sec. 6 of the paper), else the joined chain (Sec. 5)."""
+    if result.compound is not None and result.compound.merged:
+        return result.compound.profiles
+    return result.joined
+
+
+def write_outline_svg(path: str | Path, result: SynthesisResult) -> None:
+    """Write the chain's outline on every profile as one SVG drawing (y up, profile coordinates).
+
+    One group per profile (``id`` the profile's name) holds its target profile (dashed), the chain (solid) and
+    its joints and two ends (circles); the chain is the final one (:func:`final_chain`), without the joints
+    merged into compound segments.
+    """
+    chains = final_chain(result)
+    joints = _live_joints(result)
+    extents = [t.points for t in result.targets] + [c.points for c in chains]
+    radius = 0.006 * _size(np.vstack(extents))
+    body = []
+    for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
+        name = target.name or f"profile {j + 1}"
+        colour = _OUTLINE_COLOURS[j % len(_OUTLINE_COLOURS)]
+        body.append(f'<g id="{_xml_escape(name)}">')
+        body.append(_svg_path(_svg_d(target.points), "#7f7f7f", dashed=True, label=f"{name}: target profile"))
+        body.append(_svg_path(_svg_d(chain.points), colour, label=f"{name}: chain {result.design}"))
+        body += [
+            f'<circle cx="{x:.12g}" cy="{-y:.12g}" r="{radius:.6g}" fill="white" stroke="black" '
+            f'stroke-width="1" vector-effect="non-scaling-stroke"/>'
+            for x, y in chain.joints[joints]
+        ]
+        body.append("</g>")
+    Path(path).write_text(_svg_document(body, extents), encoding="utf-8")
+
+
+def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
+    """Write the chain's outline on every profile as one DXF drawing for CAD.
+
+    Per profile ``NAME``: layer ``NAME-target`` holds the target profile, ``NAME-chain`` the chain (an
+    LWPOLYLINE through the chain's points) and ``NAME-joints`` a circle at every joint and at both ends; the
+    chain is the final one (:func:`final_chain`), without the joints merged into compound segments.
+    """
+    import ezdxf
+
+    chains = final_chain(result)
+    joints = _live_joints(result)
+    radius = 0.006 * _size(np.vstack([t.points for t in result.targets]))
+    document = ezdxf.new("R2010")
+    space = document.modelspace()
+    for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
+        name = _dxf_layer_name(target.name or f"profile {j + 1}")
+        colour = j % 6 + 1  # AutoCAD colour index 1..6
+        for suffix in ("target", "chain", "joints"):
+            document.layers.add(f"{name}-{suffix}", color=8 if suffix == "target" else colour)
+        space.add_lwpolyline(target.points, format="xy", dxfattribs={"layer": f"{name}-target"})
+        space.add_lwpolyline(chain.points, format="xy", dxfattribs={"layer": f"{name}-chain"})
+        for x, y in chain.joints[joints]:
+            space.add_circle((float(x), float(y)), radius, dxfattribs={"layer": f"{name}-joints"})
+    document.saveas(str(path))
+
+
+def _live_joints(result: SynthesisResult) -> list[int]:
+    """Rows of ``JoinedProfile.joints`` that are joints of the final chain: the two ends and every revolute
+    joint not merged into a compound segment."""
+    merged = set(result.compound.merged) if result.compound is not None else set()
+    count = len(result.joined[0].joints)
+    return [k for k in range(count) if k in (0, count - 1) or (k - 1) not in merged]
+
+
+_OUTLINE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b")
+
+
+def _svg_d(points: Points) -> str:
+    return "M " + " L ".join(f"{x:.12g},{-y:.12g}" for x, y in points)
+
+
+def _dxf_layer_name(name: str) -> str:
+    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) become underscores."""
+    return "".join("_" if ch in _DXF_FORBIDDEN else ch for ch in name) or "profile"
+
+
+_DXF_FORBIDDEN = frozenset('<>/\\":;?*|=`')
 
 
 # ------------------------------------------------------------------------------------------- registry

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.synthesis.arc_segment import fit_arc_segment
+from linkwork.synthesis.error_kernels import ProfileTables
 from linkwork.synthesis.frames import to_local_frame
 from linkwork.synthesis.mean_segment import fit_mean_segment
 from linkwork.synthesis.reference import arc_segment_errors, mean_segment_errors
@@ -42,6 +43,7 @@ class SegmentFitter:
 
     def __init__(self, targets: Sequence[TargetProfile], *, cached: bool = True, vectorised: bool = True) -> None:
         self.points = [t.points for t in targets]
+        self.tables = ProfileTables(self.points)
         self.cached = cached
         self.vectorised = vectorised
         self.cache: dict[tuple[str, tuple[int, ...], tuple[int, ...]], Array] = {}
@@ -61,10 +63,10 @@ class SegmentFitter:
             if hit is not None:
                 self.hits += 1
                 return hit
-        pieces = self.pieces(starts, counts)
         if self.vectorised:
-            err = fit_mean_segment(np.stack(pieces)).errors if kind == "M" else fit_arc_segment(pieces).errors
+            err = self.tables.mean_errors(key[1], key[2][0]) if kind == "M" else self.tables.arc_errors(*key[1:])
         else:
+            pieces = self.pieces(starts, counts)
             plain = [[(float(x), float(y)) for x, y in z] for z in pieces]
             err = np.array(mean_segment_errors(plain) if kind == "M" else arc_segment_errors(plain))
         if self.cached:

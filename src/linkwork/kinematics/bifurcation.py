@@ -1,0 +1,291 @@
+"""Bifurcation points: locate a sign change of the test function, and find every branch tangent there.
+
+At a located point the reduced Jacobian ``J`` has a null space ``N`` of dimension 2 (a simple bifurcation). A
+branch tangent ``t = N a`` satisfies the quadratic branching equation ``l^T H(t, t) = 0`` for every left null vector
+``l`` of ``J``, with ``H`` the exact Hessian from Lie brackets (Kumar & Pellegrino 2000). When those quadratic forms
+vanish (degenerate) or the kernel is larger than two, the branches are found instead by intersecting the solution
+set with a small sphere around the point.
+
+References
+----------
+P. Kumar, S. Pellegrino, "Computation of kinematic paths and bifurcation points", Int. J. Solids Struct. 37
+(2000) 7003-7027.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.closure import hessian, reduce
+from linkwork.kinematics.march import evaluate, tangent_and_test
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.rank import Tolerances, numerical_rank
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class Workspace:
+    """The flattened mechanism and scratch arrays the compiled kernels need."""
+
+    twists: Array
+    loop_joint: NDArray[np.int64]
+    loop_sign: NDArray[np.int64]
+    loop_ptr: NDArray[np.int64]
+    rows: NDArray[np.int64]
+    groups: NDArray[np.int64]
+    q: Array
+    res: Array
+    jac: Array
+
+    @classmethod
+    def of(cls, mech: Mechanism) -> Workspace:
+        """Scratch space for ``mech``."""
+        lj, ls, lp = mech.loop_arrays()
+        return cls(
+            twists=mech.twists,
+            loop_joint=lj,
+            loop_sign=ls,
+            loop_ptr=lp,
+            rows=np.array(mech.rows, dtype=np.int64),
+            groups=mech.groups,
+            q=np.empty(mech.n_joints),
+            res=np.empty(mech.n_equations),
+            jac=np.empty((mech.n_equations, mech.n_unknowns)),
+        )
+
+    def evaluate(self, u: Array) -> tuple[float, Array, Array]:
+        """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
+        r = evaluate(
+            self.twists, self.loop_joint, self.loop_sign, self.loop_ptr, self.rows, self.groups,
+            np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac,
+        )
+        return float(r), self.res.copy(), self.jac.copy()
+
+
+def correct_on_plane(
+    ws: Workspace, u_pred: Array, normal: Array, tol: Tolerances, max_iter: int = 30
+) -> tuple[Array, float, bool]:
+    """Correct ``u_pred`` onto the loop within the hyperplane through it orthogonal to ``normal`` (Eq. (28))."""
+    m = u_pred.shape[0]
+    n = normal / np.linalg.norm(normal)
+    # Orthonormal basis V of the hyperplane's directions.
+    Q, _ = np.linalg.qr(np.column_stack([n, np.eye(m)]))
+    V = Q[:, 1:m]
+    u = u_pred.copy()
+    r = np.inf
+    prev = np.inf
+    for _ in range(max_iter):
+        r, res, jac = ws.evaluate(u)
+        if r < tol.closure or (r < 100 * tol.closure and r > 0.5 * prev):
+            return u, r, True
+        prev = r
+        A = jac @ V
+        U, s, Wt = np.linalg.svd(A, full_matrices=False)
+        keep = s > tol.truncate * s[0]
+        u = u - V @ (Wt[keep].T @ ((U[:, keep].T @ res) / s[keep]))
+    return u, r, r < 100 * tol.closure
+
+
+def locate(
+    ws: Workspace,
+    u_a: Array,
+    t_a: Array,
+    basis_a: Array,
+    u_b: Array,
+    t_b: Array,
+    r_path: int,
+    tol: Tolerances,
+    n_sigma: int,
+) -> tuple[Array, float]:
+    """Locate the zero of the test function between path points ``a`` and ``b`` (Illinois regula falsi).
+
+    Points are parametrised by ``h = t_a . (u - u_a)``. Each trial point is predicted by the cubic Hermite
+    interpolant between the two bracketing points (with their tangents) and corrected in the hyperplane of its
+    ``h``: the prediction error, fourth order in the bracket, stays far below the distance to the other branch
+    crossing there, so the trials stay on the branch being traced. Returns the point and the bracket width.
+    """
+
+    def evaluate_at(u: Array) -> tuple[float, Array]:
+        _, _, jac = ws.evaluate(u)
+        t = np.empty_like(t_a)
+        value = tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
+        return float(value), t
+
+    def hermite(x: float, lo: tuple[float, Array, Array], hi: tuple[float, Array, Array]) -> Array:
+        (h0, u0, t0), (h1, u1, t1) = lo, hi
+        d = h1 - h0
+        s = (x - h0) / d
+        m0, m1 = t0 / (t_a @ t0), t1 / (t_a @ t1)
+        return (
+            (2 * s**3 - 3 * s**2 + 1) * u0
+            + (s**3 - 2 * s**2 + s) * d * m0
+            + (-2 * s**3 + 3 * s**2) * u1
+            + (s**3 - s**2) * d * m1
+        )
+
+    f_lo, _ = evaluate_at(u_a)
+    f_hi, t_b2 = evaluate_at(u_b)
+    lo: tuple[float, Array, Array] = (0.0, u_a.copy(), t_a.copy())
+    hi: tuple[float, Array, Array] = (float(t_a @ (u_b - u_a)), u_b.copy(), t_b2)
+    side = 0
+    best = u_b.copy()
+    for _ in range(200):
+        if abs(hi[0] - lo[0]) < tol.locate:
+            break
+        x = hi[0] - f_hi * (hi[0] - lo[0]) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * (lo[0] + hi[0])
+        if not (min(lo[0], hi[0]) < x < max(lo[0], hi[0])):
+            x = 0.5 * (lo[0] + hi[0])
+        u_x, _, _ = correct_on_plane(ws, hermite(x, lo, hi), t_a, tol)
+        f_x, t_x = evaluate_at(u_x)
+        best = u_x
+        if f_x == 0.0:
+            return u_x, 0.0
+        if (f_x > 0) == (f_hi > 0):
+            hi, f_hi = (x, u_x, t_x), f_x
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+        else:
+            lo, f_lo = (x, u_x, t_x), f_x
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+    return best, abs(hi[0] - lo[0])
+
+
+def branch_tangents(
+    mech: Mechanism,
+    ws: Workspace,
+    u: Array,
+    tol: Tolerances,
+    radius: float = 1e-3,
+    rank_hint: int | None = None,
+) -> tuple[Array, str, int, Array]:
+    """Every branch tangent (rows, unit, in the unknowns, one per line through the point) at a singular ``u``.
+
+    ``rank_hint``: the rank a located sign change of the test function implies (one below the path's); it is
+    taken when the singular value it makes zero is below ``tol.loose`` relative, since a point located on a
+    branch through a singular point is only as close to it as the corrector's residual allows (quadratically).
+    Returns ``(tangents, method, rank, sigma)`` with ``method`` "quadratic", "sphere" or "none".
+    """
+    _, _, jac = ws.evaluate(u)
+    U, s, Vt = np.linalg.svd(jac)
+    rank = numerical_rank(s, tol)
+    if rank_hint is not None and rank_hint < rank and s[rank_hint] <= tol.loose * s[0]:
+        rank = rank_hint
+    m = jac.shape[1]
+    N = Vt[rank:].T  # (m, d) null space
+    d = N.shape[1]
+    if d < 2:  # no rank drop: not a bifurcation point
+        return np.zeros((0, m)), "none", rank, s
+    L = U[:, rank:]  # left null space
+    if d == 2 and L.shape[1] > 0:
+        H = reduce(mech, hessian(mech, mech.q_from_u(u)))  # (E, m, m), exact (Lie brackets)
+        forms = np.einsum("el,eab,ai,bj->lij", L, H, N, N)  # (c, 2, 2): l^T H(N a, N a)
+        coeffs = np.stack([forms[:, 0, 0], 2.0 * forms[:, 0, 1], forms[:, 1, 1]], axis=1)
+        scale = np.abs(H).max() if H.size else 1.0
+        _, cs, cv = np.linalg.svd(coeffs)
+        significant = cs > 1e-6 * max(scale, 1e-300)
+        if np.any(significant):
+            phis = _common_roots(cv[: int(significant.sum())], cs[: int(significant.sum())])
+            if phis:
+                tangents = np.array([N @ np.array([np.cos(p), np.sin(p)]) for p in phis])
+                return tangents, "quadratic", rank, s
+    return _sphere_tangents(ws, u, N, radius, tol), "sphere", rank, s
+
+
+def _common_roots(forms: Array, weights: Array) -> list[float]:
+    """Angles ``phi`` in ``[0, pi)`` where every form ``a c^2 + b c s + c s^2`` vanishes (least squares)."""
+    if forms.shape[0] == 1:
+        a, b, c = forms[0]
+        roots = []
+        if abs(c) < 1e-12 * max(abs(a), abs(b), 1e-300):
+            roots.append(np.pi / 2)
+            if abs(b) > 0:
+                roots.append(float(np.arctan2(-a, b)))  # a + b tan = 0
+        else:
+            disc = b * b - 4 * a * c
+            if disc < -1e-12 * (b * b + abs(4 * a * c)):
+                return []
+            disc = max(disc, 0.0)
+            for sgn in (1.0, -1.0):
+                roots.append(float(np.arctan((-b + sgn * np.sqrt(disc)) / (2 * c))))
+        return sorted({round(r % np.pi, 12) for r in roots})
+    grid = np.linspace(0.0, np.pi, 1441)
+    c, s = np.cos(grid), np.sin(grid)
+    vals = (weights[:, None] * (forms[:, 0:1] * c * c + forms[:, 1:2] * c * s + forms[:, 2:3] * s * s)) ** 2
+    total = vals.sum(axis=0)
+    out = []
+    for i in range(1, len(grid) - 1):
+        if total[i] <= total[i - 1] and total[i] <= total[i + 1] and total[i] < 1e-6 * total.max():
+            out.append(float(grid[i]))
+    return out
+
+
+def _sphere_tangents(ws: Workspace, u: Array, N: Array, radius: float, tol: Tolerances) -> Array:
+    """Directions of the solution curves leaving ``u``: the solution set met by a small sphere (fallback)."""
+    d = N.shape[1]
+    rng = np.random.default_rng(0)
+    samples = rng.normal(size=(64 * d, d)) if d > 2 else None
+    if samples is None:
+        ang = np.linspace(0.0, 2 * np.pi, 72, endpoint=False)
+        samples = np.column_stack([np.cos(ang), np.sin(ang)])
+    samples /= np.linalg.norm(samples, axis=1, keepdims=True)
+    found: list[Array] = []
+    for a in samples:
+        direction = N @ a
+        v, _r, ok = correct_on_plane(ws, u + radius * direction, direction, tol)
+        if not ok:
+            continue
+        t = (v - u) / np.linalg.norm(v - u)
+        if all(abs(t @ f) < 0.999 for f in found):
+            found.append(t)
+    return np.array(found).reshape(len(found), N.shape[0])
+
+
+def polish(
+    ws: Workspace, u: Array, tangents: Array, tol: Tolerances, radius: float = 2e-3
+) -> tuple[Array, float]:
+    """Refine a located simple bifurcation point as the intersection of its two branches.
+
+    Closing a loop at a double point is only as accurate as the square root of the residual. Here each branch
+    is sampled instead at four regular points (signed distances ``-2r, -r, r, 2r`` along its tangent, corrected
+    in the hyperplanes there, where the corrector converges quadratically), a cubic is fitted through them, and
+    the point nearest both cubics is returned with the distance between them (the intersection's accuracy).
+    """
+    if tangents.shape[0] != 2:
+        return u, float("nan")
+    fits = []
+    for t in tangents:
+        t = t / np.linalg.norm(t)
+        params, points = [], []
+        for k in (-2.0, -1.0, 1.0, 2.0):
+            p, _, ok = correct_on_plane(ws, u + k * radius * t, t, tol)
+            if not ok:
+                return u, float("nan")
+            params.append(t @ (p - u))
+            points.append(p)
+        V = np.vander(np.array(params), 4)  # cubic through the four samples
+        fits.append((t, np.linalg.solve(V, np.array(points))))
+
+    def curve(i: int, x: float) -> Array:
+        return np.vander(np.array([x]), 4)[0] @ fits[i][1]
+
+    # Nearest points of the two curves: Gauss-Newton on (x1, x2).
+    x = np.zeros(2)
+    for _ in range(30):
+        d = curve(0, x[0]) - curve(1, x[1])
+        e = 1e-7
+        J = np.column_stack(
+            [(curve(0, x[0] + e) - curve(0, x[0] - e)) / (2 * e), -(curve(1, x[1] + e) - curve(1, x[1] - e)) / (2 * e)]
+        )
+        step = np.linalg.lstsq(J, -d, rcond=None)[0]
+        x += step
+        if np.linalg.norm(step) < 1e-15:
+            break
+    a, b = curve(0, x[0]), curve(1, x[1])
+    return 0.5 * (a + b), float(np.linalg.norm(a - b))

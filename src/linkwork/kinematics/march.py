@@ -1,0 +1,292 @@
+"""The compiled predictor-corrector march: the hot loop of tracing, one call for many steps.
+
+Each step: the predictor moves along the null vector of the reduced Jacobian (Sec. 4.1, oriented so consecutive
+tangents agree, ``t_k . t_{k-1} > 0``); the corrector is Gauss-Newton with the truncated-SVD pseudo-inverse
+(Eq. (28)), either minimum-norm over all unknowns (Moore-Penrose continuation) or with the drive joint held at
+its predicted value (the paper's equal steps of the drive). A signed test function, the determinant of the
+Jacobian restricted to its range (basis kept continuous) and bordered by the tangent, is recorded at every
+point: a sign change brackets a bifurcation.
+
+Stop codes returned by :func:`march`: see :data:`STOP_REASONS`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from linkwork.kinematics.kernels import closure_jacobian, expand
+
+BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING = 0, 1, 2, 3, 4, 5, 6
+STOP_REASONS = {
+    BUDGET: "step budget",
+    TARGET: "reached target",
+    CLOSED: "closed path",
+    FAILED: "corrector failed",
+    SIGN_CHANGE: "bifurcation",
+    LIMIT: "joint limit",
+    TURNING: "drive turning point",
+}
+
+
+@njit(cache=True)
+def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac):  # type: ignore[no-untyped-def]
+    """Residual and reduced Jacobian at unknowns ``u`` (``q``, ``res``, ``jac`` are work arrays)."""
+    expand(u, groups, q)
+    closure_jacobian(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, u.shape[0], res, jac)
+    return np.sqrt(np.sum(res * res))
+
+
+@njit(cache=True)
+def correct(  # type: ignore[no-untyped-def]
+    twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, truncate, max_iter, q, res, jac
+):
+    """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
+
+    ``held`` is the unknown kept fixed (-1: none, minimum-norm correction over all unknowns). Returns
+    ``(converged, iterations, residual)``. Accepts a residual that stalls below ``100 tol`` (round-off floor of
+    very long loops) and reports it.
+    """
+    m = u.shape[0]
+    prev = np.inf
+    for it in range(max_iter + 1):
+        r = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
+        if not np.isfinite(r):
+            return False, it, r
+        if r < tol:
+            return True, it, r
+        if r < 100.0 * tol and r > 0.5 * prev:
+            return True, it, r
+        if it == max_iter or (it >= 2 and r > prev):
+            return False, it, r
+        prev = r
+        if held >= 0:
+            for e in range(jac.shape[0]):
+                jac[e, held] = 0.0
+        U, s, Vt = np.linalg.svd(jac)
+        cut = truncate * s[0]
+        for i in range(s.shape[0]):
+            if s[i] <= cut:
+                break
+            c = 0.0
+            for e in range(res.shape[0]):
+                c += U[e, i] * res[e]
+            c /= s[i]
+            for a in range(m):
+                u[a] -= Vt[i, a] * c  # Eq. (28): - sum_i w_i u_i^T e / v_ii
+    return False, max_iter, prev
+
+
+@njit(cache=True)
+def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):  # type: ignore[no-untyped-def]
+    """Oriented null vector, singular values and the signed test function at the current Jacobian.
+
+    ``basis (E, r_path)`` is the previous oriented range basis, updated in place. Returns the test value
+    (0 when the path is not of mobility one with rank ``r_path``).
+    """
+    m = jac.shape[1]
+    U, s, Vt = np.linalg.svd(jac)
+    k = min(s.shape[0], sigma_out.shape[0])
+    for i in range(sigma_out.shape[0]):
+        sigma_out[i] = s[i] if i < k else 0.0
+    dot = 0.0
+    for a in range(m):
+        t_out[a] = Vt[m - 1, a]
+        dot += t_out[a] * t_prev[a]
+    if dot < 0.0:
+        for a in range(m):
+            t_out[a] = -t_out[a]
+    if r_path + 1 != m or r_path > U.shape[1]:
+        return 0.0
+    E = jac.shape[0]
+    # Keep the range basis continuous: align the new one's orientation with the previous one's.
+    Ur = np.ascontiguousarray(U[:, :r_path])
+    M = basis.T @ Ur
+    if np.linalg.det(M) < 0.0:
+        for e in range(E):
+            Ur[e, r_path - 1] = -Ur[e, r_path - 1]
+    for e in range(E):
+        for i in range(r_path):
+            basis[e, i] = Ur[e, i]
+    A = np.empty((m, m))
+    A[:r_path, :] = Ur.T @ jac
+    A[r_path, :] = t_out
+    return np.linalg.det(A)
+
+
+@njit(cache=True)
+def march(  # type: ignore[no-untyped-def]
+    twists,
+    loop_joint,
+    loop_sign,
+    loop_ptr,
+    rows,
+    groups,
+    u0,
+    t0,
+    u_home,
+    basis,
+    paper,
+    drive,
+    h0,
+    hmin,
+    hmax,
+    cos_turn,
+    target,
+    has_target,
+    tol,
+    truncate,
+    max_iter,
+    max_steps,
+    r_path,
+    periodic,
+    lo,
+    hi,
+    detect,
+    check_closed,
+    out_u,
+    out_t,
+    out_sigma,
+    out_res,
+    out_tau,
+    out_s,
+):
+    """March from ``(u0, t0)`` for at most ``max_steps`` steps; row 0 of the outputs is the start.
+
+    ``u_home`` is where the path began (for closed-path detection across several calls).
+
+    ``paper``: fixed steps of ``h0`` in the drive unknown, corrector with the drive held (the paper's mode);
+    otherwise adaptive arclength steps in ``[hmin, hmax]`` with the minimum-norm corrector. Returns
+    ``(count, code, h)``: rows written, the stop code and the last step length.
+    """
+    m = u0.shape[0]
+    E = loop_ptr.shape[0] - 1
+    E *= rows.shape[0]
+    q = np.empty(groups.shape[0])
+    res = np.empty(E)
+    jac = np.empty((E, m))
+    u = u0.copy()
+    t = t0.copy()
+    t_new = np.empty(m)
+    sig = np.empty(out_sigma.shape[1])
+    u_try = np.empty(m)
+    h = h0
+    r0 = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
+    tau = tangent_and_test(jac, t, basis, r_path, t_new, sig)
+    t[:] = t_new
+    out_u[0, :] = u
+    out_t[0, :] = t
+    out_sigma[0, :] = sig
+    out_res[0] = r0
+    out_tau[0] = tau
+    out_s[0] = 0.0
+    s_total = 0.0
+    basis_try = basis.copy()
+    far = 0.0
+    for a in range(m):
+        diff = u0[a] - u_home[a]
+        if periodic[a]:
+            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+        far += diff * diff
+    far = np.sqrt(far)
+    count = 1
+    while count <= max_steps:
+        landing = False
+        held = -1
+        # ---- predictor (Sec. 4.1)
+        if paper:
+            if abs(t[drive]) < 1e-9:
+                return count, TURNING, h
+            step = h / t[drive]
+            if step < 0.0:
+                if count > 1:  # the drive has turned back: equal drive steps cannot go on
+                    return count, TURNING, h
+                for a in range(m):  # first step: orient the tangent along the drive direction
+                    t[a] = -t[a]
+                step = h / t[drive]
+            if has_target and abs(u[drive] + h - target) < 1e-9 * max(1.0, abs(target)):
+                landing = True
+            for a in range(m):
+                u_try[a] = u[a] + step * t[a]
+            if landing:
+                u_try[drive] = target
+            held = drive
+        else:
+            step = h
+            if has_target and abs(t[drive]) > 1e-12:
+                to_go = (target - u[drive]) / t[drive]
+                if 0.0 <= to_go <= h:
+                    step = to_go
+                    landing = True
+            for a in range(m):
+                u_try[a] = u[a] + step * t[a]
+            if landing:
+                u_try[drive] = target
+                held = drive
+        # ---- corrector (Sec. 4.2, Eq. (28))
+        ok, iters, r = correct(
+            twists, loop_joint, loop_sign, loop_ptr, rows, groups, u_try, held, tol, truncate, max_iter, q, res, jac
+        )
+        if ok:
+            basis_try[:, :] = basis
+            tau_new = tangent_and_test(jac, t, basis_try, r_path, t_new, sig)
+            turn = 0.0
+            for a in range(m):
+                turn += t_new[a] * t[a]
+            dist = 0.0
+            for a in range(m):
+                dist += (u_try[a] - u[a]) ** 2
+            dist = np.sqrt(dist)
+            if not paper and not landing and (turn < cos_turn or dist > 2.0 * step + 1e-300) and h > hmin:
+                ok = False
+        if not ok:
+            if paper:
+                return count, FAILED, h
+            h *= 0.5
+            if h < hmin:
+                return count, FAILED, h
+            continue
+        # ---- accept the step
+        s_total += dist
+        for a in range(m):
+            u[a] = u_try[a]
+            t[a] = t_new[a]
+        basis[:, :] = basis_try
+        out_u[count, :] = u
+        out_t[count, :] = t
+        out_sigma[count, :] = sig
+        out_res[count] = r
+        out_tau[count] = tau_new
+        out_s[count] = s_total
+        count += 1
+        if landing:
+            return count, TARGET, h
+        for a in range(m):
+            if u[a] < lo[a] or u[a] > hi[a]:
+                return count, LIMIT, h
+        if detect and tau_new * out_tau[count - 2] < 0.0:
+            return count, SIGN_CHANGE, h
+        if check_closed:
+            # distance to the start of the path, angles wrapped to (-pi, pi]
+            d = 0.0
+            for a in range(m):
+                diff = u[a] - u_home[a]
+                if periodic[a]:
+                    diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+                d += diff * diff
+            d = np.sqrt(d)
+            if d > far:
+                far = d
+            if far > 4.0 * hmax and d < 1.5 * h:
+                for a in range(m):
+                    diff = u_home[a] - u[a]
+                    if periodic[a]:
+                        diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+                    out_u[count - 1, a] = u[a] + diff
+                out_sigma[count - 1, :] = out_sigma[0, :]
+                out_res[count - 1] = out_res[0]
+                out_tau[count - 1] = out_tau[0]
+                return count, CLOSED, h
+        if not paper and iters <= 3 and turn > np.sqrt(cos_turn):
+            h = min(h * 1.5, hmax)
+    return count, BUDGET, h

@@ -1,0 +1,112 @@
+"""numba-compiled segment errors (Eq. 21) for the search's inner loop.
+
+The same arithmetic as :mod:`~linkwork.synthesis.error_kernels` (the numpy reference), one point at a time. All
+profiles' target points are concatenated into one ``(N, 2)`` array; profile ``j`` starts at row ``offsets[j]``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+@njit(cache=True)
+def _aligned_error(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
+    """Largest distance after the best rigid registration of ``src (n, 2)`` onto ``tgt (n, 2)``."""
+    n = src.shape[0]
+    msx = msy = mtx = mty = 0.0
+    for i in range(n):
+        msx += src[i, 0]
+        msy += src[i, 1]
+        mtx += tgt[i, 0]
+        mty += tgt[i, 1]
+    msx /= n
+    msy /= n
+    mtx /= n
+    mty /= n
+    dot = cross = 0.0
+    for i in range(n):
+        ax, ay = src[i, 0] - msx, src[i, 1] - msy
+        bx, by = tgt[i, 0] - mtx, tgt[i, 1] - mty
+        dot += ax * bx + ay * by
+        cross += ax * by - ay * bx
+    h = math.hypot(dot, cross)
+    c, s = (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
+    worst = 0.0
+    for i in range(n):
+        ax, ay = src[i, 0] - msx, src[i, 1] - msy
+        rx = c * ax - s * ay - (tgt[i, 0] - mtx)
+        ry = s * ax + c * ay - (tgt[i, 1] - mty)
+        worst = max(worst, rx * rx + ry * ry)
+    return math.sqrt(worst)
+
+
+@njit(cache=True)
+def mean_errors(points: Array, offsets: IntArray, starts: IntArray, pieces: int) -> Array:  # pragma: no cover
+    """``(p,)`` errors of an M-segment (Eqs. 12-15, 21)."""
+    p = starts.shape[0]
+    n = pieces + 1
+    z = np.empty((p, n, 2))
+    for j in range(p):
+        z[j] = points[offsets[j] + starts[j] : offsets[j] + starts[j] + n]
+    mean = np.zeros((n, 2))
+    ref = z[0]
+    mrx = mry = 0.0
+    for i in range(n):
+        mrx += ref[i, 0]
+        mry += ref[i, 1]
+    mrx /= n
+    mry /= n
+    for j in range(p):
+        mx = my = 0.0
+        for i in range(n):
+            mx += z[j, i, 0]
+            my += z[j, i, 1]
+        mx /= n
+        my /= n
+        dot = cross = 0.0
+        for i in range(n):
+            ax, ay = z[j, i, 0] - mx, z[j, i, 1] - my
+            bx, by = ref[i, 0] - mrx, ref[i, 1] - mry
+            dot += ax * bx + ay * by
+            cross += ax * by - ay * bx
+        h = math.hypot(dot, cross)
+        c, s = (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
+        if j == 0:
+            c, s = 1.0, 0.0
+        for i in range(n):
+            ax, ay = z[j, i, 0] - mx, z[j, i, 1] - my
+            mean[i, 0] += (c * ax - s * ay + mrx) / p
+            mean[i, 1] += (s * ax + c * ay + mry) / p
+    out = np.empty(p)
+    for j in range(p):
+        out[j] = _aligned_error(mean, z[j])
+    return out
+
+
+@njit(cache=True)
+def arc_errors(
+    points: Array, offsets: IntArray, starts: IntArray, pieces: IntArray, curvature: float, piece_length: float
+) -> Array:  # pragma: no cover - compiled
+    """``(p,)`` errors of the C-segment of ``curvature`` and ``piece_length`` (Eqs. 19, 21)."""
+    p = starts.shape[0]
+    longest = 0
+    for j in range(p):
+        longest = max(longest, pieces[j])
+    half = min(1.0, max(-1.0, 0.5 * curvature * piece_length))
+    turn = 2.0 * math.asin(half)
+    arc = np.zeros((longest + 1, 2))
+    for i in range(longest):
+        arc[i + 1, 0] = arc[i, 0] + piece_length * math.cos(turn * i)
+        arc[i + 1, 1] = arc[i, 1] + piece_length * math.sin(turn * i)
+    out = np.empty(p)
+    for j in range(p):
+        lo = offsets[j] + starts[j]
+        out[j] = _aligned_error(arc[: pieces[j] + 1], points[lo : lo + pieces[j] + 1])
+    return out

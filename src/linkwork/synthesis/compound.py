@@ -1,0 +1,89 @@
+"""Compound segments (Sec. 6): find revolute joints that barely move across the profiles and clamp them."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.synthesis.joining import join_chain
+from linkwork.synthesis.result import Compound, JoinedProfile, Segment, TargetProfile
+from linkwork.synthesis.segment_fit import segment_starts
+
+Array = NDArray[np.float64]
+
+
+def _wrap(a: Array) -> Array:
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def joint_angles(joined: Sequence[JoinedProfile], segment_matrix: NDArray[np.int64]) -> Array:
+    """``(q - 1, p)`` relative angle ``sigma_j^i`` at every joint of the joined chain (Sec. 6).
+
+    The turn from the direction of the piece entering segmentation point ``k_j^{i+1}`` to that of the piece
+    leaving it, measured on the joined chain (whose pieces are the links either side of the joint). Each row is
+    unwrapped about profile 1 so that ranges across ``+-pi`` come out right.
+    """
+    starts = segment_starts(segment_matrix)[1:]  # (q - 1, p) joint point indices
+    q1, p = starts.shape
+    sigma = np.empty((q1, p))
+    for j, prof in enumerate(joined):
+        k = starts[:, j]
+        p_in = prof.points[k] - prof.points[k - 1]
+        p_out = prof.points[k + 1] - prof.points[k]
+        cross = p_in[:, 0] * p_out[:, 1] - p_in[:, 1] * p_out[:, 0]
+        sigma[:, j] = np.arctan2(cross, np.sum(p_in * p_out, axis=1))
+    if q1:
+        sigma = sigma[:, :1] + _wrap(sigma - sigma[:, :1])
+    return sigma
+
+
+def joint_ranges(sigma: Array) -> Array:
+    """``(q - 1,)`` range of motion ``max_j sigma_j^i - min_l sigma_l^i`` of each joint (Eq. 34)."""
+    if sigma.size == 0:
+        return np.zeros(sigma.shape[0])
+    return sigma.max(axis=1) - sigma.min(axis=1)  # type: ignore[no-any-return]
+
+
+def merge_joints(
+    design: str,
+    segment_matrix: NDArray[np.int64],
+    segments: Sequence[Segment],
+    targets: Sequence[TargetProfile],
+    joined: Sequence[JoinedProfile],
+    threshold: float,
+    kind: str,
+) -> Compound:
+    """Merge every joint whose range (Eq. 34) is below ``threshold`` and that touches a C-segment (Sec. 6).
+
+    A merged joint is clamped at its mean angle over the profiles and the chain is joined again. A small-motion
+    joint between two M-segments is not merged (the merged link could not follow the profiles better than one
+    M-segment would): a note suggests a design with fewer segments instead.
+    """
+    sigma = joint_angles(joined, segment_matrix)
+    ranges = joint_ranges(sigma)
+    merged: list[int] = []
+    notes: list[str] = []
+    for i, rng in enumerate(ranges):
+        if not rng < threshold:
+            continue
+        if design[i] == "M" and design[i + 1] == "M":
+            notes.append(
+                f"joint {i} between M-segments {i} and {i + 1} moves only {math.degrees(rng):.3g} deg "
+                f"(< {math.degrees(threshold):.3g}): consider a design vector with fewer segments"
+            )
+        else:
+            merged.append(i)
+    if not merged:
+        em = np.column_stack([prof.errors for prof in joined])
+        return Compound(sigma, ranges, threshold, (), tuple(notes), em, float(em.max()), tuple(joined))
+    mean = sigma.mean(axis=1)
+    ties = [
+        [(i, float(prof.angles[i + 1] - prof.angles[i] + (mean[i] - sigma[i, j]))) for i in merged]
+        for j, prof in enumerate(joined)
+    ]
+    profiles = join_chain(segments, targets, kind, ties=ties, initial=joined)
+    em = np.column_stack([prof.errors for prof in profiles])
+    return Compound(sigma, ranges, threshold, tuple(merged), tuple(notes), em, float(em.max()), profiles)

@@ -1,0 +1,281 @@
+"""Joining the chain (Sec. 5): pose rigid segment shapes end to end so they best match one profile.
+
+Per profile the unknowns are the chain's first point and one chord angle per segment (``q + 2``, Fig. 9b);
+the shapes are fixed. The objective is the sum of squared distances between the chain's points and the target
+points (Eq. 33). A closed profile adds ``end = start`` (Eq. 31), a fixed-end profile pins both ends (Eq. 32).
+Joints held at a fixed relative angle (compound segments, Sec. 6) tie one angle to the one before it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares, minimize
+
+from linkwork.errors import ConvergenceError
+from linkwork.synthesis.frames import chord_angle, rotation
+from linkwork.synthesis.result import JoinedProfile, Segment, TargetProfile
+
+Array = NDArray[np.float64]
+
+#: The closure or end constraint is satisfied to this residual after joining.
+CONSTRAINT_TOL = 1e-12
+
+
+def _perp(v: Array) -> Array:
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+class ChainPose:
+    """The chain of fixed segment shapes as a function of its first point and chord angles.
+
+    Parameters
+    ----------
+    shapes
+        Per segment, its ``(n_e, 2)`` points in the local frame (first point at the origin).
+    """
+
+    def __init__(self, shapes: Sequence[Array]) -> None:
+        self.shapes = [np.asarray(s, dtype=float) for s in shapes]
+        loc = [self.shapes[0]] + [s[1:] for s in self.shapes[1:]]
+        self.local = np.vstack(loc)
+        self.seg = np.concatenate([np.full(len(pts), e) for e, pts in enumerate(loc)])
+        self.ends = np.stack([s[-1] for s in self.shapes])  # local chord vectors
+        self.first_index = np.concatenate([[0], np.cumsum([len(s) - 1 for s in self.shapes])])
+
+    @property
+    def q(self) -> int:
+        """Number of segments."""
+        return len(self.shapes)
+
+    def joints(self, start: Array, theta: Array) -> Array:
+        """``(q + 1, 2)`` segmentation points."""
+        chords = np.einsum("qab,qb->qa", rotation(theta), self.ends)
+        return np.vstack([start, start + np.cumsum(chords, axis=0)])
+
+    def points(self, start: Array, theta: Array) -> Array:
+        """``(n, 2)`` chain points, one per target point (Eq. 29)."""
+        rl = np.einsum("nab,nb->na", rotation(theta)[self.seg], self.local)
+        return self.joints(start, theta)[self.seg] + rl
+
+    def jacobian_theta(self, theta: Array) -> Array:
+        """``(n, 2, q)`` derivative of the points with respect to the chord angles."""
+        rot = rotation(theta)
+        rl = _perp(np.einsum("nab,nb->na", rot[self.seg], self.local))
+        chords = _perp(np.einsum("qab,qb->qa", rot, self.ends))
+        k = np.arange(self.q)
+        later = (self.seg[:, None] > k[None, :])[:, None, :] * chords.T[None, :, :]
+        own = (self.seg[:, None] == k[None, :])[:, None, :] * rl[:, :, None]
+        return later + own
+
+    def closure_jacobian(self, theta: Array) -> Array:
+        """``(2, q)`` derivative of the chain's end point with respect to the chord angles."""
+        return _perp(np.einsum("qab,qb->qa", rotation(theta), self.ends)).T
+
+
+def angle_map(q: int, ties: Sequence[tuple[int, float]]) -> tuple[Array, Array]:
+    """``(T, b)`` with ``theta = T @ phi + b``: joint ``i`` tied means ``theta_{i+1} = theta_i + offset``."""
+    tie = dict(ties)
+    cols: list[int] = []
+    b = np.zeros(q)
+    for e in range(q):
+        if e - 1 in tie:
+            cols.append(cols[-1])
+            b[e] = b[e - 1] + tie[e - 1]
+        else:
+            cols.append(max(cols, default=-1) + 1)
+    t = np.zeros((q, cols[-1] + 1))
+    t[np.arange(q), cols] = 1.0
+    return t, b
+
+
+def join_profile(
+    shapes: Sequence[Array],
+    target: ArrayLike,
+    start: ArrayLike,
+    angles: ArrayLike,
+    *,
+    closed: bool = False,
+    ends: tuple[ArrayLike, ArrayLike] | None = None,
+    ties: Sequence[tuple[int, float]] = (),
+) -> JoinedProfile:
+    """Join the segments and pose the chain on one target profile (Sec. 5).
+
+    Parameters
+    ----------
+    shapes
+        Per segment, its points ``(m_j^e + 1, 2)`` in the local frame; their piece counts sum to the profile's.
+    target
+        ``(m_j + 1, 2)`` target points.
+    start, angles
+        Initial guess: first point ``(2,)`` and chord angles ``(q,)`` (e.g. from the segmentation).
+    closed
+        Add the closure constraint ``end = start`` (Eq. 31).
+    ends
+        Pin the first and last chain points (Eq. 32).
+    ties
+        ``(i, offset)``: joint ``i`` is clamped, ``theta_{i+1} = theta_i + offset`` (Sec. 6).
+
+    Raises
+    ------
+    ConvergenceError
+        When the constrained optimiser fails or the constraint cannot be met.
+    """
+    chain = ChainPose(shapes)
+    z = np.asarray(target, dtype=float)
+    if len(chain.local) != len(z):
+        raise ValueError(f"Expected {len(chain.local)} target points for these segments, got {len(z)}")
+    t_map, b = angle_map(chain.q, ties)
+    theta0 = np.asarray(angles, dtype=float)
+    # the free angles: least squares through the tie map, exact when theta0 already satisfies the ties
+    phi0 = np.linalg.lstsq(t_map, theta0 - b, rcond=None)[0]
+    fixed_start = None if ends is None else np.asarray(ends[0], dtype=float)
+    end_point = None if ends is None else np.asarray(ends[1], dtype=float)
+    nf = 0 if fixed_start is not None else 2
+
+    def unpack(u: Array) -> tuple[Array, Array]:
+        s = fixed_start if fixed_start is not None else u[:2]
+        return s, t_map @ u[nf:] + b
+
+    def residual(u: Array) -> Array:
+        s, th = unpack(u)
+        return (chain.points(s, th) - z).ravel()  # Eq. (33)
+
+    def jac(u: Array) -> Array:
+        _, th = unpack(u)
+        jt = chain.jacobian_theta(th).reshape(-1, chain.q) @ t_map
+        if nf == 0:
+            return jt
+        js = np.tile(np.eye(2), (len(z), 1))
+        return np.hstack([js, jt])
+
+    def constraint(u: Array) -> Array:
+        s, th = unpack(u)
+        tip = chain.joints(s, th)[-1]
+        return tip - (s if closed else end_point)  # Eq. (31) / Eq. (32)
+
+    def constraint_jac(u: Array) -> Array:
+        _, th = unpack(u)
+        g = chain.closure_jacobian(th) @ t_map
+        return np.hstack([np.zeros((2, nf)), g]) if nf else g
+
+    u0 = np.concatenate([np.asarray(start, dtype=float) if nf else np.zeros(0), phi0])
+    constrained = closed or ends is not None
+    if not constrained:
+        sol = least_squares(residual, u0, jac=jac, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
+        u = _polish(residual, jac, None, None, sol.x)
+    else:
+        u = _constrained(residual, jac, constraint, constraint_jac, u0)
+        u = _project(constraint, constraint_jac, _polish(residual, jac, constraint, constraint_jac, u))
+    s, th = unpack(u)
+    pts = chain.points(s, th)
+    dist = np.linalg.norm(pts - z, axis=1)
+    first = chain.first_index
+    errors = np.array([dist[first[e] : first[e + 1] + 1].max() for e in range(chain.q)])  # Eq. (21)
+    return JoinedProfile(joints=chain.joints(s, th), points=pts, angles=th, errors=errors)
+
+
+def _polish(residual, jac, constraint, constraint_jac, u: Array) -> Array:  # type: ignore[no-untyped-def]
+    """Gauss-Newton steps (with the linearised constraints, KKT form) to the optimum's last digits.
+
+    The optimisers stop on the cost, which is quadratic in the unknowns, so their unknowns are good to about
+    the square root of their tolerance; a few full steps from there converge to rounding.
+    """
+    cost = float(residual(u) @ residual(u))
+    for _ in range(30):
+        r, jm = residual(u), jac(u)
+        if constraint is None:
+            step = np.linalg.lstsq(jm, -r, rcond=None)[0]
+        else:
+            g, gm = constraint(u), constraint_jac(u)
+            n = len(u)
+            kkt = np.block([[jm.T @ jm, gm.T], [gm, np.zeros((len(g), len(g)))]])
+            step = np.linalg.lstsq(kkt, np.concatenate([-jm.T @ r, -g]), rcond=None)[0][:n]
+        trial = u + step
+        r_trial = residual(trial)
+        trial_cost = float(r_trial @ r_trial)
+        if trial_cost > cost * (1.0 + 1e-12) + 1e-300:
+            break  # no longer a descent step: we are at rounding level
+        u, cost = trial, trial_cost
+        if np.max(np.abs(step)) <= 1e-15 * (1.0 + np.max(np.abs(u))):
+            break
+    return u
+
+
+def _project(constraint, constraint_jac, u: Array) -> Array:  # type: ignore[no-untyped-def]
+    """Move ``u`` onto ``constraint(u) = 0`` by minimum-norm Newton steps."""
+    for _ in range(50):
+        g = constraint(u)
+        if np.max(np.abs(g)) < CONSTRAINT_TOL:
+            return u
+        u = u - np.linalg.lstsq(constraint_jac(u), g, rcond=None)[0]
+    g = constraint(u)
+    if np.max(np.abs(g)) < 1e3 * CONSTRAINT_TOL:
+        return u
+    raise ConvergenceError(
+        f"joining: the chain cannot meet its closure/end constraint (residual {np.max(np.abs(g)):.3g}); "
+        "the segments may be too short or too long to reach"
+    )
+
+
+def _constrained(residual, jac, constraint, constraint_jac, u0: Array) -> Array:  # type: ignore[no-untyped-def]
+    """Minimise ``|residual|^2 / 2`` subject to ``constraint = 0``: SLSQP, then an exact projection."""
+    u_start = _project(constraint, constraint_jac, u0)
+
+    def f(u: Array) -> float:
+        r = residual(u)
+        return 0.5 * float(r @ r)
+
+    def grad(u: Array) -> Array:
+        return jac(u).T @ residual(u)  # type: ignore[no-any-return]
+
+    sol = minimize(
+        f,
+        u_start,
+        jac=grad,
+        method="SLSQP",
+        constraints=[{"type": "eq", "fun": constraint, "jac": constraint_jac}],
+        options={"ftol": 1e-15, "maxiter": 500},
+    )
+    u = sol.x if np.all(np.isfinite(sol.x)) else u_start
+    u = _project(constraint, constraint_jac, u)
+    if f(u) > f(u_start):  # SLSQP wandered: keep the feasible start
+        u = u_start
+    return u
+
+
+def join_chain(
+    segments: Sequence[Segment],
+    targets: Sequence[TargetProfile],
+    kind: str,
+    ties: Sequence[Sequence[tuple[int, float]]] | None = None,
+    initial: Sequence[JoinedProfile] | None = None,
+) -> tuple[JoinedProfile, ...]:
+    """Join the segments on every profile (Sec. 5), each profile on its own.
+
+    The initial guess is where the segmentation placed each segment (or ``initial``, a previous joining). A
+    fixed-end chain is pinned to profile 1's end points (the ground pivots of the mechanism).
+    """
+    out = []
+    ends = (targets[0].points[0], targets[0].points[-1]) if kind == "fixed-end" else None
+    for j, target in enumerate(targets):
+        shapes = [seg.local_points(j) for seg in segments]
+        if initial is None:
+            start = segments[0].instances[j][0]
+            angles = np.array([chord_angle(seg.instances[j]) for seg in segments])
+        else:
+            start, angles = initial[j].joints[0], initial[j].angles
+        out.append(
+            join_profile(
+                shapes,
+                target.points,
+                start,
+                angles,
+                closed=kind == "closed",
+                ends=ends,
+                ties=() if ties is None else ties[j],
+            )
+        )
+    return tuple(out)

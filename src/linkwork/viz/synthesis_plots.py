@@ -1,0 +1,350 @@
+"""Figures of shape-change synthesis, after Shamsudin et al. (2013): design and target profiles (their Fig. 3),
+an M-segment's registration (Fig. 6), a C-segment's arcs (Fig. 7), the chain before and after joining (Fig. 8)
+and after merging joints into compound segments (Fig. 10).
+
+matplotlib is imported inside the functions (it is an optional extra) and only its object-oriented API is used
+(``matplotlib.figure.Figure``, drawn by the Agg renderer): nothing is ever displayed and no global pyplot state
+is touched. Every figure has equal axes, labelled axes and a legend.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Kinematic synthesis of planar, shape-changing,
+rigid body mechanisms for design profiles with significant differences in arc length, Mech. Mach. Theory 70
+(2013) 425-440.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.synthesis.result import JoinedProfile, SynthesisResult
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+Array = NDArray[np.float64]
+
+DPI = 100
+"""Resolution of the PNG files (the figures are about 8 x 5 inches: PNGs of 30-120 kB)."""
+
+
+# --------------------------------------------------------------------------------------------- helpers
+
+
+def _colour(j: int) -> str:
+    palette = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
+    return palette[j % len(palette)]
+
+
+def _name(result: SynthesisResult, j: int) -> str:
+    return result.targets[j].name or f"profile {j + 1}"
+
+
+def _segment_piece(result: SynthesisResult, e: int, j: int) -> Array:
+    """The target points segment ``e`` spans on profile ``j``."""
+    segment = result.segments[e]
+    start = int(segment.starts[j])
+    return result.targets[j].points[start : start + int(segment.pieces[j]) + 1]
+
+
+def _extent(arrays: Sequence[Array]) -> tuple[float, float]:
+    """Width and height of the bounding box of all points."""
+    everything = np.vstack([np.asarray(a).reshape(-1, 2) for a in arrays])
+    width, height = np.ptp(everything, axis=0)
+    return float(width), float(height)
+
+
+def _figure(panels: int, extent: tuple[float, float], *, width: float = 8.0) -> tuple[Figure, list[Axes]]:
+    """A figure of ``panels`` equal-aspect axes, stacked when the drawing is wide, side by side when tall."""
+    from matplotlib.figure import Figure
+
+    aspect = extent[1] / extent[0] if extent[0] > 0 else 1.0
+    aspect = min(max(aspect, 0.15), 2.0)
+    wide = aspect < 0.8 or panels == 1
+    rows, cols = (panels, 1) if wide else (1, panels)
+    panel_width = width / cols
+    height = min(8.0, max(2.2, rows * panel_width * aspect + 0.9 * rows + 0.4))
+    figure = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
+    axes = figure.subplots(rows, cols, squeeze=False).ravel().tolist()
+    for ax in axes:
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.grid(True, linewidth=0.3, alpha=0.5)
+    return figure, axes
+
+
+def _legend(ax: Axes, **kwargs: Any) -> None:
+    """A small legend; beside the axes (outside the drawing) when the drawing is wide and flat."""
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    if (y1 - y0) < 0.45 * (x1 - x0):
+        kwargs = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0), **kwargs}
+    ax.legend(fontsize="small", framealpha=0.85, **kwargs)
+
+
+def _draw_chain(
+    ax: Axes, chain: JoinedProfile, colour: str, label: str, *, merged: Sequence[int] = ()
+) -> None:
+    """The chain's points, its two ends as dots and its revolute joints as open circles (``merged`` joints,
+    0-based, fused into compound segments, as small crosses)."""
+    ax.plot(*chain.points.T, "-", color=colour, linewidth=1.8, label=label)
+    ax.plot(*chain.joints[[0, -1]].T, ".", color="black", markersize=6, zorder=5)
+    interior = chain.joints[1:-1]
+    live = [i for i in range(len(interior)) if i not in merged]
+    ax.plot(*interior[live].T, "o", markersize=5, markerfacecolor="white", markeredgecolor="black", zorder=5)
+    if merged:
+        ax.plot(*interior[list(merged)].T, "x", color="black", markersize=4, zorder=5)
+
+
+def _draw_targets(ax: Axes, result: SynthesisResult, *, label: bool = True) -> None:
+    for j, target in enumerate(result.targets):
+        ax.plot(
+            *target.points.T,
+            "--",
+            color=_colour(j),
+            linewidth=0.8,
+            alpha=0.6,
+            label=f"target {_name(result, j)}" if label else None,
+        )
+
+
+# ---------------------------------------------------------------------------------------------- figures
+
+
+def plot_profiles(result: SynthesisResult) -> Figure:
+    """Design profiles (solid) and their target profiles (points), segmentation points black (paper's Fig. 3)."""
+    figure, (ax,) = _figure(1, _extent(result.problem.profiles))
+    for j, (design, target) in enumerate(zip(result.problem.profiles, result.targets, strict=True)):
+        ax.plot(
+            *design.T,
+            "-",
+            color=_colour(j),
+            linewidth=1.0,
+            label=f"{_name(result, j)}: C = {target.arc_length:.4g}",
+        )
+        ax.plot(
+            *target.points.T,
+            ".",
+            color=_colour(j),
+            markersize=3,
+            label=f"target: {target.pieces} pieces of {target.target_length:.4g}",
+        )
+    for e, segment in enumerate(result.segments):
+        for j, target in enumerate(result.targets):
+            ax.plot(
+                *target.points[int(segment.starts[j])],
+                "o",
+                color="black",
+                markersize=4,
+                label="segmentation points" if e == 0 and j == 0 else None,
+            )
+    for j, target in enumerate(result.targets):
+        ax.plot(*target.points[-1], "o", color="black", markersize=4)
+    ax.set_title(f"Design and target profiles (desired piece length {result.problem.piece_length:g})")
+    _legend(ax, ncols=2)
+    return figure
+
+
+def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
+    """An M-segment's construction (paper's Fig. 6): (a) its piece on every profile, (b) registered onto
+    profile 1, (c) the mean of corresponding points, (d) the mean moved back onto every profile.
+
+    Raises
+    ------
+    ValueError
+        If segment ``index`` is not an M-segment.
+    """
+    from linkwork.synthesis.registration import register
+
+    segment = result.segments[index]
+    if segment.kind != "M":
+        raise ValueError(f"Expected an M-segment, segment {index + 1} is a {segment.kind}-segment")
+    pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
+    moved = [pieces[0]] + [register(piece, pieces[0]).apply(piece) for piece in pieces[1:]]
+    mean = np.mean(moved, axis=0)
+    figure, axes = _figure(4, _extent(pieces + list(segment.instances)))
+    panels = (
+        "(a) pieces on the target profiles",
+        "(b) registered onto profile 1",
+        "(c) mean segment",
+        "(d) mean moved back onto each profile",
+    )
+    for j, piece in enumerate(pieces):
+        axes[0].plot(*piece.T, ".-", color=_colour(j), linewidth=1.0, markersize=3, label=_name(result, j))
+        axes[1].plot(*moved[j].T, ".-", color=_colour(j), linewidth=1.0, markersize=3, label=_name(result, j))
+        axes[2].plot(*moved[j].T, "-", color=_colour(j), linewidth=0.6, alpha=0.5)
+        axes[3].plot(*piece.T, ".", color=_colour(j), markersize=3, label=f"{_name(result, j)} target")
+        axes[3].plot(
+            *segment.instances[j].T,
+            "-",
+            color=_colour(j),
+            linewidth=1.5,
+            label=f"mean on {_name(result, j)}: E = {segment.errors[j]:.3g}",
+        )
+    axes[2].plot(*mean.T, "k.-", linewidth=1.5, markersize=3, label="mean segment")
+    for ax, title in zip(axes, panels, strict=True):
+        ax.set_title(title, fontsize="medium")
+        _legend(ax)
+    figure.suptitle(f"M-segment {index + 1}: {int(segment.pieces[0])} pieces on every profile")
+    return figure
+
+
+def plot_arc_segment(result: SynthesisResult, index: int) -> Figure:
+    """A C-segment (paper's Fig. 7): (a) its pieces on every profile, (b) arcs of one radius and different
+    lengths placed on each.
+
+    Raises
+    ------
+    ValueError
+        If segment ``index`` is not a C-segment.
+    """
+    segment = result.segments[index]
+    if segment.kind != "C":
+        raise ValueError(f"Expected a C-segment, segment {index + 1} is a {segment.kind}-segment")
+    pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
+    figure, axes = _figure(2, _extent(pieces + list(segment.instances)))
+    lengths = segment.lengths
+    for j, piece in enumerate(pieces):
+        axes[0].plot(
+            *piece.T,
+            ".-",
+            color=_colour(j),
+            linewidth=1.0,
+            markersize=3,
+            label=f"{_name(result, j)}: {int(segment.pieces[j])} pieces",
+        )
+        axes[1].plot(*piece.T, ".", color=_colour(j), markersize=3)
+        axes[1].plot(
+            *segment.instances[j].T,
+            "-",
+            color=_colour(j),
+            linewidth=1.5,
+            label=f"L = {lengths[j]:.3g}, E = {segment.errors[j]:.3g}",
+        )
+    radius = segment.radius
+    shown = "straight (r = inf)" if radius is None or math.isinf(radius) else f"r = {radius:.4g}"
+    axes[0].set_title("(a) pieces on the target profiles", fontsize="medium")
+    axes[1].set_title(f"(b) arcs of one radius, {shown}", fontsize="medium")
+    for ax in axes:
+        _legend(ax)
+    figure.suptitle(f"C-segment {index + 1}: mean piece length {segment.piece_length:.4g}")
+    return figure
+
+
+def plot_chain(result: SynthesisResult) -> Figure:
+    """The chain on every profile before and after joining (paper's Fig. 8): segments where each fits best,
+    then moved to unite their end points at revolute joints."""
+    figure, axes = _figure(2, _extent([t.points for t in result.targets]))
+    _draw_targets(axes[0], result)
+    _draw_targets(axes[1], result, label=False)
+    for e, segment in enumerate(result.segments):
+        for j, instance in enumerate(segment.instances):
+            axes[0].plot(
+                *instance.T,
+                "-",
+                color=_colour(j),
+                linewidth=1.8,
+                label=f"segments on {_name(result, j)}" if e == 0 else None,
+            )
+            axes[0].plot(*instance[[0, -1]].T, "|", color="black", markersize=7)
+    for j, chain in enumerate(result.joined):
+        _draw_chain(axes[1], chain, _colour(j), f"chain on {_name(result, j)}")
+    axes[0].set_title(
+        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g}", fontsize="medium"
+    )
+    axes[1].set_title(
+        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g}", fontsize="medium"
+    )
+    for ax in axes:
+        _legend(ax)
+    return figure
+
+
+def plot_compound(result: SynthesisResult) -> Figure:
+    """The joined chain and the chain after merging small-motion joints into compound segments (paper's
+    Fig. 10), with each joint's range of motion.
+
+    Raises
+    ------
+    ValueError
+        If the result has no compound stage (``merge_below`` was 0).
+    """
+    compound = result.compound
+    if compound is None:
+        raise ValueError("Expected a result with a compound stage (merge_below > 0), got compound = None")
+    figure, axes = _figure(2, _extent([t.points for t in result.targets]))
+    for ax, chains, merged in zip(
+        axes, (result.joined, compound.profiles), ((), compound.merged), strict=True
+    ):
+        _draw_targets(ax, result, label=ax is axes[0])
+        for j, chain in enumerate(chains):
+            _draw_chain(ax, chain, _colour(j), f"chain on {_name(result, j)}", merged=merged)
+    # Label every joint with its range of motion (Eq. 34) next to its position on profile 1.
+    for i, motion in enumerate(compound.joint_ranges):
+        x, y = result.joined[0].joints[i + 1]
+        merged = i in compound.merged
+        axes[0].annotate(
+            f"{i + 1}: {math.degrees(motion):.1f}°",
+            (x, y),
+            xytext=(6, 6),
+            textcoords="offset points",
+            fontsize="small",
+            color="black" if merged else "dimgray",
+            weight="bold" if merged else "normal",
+        )
+    axes[0].set_title(
+        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g}", fontsize="medium"
+    )
+    merged_list = ", ".join(str(i + 1) for i in compound.merged) or "none"
+    axes[1].set_title(
+        f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; E_max = {compound.e_max:.3g}",
+        fontsize="medium",
+    )
+    for ax in axes:
+        _legend(ax)
+    return figure
+
+
+# ----------------------------------------------------------------------------------------------- writer
+
+
+def _save(figure: Figure, out_dir: Path, stem: str) -> list[Path]:
+    import matplotlib
+
+    paths = [out_dir / f"{stem}.png", out_dir / f"{stem}.svg"]
+    # A fixed hash salt and no date make the SVG files reproducible byte for byte.
+    with matplotlib.rc_context({"svg.hashsalt": "linkwork", "svg.fonttype": "none"}):
+        figure.savefig(paths[0], dpi=DPI, metadata={"Software": None})
+        figure.savefig(paths[1], metadata={"Date": None, "Creator": None})
+    return paths
+
+
+def write_synthesis_figures(result: SynthesisResult, out_dir: str | Path) -> list[Path]:
+    """Write every synthesis figure as PNG and SVG into ``out_dir`` and return the paths written.
+
+    Files: ``profiles`` (Fig. 3), ``m_segment`` (Fig. 6, the first M-segment, if any), ``c_segment`` (Fig. 7,
+    the first C-segment, if any), ``chain`` (Fig. 8) and ``compound`` (Fig. 10, when joints were merged).
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    figures: list[tuple[str, Figure]] = [("profiles", plot_profiles(result))]
+    kinds = [segment.kind for segment in result.segments]
+    if "M" in kinds:
+        figures.append(("m_segment", plot_mean_segment(result, kinds.index("M"))))
+    if "C" in kinds:
+        figures.append(("c_segment", plot_arc_segment(result, kinds.index("C"))))
+    figures.append(("chain", plot_chain(result)))
+    if result.compound is not None and result.compound.merged:
+        figures.append(("compound", plot_compound(result)))
+    written: list[Path] = []
+    for stem, figure in figures:
+        written += _save(figure, out, stem)
+    return written
