@@ -1,0 +1,104 @@
+"""``linkwork demo``: both halves of linkwork on bundled examples, written into one folder a newcomer can open."""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from linkwork.cli.common import console, friendly_errors
+
+
+@friendly_errors
+def demo(
+    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("linkwork-demo"),
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
+) -> None:
+    """Deploy Hedgepeth's hexagon (Fig. 12), follow Guest's frame through its bifurcations (Figs. 15-16), and
+    synthesise a morphing wing; write everything with an index.html into --out."""
+    import numpy as np
+
+    import linkwork as lw
+    from linkwork.cli.trace import summary, write_trace_outputs
+    from linkwork.linkages import deployed_angle
+
+    sections: list[tuple[str, str, Path, list[str]]] = []
+
+    console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Fig. 12)")
+    hexagon = lw.load("hedgepeth", n=6)
+    path = lw.trace(hexagon, until=("A", deployed_angle(6)), steps=200)
+    figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots)
+    summary(path)
+    a = np.degrees(path.angles[-1])
+    sections.append(
+        (
+            "Hedgepeth's hexagon, bundle to hexagon",
+            f"200 equal steps of θA from the folded bundle to Eq. (10)'s deployed angle "
+            f"{np.degrees(deployed_angle(6)):.4f}°; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
+            f"B = D = F = {a[1]:.4f}° at the end (max |A - C| along the path "
+            f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°).",
+            out / "hexagon",
+            [f.name for f in figs],
+        )
+    )
+
+    console.rule("[bold]2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)")
+    try:
+        frame = lw.load("guest-frame")
+    except lw.SpecError:
+        frame = None
+    if frame is not None:
+        path = lw.trace(frame, branches=True, max_steps=6000)
+        figs = write_trace_outputs(path, out / "guest-frame", plots=not no_plots)
+        summary(path)
+        sections.append(
+            (
+                "Guest's frame, every branch",
+                f"{len(path.bifurcations)} bifurcation points (rank {path.stats['start_rank']} → "
+                f"{min((b.rank for b in path.bifurcations), default=path.stats['start_rank'])}) and "
+                f"{len(path.branches)} traced branches.",
+                out / "guest-frame",
+                [f.name for f in figs],
+            )
+        )
+
+    console.rule("[bold]3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)")
+    try:
+        from linkwork.cli.synth import run_synthesis_example
+    except ImportError:  # pragma: no cover - synthesis not installed
+        run_synthesis_example = None  # type: ignore[assignment]
+    if run_synthesis_example is not None:
+        run_synthesis_example(out / "synthesis-wing", "wing")
+        figs_s = sorted(p.name for p in (out / "synthesis-wing").glob("*.png"))
+        sections.append(
+            (
+                "Morphing wing synthesis",
+                "A chain of rigid links that approximates three wing profiles of different arc length.",
+                out / "synthesis-wing",
+                figs_s,
+            )
+        )
+    _write_index(out, sections)
+    console.print(f"\nopen {out / 'index.html'} to see every result")
+
+
+def _write_index(out: Path, sections: list[tuple[str, str, Path, list[str]]]) -> None:
+    """A plain, self-contained index.html linking every file written."""
+    parts = [
+        "<!doctype html><html><head><meta charset='utf-8'><title>linkwork demo</title>",
+        "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}"
+        "img{max-width:100%;border:1px solid #ddd;margin:.5em 0}</style></head><body>",
+        "<h1>linkwork demo</h1>",
+    ]
+    for title, text, folder, figures in sections:
+        rel = folder.relative_to(out)
+        files = sorted(p.name for p in folder.iterdir() if p.is_file())
+        parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p><p>files: ")
+        parts.append(", ".join(f"<a href='{rel}/{html.escape(f)}'>{html.escape(f)}</a>" for f in files))
+        parts.append("</p>")
+        for fig in figures:
+            parts.append(f"<img src='{rel}/{html.escape(fig)}' alt='{html.escape(fig)}'>")
+    parts.append("</body></html>")
+    (out / "index.html").write_text("\n".join(parts))

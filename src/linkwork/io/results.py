@@ -1,0 +1,134 @@
+"""Result files of a trace: ``path.csv`` (one row per traced point) and ``report.json`` (the summary).
+
+Angles are written in degrees (prismatic joints in length units); the column and key names are a contract
+(DESIGN.md, "Contract: commands and outputs").
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path as FilePath
+from typing import Any
+
+import numpy as np
+
+from linkwork.kinematics.tracer import Path
+
+
+def _display(path: Path, values: np.ndarray) -> np.ndarray:
+    """Joint values in file units: degrees for revolute joints, lengths as they are for prismatic ones."""
+    revolute = np.array([t == "R" for t in path.mechanism.joint_types])
+    out = np.array(values, dtype=float, copy=True)
+    out[..., revolute] = np.degrees(out[..., revolute])
+    return out
+
+
+def path_rows(path: Path) -> tuple[list[str], list[list[Any]]]:
+    """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual``."""
+    names = list(path.mechanism.joint_names)
+    k = path.sigma.shape[1]
+    header = ["branch", "step", "s", *names, *[f"sigma_{i + 1}" for i in range(k)], "residual"]
+    angles = _display(path, path.angles)
+    s_deg = np.degrees(path.arclength)
+    rows = []
+    for i in range(len(path.branch)):
+        rows.append(
+            [
+                int(path.branch[i]),
+                int(path.step[i]),
+                float(s_deg[i]),
+                *map(float, angles[i]),
+                *map(float, path.sigma[i]),
+                float(path.residual[i]),
+            ]
+        )
+    return header, rows
+
+
+def write_path_csv(path: Path, file: FilePath) -> None:
+    """Write ``path.csv`` (floats with 17 significant digits, so nothing is lost)."""
+    header, rows = path_rows(path)
+    with open(file, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(header)
+        for row in rows:
+            writer.writerow([f"{v:.17g}" if isinstance(v, float) else v for v in row])
+
+
+def report_dict(path: Path, assembly: Any | None = None) -> dict[str, Any]:
+    """The content of ``report.json``."""
+    mech = path.mechanism
+    names = list(mech.joint_names)
+    start_rank = int(path.stats.get("start_rank", path.rank[0]))
+    regular = np.ones(len(path.rank), dtype=bool)
+    for b in path.bifurcations:
+        regular &= np.linalg.norm(path.angles - b.angles, axis=1) > 1e-6
+    ranks = path.rank[regular] if np.any(regular) else path.rank
+    cond = path.condition()
+    out: dict[str, Any] = {
+        "name": mech.name,
+        "joints": names,
+        "joint_types": list(mech.joint_types),
+        "units": {"angles": "deg", "s": "deg (arclength in the unknowns)"},
+        "drive": path.drive,
+        "mode": path.stats.get("mode"),
+        "unknowns": mech.n_unknowns,
+        "couplings": [[names[j] for j in group] for group in mech.group_members() if len(group) > 1],
+        "fixed": [names[j] for j in np.flatnonzero(mech.groups < 0)],
+        "equations": mech.n_equations,
+        "rank": start_rank,
+        "mobility": mech.n_unknowns - start_rank,
+        "rank_along_path": {"min": int(ranks.min()), "max": int(ranks.max())},
+        "mobility_along_path": {
+            "min": int(mech.n_unknowns - ranks.max()),
+            "max": int(mech.n_unknowns - ranks.min()),
+        },
+        "points": len(path.branch),
+        "max_residual": float(path.residual.max()),
+        "max_condition": path.max_condition,
+        "condition_at_end": float(cond[-1]) if len(cond) else None,
+        "bifurcations": [
+            {
+                "id": b.id,
+                "branch": b.branch,
+                "step": b.step,
+                "angles": dict(zip(names, map(float, _display(path, b.angles)), strict=True)),
+                "rank": b.rank,
+                "singular_values": [float(x) for x in b.sigma],
+                "tangents": [[float(x) for x in t] for t in b.tangents],
+                "method": b.method,
+                "residual": b.residual,
+                "accuracy": b.bracket,
+            }
+            for b in path.bifurcations
+        ],
+        "branches": [
+            {
+                "id": br.id,
+                "parent": br.parent,
+                "bifurcation": br.bifurcation,
+                "direction": br.direction,
+                "steps": br.steps,
+                "end_reason": br.end_reason,
+                "start": dict(zip(names, map(float, _display(path, path.angles[path.branch == br.id][0])), strict=True)),
+                "end": dict(zip(names, map(float, _display(path, path.angles[path.branch == br.id][-1])), strict=True)),
+            }
+            for br in path.branches
+        ],
+        "seconds": path.stats.get("seconds"),
+    }
+    if assembly is not None:
+        out["assembly"] = {
+            "residual_before": float(assembly.residual_before),
+            "residual_after": float(assembly.residual_after),
+            "correction_deg": dict(zip(names, map(float, np.degrees(assembly.correction)), strict=True)),
+        }
+    return out
+
+
+def write_report_json(path: Path, file: FilePath, assembly: Any | None = None) -> None:
+    """Write ``report.json``."""
+    with open(file, "w") as fh:
+        json.dump(report_dict(path, assembly), fh, indent=2)
+        fh.write("\n")

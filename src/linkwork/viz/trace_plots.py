@@ -1,0 +1,105 @@
+"""Figures of a traced path: hinge angles against the drive angle (like the paper's Figs. 9, 10, 12) and the
+Jacobian's singular values along the path (like Fig. 15). matplotlib is imported inside the functions."""
+
+from __future__ import annotations
+
+from pathlib import Path as FilePath
+
+import numpy as np
+
+from linkwork.kinematics.tracer import Path
+
+
+def _unwrap_branch(path: Path, mask: np.ndarray) -> np.ndarray:
+    return np.degrees(path.angles[mask])
+
+
+def plot_angles(path: Path, file: FilePath) -> FilePath:
+    """Every hinge angle against the drive angle, one colour per joint, one line style per branch."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    mech = path.mechanism
+    d = mech.index(path.drive)
+    fig, ax = plt.subplots(figsize=(7.5, 5.0), layout="constrained")
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    styles = ["-", "--", ":", "-."]
+    for br in path.branches:
+        mask = path.of_branch(br.id)
+        deg = _unwrap_branch(path, mask)
+        for j, name in enumerate(mech.joint_names):
+            if j == d:
+                continue
+            # One line style per joint, so that coincident curves (B = D = F) stay visible as dashes.
+            ax.plot(
+                deg[:, d],
+                deg[:, j],
+                styles[j % len(styles)],
+                color=colors[j % len(colors)],
+                lw=2.2 - 0.3 * (j % len(styles)) if br.id == 0 else 0.8,
+                alpha=1.0 if br.id == 0 else 0.45,
+                label=f"θ{name}" if br.id == 0 else None,
+            )
+    for b in path.bifurcations:
+        a = np.degrees(b.angles)
+        ax.plot(np.full(len(a) - 1, a[d]), np.delete(a, d), "ko", ms=4)
+    ax.set_xlabel(f"θ{path.drive} (deg)")
+    ax.set_ylabel("hinge angle (deg)")
+    title = f"{mech.name}: hinge angles"
+    if len(path.branches) > 1:
+        title += f" ({len(path.branches)} branches, {len(path.bifurcations)} bifurcation points ●)"
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(ncol=2, fontsize=8)
+    fig.savefig(file, dpi=120)
+    fig.savefig(FilePath(file).with_suffix(".svg"))
+    plt.close(fig)
+    return FilePath(file)
+
+
+def plot_singular_values(path: Path, file: FilePath, branch: int = 0) -> FilePath:
+    """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    mech = path.mechanism
+    d = mech.index(path.drive)
+    mask = path.of_branch(branch)
+    x = np.degrees(path.angles[mask, d])
+    s = path.sigma[mask]
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), layout="constrained")
+    steps = path.step[mask]
+    rank = int(path.stats.get("start_rank", s.shape[1]))
+    # Left: the non-zero singular values on a linear scale against the step (as the paper's Fig. 15);
+    # right: all of them on a log scale against the drive angle, the null ones at round-off.
+    for i in range(min(rank, s.shape[1])):
+        axes[0].plot(steps, s[:, i], lw=1.3, label=f"σ{i + 1}")
+    axes[0].set_xlabel("step")
+    axes[0].set_ylim(0, None)
+    for i in range(s.shape[1]):
+        axes[1].semilogy(x, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
+    axes[1].set_xlabel(f"θ{path.drive} (deg)")
+    axes[1].set_ylim(1e-17, None)
+    for ax in axes:
+        ax.set_ylabel("singular value")
+        ax.grid(alpha=0.3, which="both")
+    for b in path.bifurcations:
+        if b.branch == branch:
+            axes[0].axvline(b.step, color="k", lw=0.8, ls="--")
+            axes[1].axvline(np.degrees(b.angles[d]), color="k", lw=0.8, ls="--")
+    axes[1].legend(fontsize=8, ncol=2)
+    fig.suptitle(f"{mech.name}: singular values of the Jacobian along branch {branch}", fontsize=10)
+    fig.savefig(file, dpi=120)
+    fig.savefig(FilePath(file).with_suffix(".svg"))
+    plt.close(fig)
+    return FilePath(file)
+
+
+def write_trace_figures(path: Path, out: FilePath) -> list[FilePath]:
+    """All trace figures into folder ``out``; returns the PNG paths."""
+    out = FilePath(out)
+    return [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]
