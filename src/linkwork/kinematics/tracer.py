@@ -307,7 +307,11 @@ def trace(
                 continue
             reason = STOP_REASONS[code]
             if code == FAILED:
-                reason = f"corrector failed (step below {min_step:.1e} or residual not reduced)"
+                reason = (
+                    "corrector failed at a fixed drive step (the drive cannot take that value here)"
+                    if paper
+                    else f"corrector failed (step halved below {min_step:.1e} without converging)"
+                )
             return n_steps, reason
 
     paper = steps is not None

@@ -1,0 +1,120 @@
+"""Stop conditions, step control and bifurcations of the tracer, against closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linkwork.errors import LinkworkError, SpecError
+from linkwork.kinematics.chains import from_dh
+from linkwork.kinematics.closure import jacobian
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.tracer import trace
+
+DEG = np.pi / 180.0
+
+
+def bennett(a1: float, a2: float, t1: float) -> Mechanism:
+    """Bennett linkage in DH form: a_i = sin(alpha_i), theta3 = -theta1, theta4 = -theta2 (Bennett 1903)."""
+    k = np.sin((a2 + a1) / 2) / np.sin((a2 - a1) / 2)
+    t2 = 2 * np.arctan(k / np.tan(t1 / 2))
+    params = [
+        {"theta": t1, "a": np.sin(a1), "alpha": a1},
+        {"theta": t2, "a": np.sin(a2), "alpha": a2},
+        {"theta": -t1, "a": np.sin(a1), "alpha": a1},
+        {"theta": -t2, "a": np.sin(a2), "alpha": a2},
+    ]
+    return from_dh("bennett", params)[0]
+
+
+def parallelogram(theta: float) -> Mechanism:
+    """A planar parallelogram four-bar (crank 1, coupler 2, ground 2): its change points are bifurcations."""
+    O2, O4 = np.array([0.0, 0.0]), np.array([2.0, 0.0])
+    A = O2 + np.array([np.cos(theta), np.sin(theta)])
+    B = A + np.array([2.0, 0.0])
+    joints = [
+        {"name": "O2", "bodies": ["ground", "crank"], "point": O2, "direction": [0, 0, 1]},
+        {"name": "A", "bodies": ["crank", "coupler"], "point": A, "direction": [0, 0, 1]},
+        {"name": "B", "bodies": ["coupler", "rocker"], "point": B, "direction": [0, 0, 1]},
+        {"name": "O4", "bodies": ["rocker", "ground"], "point": O4, "direction": [0, 0, 1]},
+    ]
+    return Mechanism.from_joints("parallelogram", joints, planar=True)
+
+
+def test_bennett_path_keeps_the_closed_form_relation_and_closes_after_a_full_turn() -> None:
+    a1, a2, t1 = 45 * DEG, 75 * DEG, 90 * DEG
+    mech = bennett(a1, a2, t1)
+    path = trace(mech, max_steps=3000)
+    assert path.branches[0].end_reason == "closed path"
+    th = path.angles
+    k = np.sin((a2 + a1) / 2) / np.sin((a2 - a1) / 2)
+    # tan(t1/2) tan(t2/2) = k, written without poles: sin(t1/2) sin(t2/2) - k cos(t1/2) cos(t2/2) = 0
+    rel = np.sin(th[:, 0] / 2) * np.sin(th[:, 1] / 2) - k * np.cos(th[:, 0] / 2) * np.cos(th[:, 1] / 2)
+    assert np.max(np.abs(rel)) < 1e-10
+    np.testing.assert_allclose(np.sin(th[:, 2] + th[:, 0]), 0.0, atol=1e-10)  # theta3 = -theta1 (mod 2 pi)
+    # the drive (joint A) goes once round
+    assert np.ptp(th[:, 0]) == pytest.approx(2 * np.pi, abs=0.05)
+
+
+def test_landing_on_until_is_exact_in_adaptive_mode() -> None:
+    mech = bennett(30 * DEG, 80 * DEG, 60 * DEG)
+    target = 60 * DEG + 1.2345
+    path = trace(mech, until=("A", target), max_step=3 * DEG)
+    assert path.branches[0].end_reason == "reached target"
+    assert path.angles[-1, 0] == target  # exactly, not approximately
+    steps = np.linalg.norm(np.diff(path.angles, axis=0), axis=1)
+    # The predictor step never exceeds max_step; the chord adds the corrector's small normal move (< 1 %).
+    assert steps.max() <= 3 * DEG * 1.01
+
+
+def test_step_budget_is_reported() -> None:
+    mech = bennett(30 * DEG, 80 * DEG, 60 * DEG)
+    path = trace(mech, max_steps=7)
+    assert path.branches[0].end_reason == "step budget"
+    assert len(path.angles) == 8
+
+
+def test_paper_mode_reports_a_drive_turning_point_instead_of_failing_silently() -> None:
+    # A crank-rocker four-bar: the rocker's angle has a maximum; equal steps of the rocker cannot pass it.
+    from test_planar_mechanisms import four_bar
+
+    mech, _, _ = four_bar(1.0, 3.0, 2.5, 3.2, 0.3)
+    path = trace(mech, until=("O4", 2.0), steps=100)  # the rocker cannot swing 2 rad
+    reason = path.branches[0].end_reason
+    assert reason == "drive turning point" or reason.startswith("corrector failed at a fixed drive step")
+    assert path.angles[-1, 3] < 2.0
+
+
+def test_mobility_two_is_refused_with_advice() -> None:
+    from linkwork.linkages.hedgepeth import hedgepeth
+
+    with pytest.raises(LinkworkError, match="mobility 3"):
+        trace(hedgepeth(8, couple=False))
+
+
+def test_paper_mode_needs_a_target() -> None:
+    with pytest.raises(SpecError, match="until"):
+        trace(bennett(30 * DEG, 80 * DEG, 60 * DEG), steps=10)
+
+
+def test_parallelogram_change_point_is_located_and_both_branches_traced() -> None:
+    mech = parallelogram(60 * DEG)
+    path = trace(mech, drive="O2", branches=True, max_steps=4000, max_step=4 * DEG)
+    assert path.bifurcations, "the change points of a parallelogram linkage are bifurcations"
+    for b in path.bifurcations:
+        # At a change point every link is collinear: the crank is at 0 or 180 degrees from the ground line.
+        crank = 60 * DEG + b.angles[0]
+        assert abs(np.sin(crank)) < 1e-9
+        assert b.rank == 2  # 3 planar equations lose one rank
+        s = b.sigma
+        assert s[2] / s[0] < 1e-9
+        # Two branches: the parallelogram (coupler keeps its direction: A + B = 0) and the anti-parallelogram.
+        assert len(b.tangents) == 2
+        J = jacobian(mech, b.angles - mech.offsets)
+        for t in b.tangents:
+            assert np.linalg.norm(J @ t) < 1e-8
+        coupler_turn = [abs(t[0] + t[1]) for t in b.tangents]
+        assert min(coupler_turn) < 1e-8  # one branch keeps the coupler parallel to the ground
+    assert any(br.parent is not None for br in path.branches)
+    for br in path.branches:
+        assert br.end_reason != "corrector failed"
