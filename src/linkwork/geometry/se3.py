@@ -93,13 +93,23 @@ def inverse(T: ArrayLike) -> Array:
 
 
 def _so3_coefficients(theta: Array) -> tuple[Array, Array, Array]:
-    """``A = sin t / t``, ``B = (1 - cos t) / t^2``, ``C = (t - sin t) / t^3`` with series near zero."""
+    """``A = sin t / t``, ``B = (1 - cos t) / t^2``, ``C = (t - sin t) / t^3``, free of cancellation.
+
+    ``B`` is evaluated as ``2 sin^2(t/2) / t^2``; ``C`` by its Taylor series below 1e-2 (truncation < 1e-20).
+    """
     small = theta < SMALL_ANGLE
     t = np.where(small, 1.0, theta)
     t2 = theta * theta
     A = np.where(small, 1.0 - t2 / 6.0, np.sin(t) / t)
-    B = np.where(small, 0.5 - t2 / 24.0, (1.0 - np.cos(t)) / (t * t))
-    C = np.where(small, 1.0 / 6.0 - t2 / 120.0, (t - np.sin(t)) / (t * t * t))
+    half = np.sin(0.5 * t) / t
+    B = np.where(small, 0.5 - t2 / 24.0, 2.0 * half * half)
+    series = theta < 1e-2
+    tc = np.where(series, 1.0, theta)
+    C = np.where(
+        series,
+        1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0 - t2 * t2 * t2 / 362880.0,
+        (tc - np.sin(tc)) / (tc * tc * tc),
+    )
     return A, B, C
 
 
@@ -168,10 +178,16 @@ def log_se3(T: ArrayLike) -> Array:
     w = log_so3(T[..., :3, :3])
     theta = np.linalg.norm(w, axis=-1)
     A, B, _ = _so3_coefficients(theta)
-    small = theta < SMALL_ANGLE
-    t2 = np.where(small, 1.0, theta * theta)
-    # V^{-1} = I - K/2 + (1 - A / (2B)) / t^2 K^2
-    D = np.where(small, 1.0 / 12.0 + theta * theta / 720.0, (1.0 - A / (2.0 * B)) / t2)
+    # V^{-1} = I - K/2 + D K^2 with D = (1 - A / (2B)) / t^2, by its Taylor series below 1e-2 where the closed
+    # form cancels (truncation < 1e-20).
+    series = theta < 1e-2
+    th2 = theta * theta
+    t2 = np.where(series, 1.0, th2)
+    D = np.where(
+        series,
+        1.0 / 12.0 + th2 / 720.0 + th2 * th2 / 30240.0 + th2 * th2 * th2 / 1209600.0,
+        (1.0 - A / (2.0 * B)) / t2,
+    )
     K = hat3(w)
     eye = np.broadcast_to(np.eye(3), K.shape)
     Vinv = eye - 0.5 * K + D[..., None, None] * (K @ K)

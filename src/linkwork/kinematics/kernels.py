@@ -82,8 +82,9 @@ def log_rigid(R: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
         wx, wy, wz = f * sx, f * sy, f * sz
     out[0], out[1], out[2] = wx, wy, wz
     # v = V^-1 p with V^-1 = I - K/2 + D K^2
-    if t < 1e-6:
-        D = 1.0 / 12.0 + t * t / 720.0
+    if t < 1e-2:  # Taylor series where the closed form cancels (truncation < 1e-20)
+        t2 = t * t
+        D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
     else:
         A = np.sin(t) / t
         B = (1.0 - np.cos(t)) / (t * t)

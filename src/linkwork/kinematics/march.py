@@ -63,6 +63,11 @@ def correct(  # type: ignore[no-untyped-def]
         if held >= 0:
             for e in range(jac.shape[0]):
                 jac[e, held] = 0.0
+            # With the drive held the remaining columns have full rank away from singular points, and Eq. (28)
+            # keeps every singular value: its pseudo-inverse step is then the least-squares step, solved here
+            # by Cholesky on the normal equations; an ill-conditioned case falls back to the truncated SVD.
+            if least_squares_step(jac, res, held, u):
+                continue
         U, s, Vt = np.linalg.svd(jac)
         cut = truncate * s[0]
         for i in range(s.shape[0]):
@@ -75,6 +80,64 @@ def correct(  # type: ignore[no-untyped-def]
             for a in range(m):
                 u[a] -= Vt[i, a] * c  # Eq. (28): - sum_i w_i u_i^T e / v_ii
     return False, max_iter, prev
+
+
+@njit(cache=True)
+def least_squares_step(jac, res, held, u):  # type: ignore[no-untyped-def]
+    """``u -= argmin |J du + r|`` over the unknowns other than ``held``, by Cholesky of ``J^T J``.
+
+    Returns False (and leaves ``u`` alone) when a pivot is below ``1e-10`` of the largest diagonal, i.e. when
+    the condition number exceeds about 1e5: then the truncated SVD must decide what to keep.
+    """
+    E, m = jac.shape
+    k = m - 1
+    idx = np.empty(k, dtype=np.int64)
+    c = 0
+    for a in range(m):
+        if a != held:
+            idx[c] = a
+            c += 1
+    A = np.zeros((k, k))
+    b = np.zeros(k)
+    for i in range(k):
+        for j in range(i + 1):
+            acc = 0.0
+            for e in range(E):
+                acc += jac[e, idx[i]] * jac[e, idx[j]]
+            A[i, j] = acc
+        acc = 0.0
+        for e in range(E):
+            acc += jac[e, idx[i]] * res[e]
+        b[i] = acc
+    dmax = 0.0
+    for i in range(k):
+        dmax = max(dmax, A[i, i])
+    L = np.zeros((k, k))
+    for i in range(k):
+        for j in range(i + 1):
+            acc = A[i, j]
+            for p in range(j):
+                acc -= L[i, p] * L[j, p]
+            if i == j:
+                if acc <= 1e-10 * dmax:
+                    return False
+                L[i, i] = np.sqrt(acc)
+            else:
+                L[i, j] = acc / L[j, j]
+    y = np.empty(k)
+    for i in range(k):
+        acc = b[i]
+        for p in range(i):
+            acc -= L[i, p] * y[p]
+        y[i] = acc / L[i, i]
+    for i in range(k - 1, -1, -1):
+        acc = y[i]
+        for p in range(i + 1, k):
+            acc -= L[p, i] * y[p]
+        y[i] = acc / L[i, i]
+    for i in range(k):
+        u[idx[i]] -= y[i]
+    return True
 
 
 @njit(cache=True)

@@ -61,3 +61,16 @@ def numerical_rank(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> int:
     if ratios[best] >= tol.min_gap:
         return sure + best
     return candidates
+
+
+def numerical_ranks(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> np.ndarray:
+    """:func:`numerical_rank` of every row of ``sigma (N, k)``, vectorised over the rows that need no gap test."""
+    s = np.atleast_2d(np.asarray(sigma, dtype=float))
+    first = np.where(s[:, :1] > 0.0, s[:, :1], 1.0)
+    rel = s / first
+    sure = np.sum(rel > tol.loose, axis=1)
+    candidates = np.sum(rel > tol.floor, axis=1)
+    out = np.where(s[:, 0] > 0.0, sure, 0).astype(np.int64)
+    for i in np.flatnonzero((candidates != sure) & (s[:, 0] > 0.0)):
+        out[i] = numerical_rank(s[i], tol)
+    return out

@@ -20,7 +20,7 @@ from linkwork.errors import LinkworkError, SpecError
 from linkwork.kinematics.bifurcation import Workspace, branch_tangents, correct_on_plane, locate, polish
 from linkwork.kinematics.march import FAILED, SIGN_CHANGE, STOP_REASONS, march
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank
+from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 
 Array = NDArray[np.float64]
 Progress = Callable[[float, str], None]
@@ -123,15 +123,29 @@ class Path:
 
 @dataclass
 class _Rows:
-    """Growing per-point storage."""
+    """Growing per-point storage, one block of rows per compiled march call."""
 
     u: list[Array] = field(default_factory=list)
     sigma: list[Array] = field(default_factory=list)
-    res: list[float] = field(default_factory=list)
-    tau: list[float] = field(default_factory=list)
-    s: list[float] = field(default_factory=list)
-    branch: list[int] = field(default_factory=list)
-    step: list[int] = field(default_factory=list)
+    res: list[Array] = field(default_factory=list)
+    tau: list[Array] = field(default_factory=list)
+    s: list[Array] = field(default_factory=list)
+    branch: list[NDArray[np.int64]] = field(default_factory=list)
+    step: list[NDArray[np.int64]] = field(default_factory=list)
+
+    def add_point(self, u: Array, sigma: Array, res: float, branch: int) -> None:
+        """Append one point (a bifurcation point opening a branch: arclength 0, step 0, test 0)."""
+        self.u.append(u[None, :].copy())
+        self.sigma.append(sigma[None, :].copy())
+        self.res.append(np.array([res]))
+        self.tau.append(np.zeros(1))
+        self.s.append(np.zeros(1))
+        self.branch.append(np.array([branch], dtype=np.int64))
+        self.step.append(np.zeros(1, dtype=np.int64))
+
+    def count(self) -> int:
+        """Number of points stored."""
+        return sum(len(b) for b in self.branch)
 
 
 def trace(
@@ -261,16 +275,15 @@ def trace(
                 tol.closure, tol.truncate, 25, N, r_path, periodic, lo, hi, True,
                 target is None, out_u, out_t, out_sigma, out_res, out_tau, out_s,
             )  # fmt: skip
-            s_base = rows.s[-1] if (not first and rows.s) else 0.0
+            s_base = rows.s[-1][-1] if (not first and rows.s) else 0.0
             begin = 0 if first else 1
-            for i in range(begin, count):
-                rows.u.append(out_u[i].copy())
-                rows.sigma.append(out_sigma[i].copy())
-                rows.res.append(float(out_res[i]))
-                rows.tau.append(float(out_tau[i]))
-                rows.s.append(s_base + float(out_s[i]))
-                rows.branch.append(branch_id)
-                rows.step.append(n_steps + i - begin + (0 if first else 1))
+            rows.u.append(out_u[begin:count])
+            rows.sigma.append(out_sigma[begin:count])
+            rows.res.append(out_res[begin:count])
+            rows.tau.append(out_tau[begin:count])
+            rows.s.append(s_base + out_s[begin:count])
+            rows.branch.append(np.full(count - begin, branch_id, dtype=np.int64))
+            rows.step.append(n_steps + np.arange(begin, count) - begin + (0 if first else 1))
             n_steps += count - 1
             budget[0] -= count - 1
             first = False
@@ -286,7 +299,7 @@ def trace(
                 known = _match(found, u_star, periodic)
                 if known is None:
                     bif = _make_bifurcation(
-                        mech, ws, len(found), branch_id, len(rows.u) - 1, u_star, width, tol, r_path - 1
+                        mech, ws, len(found), branch_id, rows.count() - 1, u_star, width, tol, r_path - 1
                     )
                     found.append(bif)
                     if branches:
@@ -335,42 +348,36 @@ def trace(
         U1, _, Vt1 = np.linalg.svd(jac1)
         t1 = Vt1[-1] if Vt1[-1] @ t_dir > 0 else -Vt1[-1]
         # Record the bifurcation point itself as the branch's first point, then march on.
-        _, _, jst = ws.evaluate(u_star)
-        rows.u.append(u_star.copy())
-        rows.sigma.append(np.linalg.svd(jst, compute_uv=False)[:n_sigma])
-        rows.res.append(_r)
-        rows.tau.append(0.0)
-        rows.s.append(0.0)
-        rows.branch.append(bid)
-        rows.step.append(0)
+        r_star, _, jst = ws.evaluate(u_star)
+        rows.add_point(u_star, np.linalg.svd(jst, compute_uv=False)[:n_sigma], r_star, bid)
         s_off = float(np.linalg.norm(u1 - u_star))
         start_len = len(rows.u)
         nb, rb = run_branch(bid, u1, t1, np.ascontiguousarray(U1[:, :r_path]), False, h, True)
         for i in range(start_len, len(rows.u)):
-            rows.s[i] += s_off
-            rows.step[i] += 1
+            rows.s[i] = rows.s[i] + s_off
+            rows.step[i] = rows.step[i] + 1
         branch_list.append(Branch(bid, parent, bif_id, direction, nb + 1, rb))
 
-    U = np.array(rows.u).reshape(len(rows.u), m)
+    U = np.concatenate(rows.u, axis=0)
     q = mech.q_from_u(U)
-    sigma = np.array(rows.sigma).reshape(len(rows.u), n_sigma)
-    ranks = np.array([numerical_rank(s, tol) for s in sigma], dtype=np.int64)
+    sigma = np.concatenate(rows.sigma, axis=0)
+    ranks = numerical_ranks(sigma, tol)
     return Path(
         mechanism=mech,
         drive=mech.joint_names[d_joint],
         angles=mech.angles_from_q(q),
         sigma=sigma,
-        residual=np.array(rows.res),
-        branch=np.array(rows.branch, dtype=np.int64),
-        step=np.array(rows.step, dtype=np.int64),
-        arclength=np.array(rows.s),
-        test=np.array(rows.tau),
+        residual=np.concatenate(rows.res),
+        branch=np.concatenate(rows.branch),
+        step=np.concatenate(rows.step),
+        arclength=np.concatenate(rows.s),
+        test=np.concatenate(rows.tau),
         rank=ranks,
         bifurcations=tuple(found),
         branches=tuple(branch_list),
         stats={
             "seconds": time.perf_counter() - started,
-            "points": len(rows.u),
+            "points": len(U),
             "start_rank": r_path,
             "start_mobility": mobility,
             "mode": "paper" if paper else "adaptive",
