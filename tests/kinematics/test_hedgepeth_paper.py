@@ -12,10 +12,20 @@ from linkwork.linkages.hedgepeth import deployed_angle, hedgepeth, hedgepeth_ang
 S2, S3, S6 = np.sqrt(2.0), np.sqrt(3.0), np.sqrt(6.0)
 # The paper's printed T_1 (Sec. 3.1) and the type-2 matrix printed inside Eq. (13).
 T1_PRINTED = np.array(
-    [[-2 / 3, S3 / 3, -S2 / 3, S6 / 3], [S3 / 3, 0, -S6 / 3, 0], [-S2 / 3, -S6 / 3, -1 / 3, S3 / 3], [0, 0, 0, 1]]
+    [
+        [-2 / 3, S3 / 3, -S2 / 3, S6 / 3],
+        [S3 / 3, 0, -S6 / 3, 0],
+        [-S2 / 3, -S6 / 3, -1 / 3, S3 / 3],
+        [0, 0, 0, 1],
+    ]
 )
 T2_PRINTED = np.array(
-    [[-2 / 3, -S3 / 3, -S2 / 3, S6 / 3], [-S3 / 3, 0, S6 / 3, 0], [-S2 / 3, S6 / 3, -1 / 3, S3 / 3], [0, 0, 0, 1]]
+    [
+        [-2 / 3, -S3 / 3, -S2 / 3, S6 / 3],
+        [-S3 / 3, 0, S6 / 3, 0],
+        [-S2 / 3, S6 / 3, -1 / 3, S3 / 3],
+        [0, 0, 0, 1],
+    ]
 )
 
 
@@ -31,7 +41,9 @@ def test_rod_angles_for_the_square_match_section_3_1() -> None:
     assert np.degrees(g["phi"]) == pytest.approx(-30.0, abs=1e-12)
     assert np.degrees(g["omega"]) == pytest.approx(90.0 + np.degrees(np.arctan(1 / np.sqrt(8))), abs=1e-12)
     assert np.degrees(g["psi"]) == pytest.approx(-150.0, abs=1e-12)
-    np.testing.assert_allclose(rod_transform(g["phi"], g["omega"], g["psi"], [S6 / 3, 0, S3 / 3]), T1_PRINTED, atol=1e-15)
+    np.testing.assert_allclose(
+        rod_transform(g["phi"], g["omega"], g["psi"], [S6 / 3, 0, S3 / 3]), T1_PRINTED, atol=1e-15
+    )
 
 
 @pytest.mark.parametrize("n", [4, 6, 8, 10, 12, 20, 50])
@@ -81,7 +93,9 @@ def test_trace_from_the_bundle_lands_on_the_deployed_angle_of_equation_10(n: int
 def test_equations_10_and_13_agree_on_the_deployed_square() -> None:
     # Eq. (10) gives theta_A = 120 deg for n = 4; Eq. (13) then gives theta_B = 60 deg; the tracer must end there.
     path = trace(hedgepeth(4), until=("A", deployed_angle(4)), steps=200)
-    assert np.degrees(path.angles[-1, 1]) == pytest.approx(np.degrees(_eq13(np.array([deployed_angle(4)]))[0]), abs=1e-9)
+    assert np.degrees(path.angles[-1, 1]) == pytest.approx(
+        np.degrees(_eq13(np.array([deployed_angle(4)]))[0]), abs=1e-9
+    )
     assert np.degrees(path.angles[-1, 1]) == pytest.approx(60.0, abs=1e-9)
 
 

@@ -24,7 +24,8 @@ def linkages() -> None:
         entry = REGISTRY[name]
         defaults = entry.file_defaults()
         params = "\n".join(
-            f"{k} = {defaults[k]:g}{' deg' if p.unit == 'deg' else ''}: {p.help}" for k, p in entry.params.items()
+            f"{k} = {defaults[k]:g}{' deg' if p.unit == 'deg' else ''}: {p.help}"
+            for k, p in entry.params.items()
         )
         table.add_row(name, params or "-", entry.summary)
     console.print(table)
@@ -36,7 +37,9 @@ def show(
     spec: Annotated[str, typer.Argument(help="A built-in name or a TOML spec file.")],
     set_: Annotated[
         list[str] | None,
-        typer.Option("--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False),
+        typer.Option(
+            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
+        ),
     ] = None,
 ) -> None:
     """Print a linkage as a TOML spec file (its joints' axes at the start), ready to edit and trace."""

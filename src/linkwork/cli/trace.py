@@ -42,30 +42,42 @@ def _parse_couple(items: list[str] | None) -> list[list[str]]:
 
 @friendly_errors
 def trace(
-    spec: Annotated[str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")],
+    spec: Annotated[
+        str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")
+    ],
     set_: Annotated[
         list[str] | None,
-        typer.Option("--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False),
+        typer.Option(
+            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
+        ),
     ] = None,
     drive: Annotated[str | None, typer.Option(help="Joint that orients and counts the steps.")] = None,
     until: Annotated[
         str | None, typer.Option(help="Stop exactly when JOINT reaches VALUE (degrees), e.g. A=87.0067.")
     ] = None,
     steps: Annotated[
-        int | None, typer.Option(help="Paper mode: N equal steps of the drive up to --until (the paper uses 200).")
+        int | None,
+        typer.Option(help="Paper mode: N equal steps of the drive up to --until (the paper uses 200)."),
     ] = None,
-    max_step: Annotated[float, typer.Option(help="Largest adaptive step (degrees, arclength in the joints).")] = 2.0,
+    max_step: Annotated[
+        float, typer.Option(help="Largest adaptive step (degrees, arclength in the joints).")
+    ] = 2.0,
     max_steps: Annotated[int, typer.Option(help="Step budget over all branches.")] = 5000,
     couple: Annotated[
         list[str] | None, typer.Option(help="Force joints equal, e.g. A=C=E; repeatable.", show_default=False)
     ] = None,
     fixed: Annotated[
-        list[str] | None, typer.Option(help="Hold a joint at its start value; repeatable.", show_default=False)
+        list[str] | None,
+        typer.Option(help="Hold a joint at its start value; repeatable.", show_default=False),
     ] = None,
-    branches: Annotated[bool, typer.Option("--branches", help="Follow every branch at every bifurcation.")] = False,
+    branches: Annotated[
+        bool, typer.Option("--branches", help="Follow every branch at every bifurcation.")
+    ] = False,
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
-    html: Annotated[bool, typer.Option("--html", help="Interactive viewer (not available in this version).")] = False,
+    html: Annotated[
+        bool, typer.Option("--html", help="Interactive viewer (not available in this version).")
+    ] = False,
 ) -> None:
     """Trace a closed-loop linkage: path.csv, report.json and figures in --out."""
     import numpy as np
@@ -132,12 +144,12 @@ def trace(
     console.print(f"wrote {', '.join(written)} to {out}/")
 
 
-def summary(path) -> None:  # type: ignore[no-untyped-def]
+def summary(path) -> None:
     """Print the summary tables of a traced path (used by ``linkwork demo`` too)."""
     _summary(path)
 
 
-def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True) -> list[Path]:  # type: ignore[no-untyped-def]
+def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True) -> list[Path]:
     """Write path.csv, report.json and (if matplotlib is there) the figures into ``out``, all or nothing."""
     from linkwork.io.results import write_path_csv, write_report_json
 
@@ -155,7 +167,7 @@ def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True) -> l
     return [Path(out) / f.name for f in figures]
 
 
-def _summary(path) -> None:  # type: ignore[no-untyped-def]
+def _summary(path) -> None:
     """Print the rich summary tables of a traced path."""
     import numpy as np
     from rich.table import Table

@@ -111,8 +111,12 @@ def report_dict(path: Path, assembly: Any | None = None) -> dict[str, Any]:
                 "direction": br.direction,
                 "steps": br.steps,
                 "end_reason": br.end_reason,
-                "start": dict(zip(names, map(float, _display(path, path.angles[path.branch == br.id][0])), strict=True)),
-                "end": dict(zip(names, map(float, _display(path, path.angles[path.branch == br.id][-1])), strict=True)),
+                "start": dict(
+                    zip(names, map(float, _display(path, path.angles[path.branch == br.id][0])), strict=True)
+                ),
+                "end": dict(
+                    zip(names, map(float, _display(path, path.angles[path.branch == br.id][-1])), strict=True)
+                ),
             }
             for br in path.branches
         ],

@@ -60,8 +60,16 @@ class Workspace:
     def evaluate(self, u: Array) -> tuple[float, Array, Array]:
         """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
         r = evaluate(
-            self.twists, self.loop_joint, self.loop_sign, self.loop_ptr, self.rows, self.groups,
-            np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac,
+            self.twists,
+            self.loop_joint,
+            self.loop_sign,
+            self.loop_ptr,
+            self.rows,
+            self.groups,
+            np.ascontiguousarray(u, dtype=float),
+            self.q,
+            self.res,
+            self.jac,
         )
         return float(r), self.res.copy(), self.jac.copy()
 
@@ -281,7 +289,10 @@ def polish(
         d = curve(0, x[0]) - curve(1, x[1])
         e = 1e-7
         J = np.column_stack(
-            [(curve(0, x[0] + e) - curve(0, x[0] - e)) / (2 * e), -(curve(1, x[1] + e) - curve(1, x[1] - e)) / (2 * e)]
+            [
+                (curve(0, x[0] + e) - curve(0, x[0] - e)) / (2 * e),
+                -(curve(1, x[1] + e) - curve(1, x[1] - e)) / (2 * e),
+            ]
         )
         step = np.linalg.lstsq(J, -d, rcond=None)[0]
         x += step

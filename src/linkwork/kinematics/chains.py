@@ -135,7 +135,9 @@ def from_dh(
     """
     names = list(joint_names or [chr(ord("A") + i) for i in range(len(params))])
     constants = [
-        translation([0.0, 0.0, p.get("d", 0.0)]) @ translation([p.get("a", 0.0), 0.0, 0.0]) @ rot_x(p.get("alpha", 0.0))
+        translation([0.0, 0.0, p.get("d", 0.0)])
+        @ translation([p.get("a", 0.0), 0.0, 0.0])
+        @ rot_x(p.get("alpha", 0.0))
         for p in params
     ]
     thetas = [p.get("theta", 0.0) for p in params]

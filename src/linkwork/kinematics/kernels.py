@@ -40,7 +40,9 @@ def exp_unit_twist(w: np.ndarray, v: np.ndarray, theta: float, R: np.ndarray, p:
     wxv2 = w[0] * v[1] - w[1] * v[0]
     wv = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
     for i in range(3):
-        p[i] = (wxv0 if i == 0 else (wxv1 if i == 1 else wxv2)) - (R[i, 0] * wxv0 + R[i, 1] * wxv1 + R[i, 2] * wxv2)
+        p[i] = (wxv0 if i == 0 else (wxv1 if i == 1 else wxv2)) - (
+            R[i, 0] * wxv0 + R[i, 1] * wxv1 + R[i, 2] * wxv2
+        )
         p[i] += w[i] * wv * theta
 
 

@@ -30,7 +30,7 @@ STOP_REASONS = {
 
 
 @njit(cache=True)
-def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac):  # type: ignore[no-untyped-def]
+def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac):
     """Residual and reduced Jacobian at unknowns ``u`` (``q``, ``res``, ``jac`` are work arrays)."""
     expand(u, groups, q)
     closure_jacobian(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, u.shape[0], res, jac)
@@ -38,7 +38,7 @@ def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, j
 
 
 @njit(cache=True)
-def correct(  # type: ignore[no-untyped-def]
+def correct(
     twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, truncate, max_iter, q, res, jac
 ):
     """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
@@ -83,7 +83,7 @@ def correct(  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def least_squares_step(jac, res, held, u):  # type: ignore[no-untyped-def]
+def least_squares_step(jac, res, held, u):
     """``u -= argmin |J du + r|`` over the unknowns other than ``held``, by Cholesky of ``J^T J``.
 
     Returns False (and leaves ``u`` alone) when a pivot is below ``1e-10`` of the largest diagonal, i.e. when
@@ -141,7 +141,7 @@ def least_squares_step(jac, res, held, u):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True)
-def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):  # type: ignore[no-untyped-def]
+def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
     """Oriented null vector, singular values and the signed test function at the current Jacobian.
 
     ``basis (E, r_path)`` is the previous oriented range basis, updated in place. Returns the test value
@@ -178,7 +178,7 @@ def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):  # type: ign
 
 
 @njit(cache=True)
-def march(  # type: ignore[no-untyped-def]
+def march(
     twists,
     loop_joint,
     loop_sign,
@@ -288,7 +288,20 @@ def march(  # type: ignore[no-untyped-def]
                 held = drive
         # ---- corrector (Sec. 4.2, Eq. (28))
         ok, iters, r = correct(
-            twists, loop_joint, loop_sign, loop_ptr, rows, groups, u_try, held, tol, truncate, max_iter, q, res, jac
+            twists,
+            loop_joint,
+            loop_sign,
+            loop_ptr,
+            rows,
+            groups,
+            u_try,
+            held,
+            tol,
+            truncate,
+            max_iter,
+            q,
+            res,
+            jac,
         )
         if ok:
             basis_try[:, :] = basis

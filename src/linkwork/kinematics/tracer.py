@@ -293,8 +293,15 @@ def trace(
                 # Locate between the last two points; the basis before the change orients the test function.
                 basis_a = _basis_before(ws, out_u[count - 2], out_t[count - 2], basis_prev, r_path)
                 u_star, width = locate(
-                    ws, out_u[count - 2], out_t[count - 2], basis_a, out_u[count - 1], out_t[count - 1],
-                    r_path, tol, n_sigma,
+                    ws,
+                    out_u[count - 2],
+                    out_t[count - 2],
+                    basis_a,
+                    out_u[count - 1],
+                    out_t[count - 1],
+                    r_path,
+                    tol,
+                    n_sigma,
                 )
                 known = _match(found, u_star, periodic)
                 if known is None:
@@ -349,7 +356,9 @@ def trace(
         t1 = Vt1[-1] if Vt1[-1] @ t_dir > 0 else -Vt1[-1]
         # Record the bifurcation point itself as the branch's first point, then march on.
         r_star, _, jst = ws.evaluate(u_star)
-        rows.add_point(u_star, np.linalg.svd(jst, compute_uv=False)[:n_sigma], r_star, bid)
+        rows.add_point(
+            u_star, np.asarray(np.linalg.svd(jst, compute_uv=False)[:n_sigma], dtype=float), r_star, bid
+        )
         s_off = float(np.linalg.norm(u1 - u_star))
         start_len = len(rows.u)
         nb, rb = run_branch(bid, u1, t1, np.ascontiguousarray(U1[:, :r_path]), False, h, True)
@@ -401,7 +410,7 @@ def _match(found: list[Bifurcation], u: Array, periodic: NDArray[np.bool_], tol:
     for b in found:
         diff = b.u - u
         diff[periodic] = (diff[periodic] + np.pi) % (2.0 * np.pi) - np.pi
-        if np.linalg.norm(diff) < tol * max(1.0, np.linalg.norm(u)):
+        if np.linalg.norm(diff) < tol * max(1.0, float(np.linalg.norm(u))):
             return b.id
     return None
 

@@ -61,7 +61,8 @@ class LinkageEntry:
     def file_defaults(self) -> dict[str, float | int]:
         """Defaults in file units (degrees for angles)."""
         return {
-            k: (float(np.degrees(p.default)) if p.unit == "deg" else p.default) for k, p in self.params.items()
+            k: (float(np.degrees(p.default)) if p.unit == "deg" else p.default)
+            for k, p in self.params.items()
         }
 
 
