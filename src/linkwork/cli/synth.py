@@ -1,4 +1,4 @@
-"""``linkwork synth``: synthesise a shape-changing chain from a problem file, write its files, print a summary.
+"""``linkwork synth``: synthesise a shape-changing chain from a problem file, write files, print a summary.
 
 A thin layer over :func:`linkwork.io.problem.load_problem` and :func:`linkwork.synthesis.synthesize`. The
 command writes into a staging folder and moves the files into ``--out`` only when all of them were written, so
@@ -44,7 +44,7 @@ def synth(
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
     html: Annotated[bool, typer.Option("--html", help="Also write an interactive HTML viewer.")] = False,
 ) -> None:
-    """Synthesise a chain of rigid segments with revolute and prismatic joints that approximates every profile.
+    """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
 
     Writes chain.json, target_profiles.csv, outline.svg, outline.dxf and the figures (PNG and SVG) into --out,
     and prints a summary: the profiles, the design vector, the segment and error matrices, E_max and E_mean
@@ -80,14 +80,15 @@ def synth(
     print_summary(result)
     console.print(f"wrote {len(written)} files to {out}/: " + ", ".join(path.name for path in written))
     if html:
-        console.print("note: the interactive HTML viewer of synthesis results comes in a later release")
+        console.print("note: --html: the interactive HTML viewer comes in a later release")
 
 
 def write_synthesis_outputs(result: SynthesisResult, folder: Path, *, plots: bool = True) -> list[Path]:
     """Write every output file of a synthesis result into ``folder`` and return their paths.
 
     ``chain.json`` (the contract of ``result.to_dict()``), ``target_profiles.csv``, ``outline.svg``,
-    ``outline.dxf`` and, when ``plots``, the figures of :func:`linkwork.viz.synthesis_plots.write_synthesis_figures`.
+    ``outline.dxf`` and, when ``plots``, the figures of
+    :func:`linkwork.viz.synthesis_plots.write_synthesis_figures`.
     """
     from linkwork.io.profiles import write_outline_dxf, write_outline_svg
     from linkwork.synthesis import write_target_profiles_csv

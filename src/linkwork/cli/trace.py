@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -25,7 +26,7 @@ def _parse_until(text: str | None) -> tuple[str, float] | None:
         value = float(raw)
     except ValueError:
         value = float("nan")
-    if not sep or not name.strip() or value != value:
+    if not sep or not name.strip() or not math.isfinite(value):
         raise fail(f"--until {text!r}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
     return name.strip(), value
 

@@ -1,6 +1,7 @@
-"""Synthesis problem files: read the TOML file of ``linkwork synth`` into a :class:`~linkwork.synthesis.problem.Problem`.
+"""Synthesis problem files: read the TOML file of ``linkwork synth`` into a
+:class:`~linkwork.synthesis.problem.Problem`.
 
-The file is data, never code: it is parsed with :mod:`tomllib` and every key is checked for its type and range.
+The file is data, never code: it is parsed with :mod:`tomllib` and every key is checked for type and range.
 Angles are in degrees in the file and in radians in the returned problem. A mistake is reported as a
 :class:`~linkwork.errors.SpecError` naming the file, the key and what was expected, for example
 ``problem.toml: piece_length: expected a positive number, got "abc"``.
@@ -33,7 +34,7 @@ import numpy as np
 
 from linkwork.errors import SpecError
 from linkwork.io.profiles import COINCIDENT, load_profile
-from linkwork.synthesis.problem import Problem
+from linkwork.synthesis.problem import Problem, ProfileKind
 
 KINDS = ("open", "closed", "fixed-end")
 """The values of ``type``."""
@@ -74,7 +75,7 @@ def _show(value: Any) -> str:
 
 
 class _Keys:
-    """The table of a problem file with typed, checked getters that raise :class:`SpecError` naming the key."""
+    """A problem file's table with typed, checked getters that raise :class:`SpecError` naming the key."""
 
     def __init__(self, table: dict[str, Any], source: str) -> None:
         self.table = table
@@ -187,8 +188,9 @@ def load_problem(path: str | Path) -> Problem:
     Raises
     ------
     SpecError
-        ``file: key: what was expected`` for an unknown key, a missing required key, a value of the wrong type or
-        range, a profile file that is missing, or a closed problem whose profile does not return to its start.
+        ``file: key: what was expected`` for an unknown key, a missing required key, a value of the wrong type
+        or range, a profile file that is missing, or a closed problem whose profile does not return to its
+        start.
         An unreadable or malformed profile file is reported naming that file.
     """
     path = Path(path)
@@ -199,8 +201,10 @@ def load_problem(path: str | Path) -> Problem:
         if key not in KEYS:
             raise keys.error(key, f"unknown key; expected one of {', '.join(KEYS)}")
 
-    kind = keys.get("type", "open", lambda v: v if v in KINDS else None, "one of open, closed, fixed-end")
-    files = keys.get("profiles", [], _string_list, "a list of at least 2 profile files")
+    kind: ProfileKind = keys.get(
+        "type", "open", lambda v: v if v in KINDS else None, "one of open, closed, fixed-end"
+    )
+    files: list[str] = keys.get("profiles", [], _string_list, "a list of at least 2 profile files")
     if len(files) < 2:
         raise keys.error("profiles", f"lists {len(files)} file(s); expected at least 2 profile files")
     piece_length = keys.get("piece_length", 0.0, _positive, "a positive number")

@@ -9,12 +9,13 @@ distinct consecutive points on a curve that does not cross itself. Problems are 
 Curved geometry (SVG arcs and Bézier curves, DXF bulges and splines) is flattened into straight pieces whose
 largest distance from the true curve (the sagitta) is at most ``tolerance`` times the size of the drawing, the
 diagonal of the bounding box of the shape's defining points (vertices and control points). The default,
-:data:`FLATTEN_TOLERANCE`, is ``1e-4``: a curve one unit across is followed to within 0.0001. Every vertex of the
-flattened polyline lies on the true curve (to rounding).
+:data:`FLATTEN_TOLERANCE`, is ``1e-4``: a curve one unit across is followed to within 0.0001. Every
+vertex of the flattened polyline lies on the true curve (to rounding).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -46,7 +47,7 @@ _CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier
 
 
 def _size(points: Points) -> float:
-    """The diagonal of the bounding box of ``points`` (1 for a degenerate box, so tolerances stay positive)."""
+    """The diagonal of the bounding box of ``points`` (1 for a degenerate box: tolerances stay positive)."""
     if len(points) == 0:
         return 1.0
     diagonal = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))
@@ -74,9 +75,9 @@ def is_closed(points: ArrayLike) -> bool:
 def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
     """The first pair of pieces of a polyline that meet other than at their shared point, or None.
 
-    Piece ``i`` joins points ``i`` and ``i + 1``. Neighbouring pieces may share their common point but must not
-    fold back onto each other; any other two pieces must not touch. For a closed polyline (last point equal to
-    the first) the first and last pieces share the closing point, which is not a crossing.
+    Piece ``i`` joins points ``i`` and ``i + 1``. Neighbouring pieces may share their common point but must
+    not fold back onto each other; no other two pieces may touch. For a closed polyline (last point equal
+    to the first) the first and last pieces share the closing point, which is not a crossing.
 
     Parameters
     ----------
@@ -111,8 +112,8 @@ def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
     lo = np.minimum(a, b) - length_tol
     hi = np.maximum(a, b) + length_tol
 
-    # Sweep along x: after sorting pieces by their left end, piece k can only meet the pieces that start before
-    # it ends, a contiguous run found by searchsorted; the run is short for any curve that is not a tangle.
+    # Sweep along x: after sorting pieces by their left end, piece k can only meet the pieces that start
+    # before it ends, a contiguous run found by searchsorted; the run is short for any curve but a tangle.
     order = np.argsort(lo[:, 0], kind="stable")
     run_end = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
     counts = np.maximum(run_end - np.arange(n_pieces) - 1, 0)
@@ -122,8 +123,8 @@ def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
     for first in range(0, total, batch):
         flat = np.arange(first, min(first + batch, total))
         k = np.searchsorted(offsets, flat, side="right") - 1
-        i, j = order[k], order[k + 1 + flat - offsets[k]]
-        i, j = np.minimum(i, j), np.maximum(i, j)
+        first_piece, other_piece = order[k], order[k + 1 + flat - offsets[k]]
+        i, j = np.minimum(first_piece, other_piece), np.maximum(first_piece, other_piece)
         keep = (j >= i + 2) & np.all(lo[i] <= hi[j], axis=1) & np.all(lo[j] <= hi[i], axis=1)
         if closed:
             keep &= ~((i == 0) & (j == n_pieces - 1))
@@ -136,7 +137,7 @@ def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
 
 
 def _pieces_meet(a: Points, b: Points, c: Points, d: Points, length_tol: float) -> NDArray[np.bool_]:
-    """Whether pieces ``a-b`` and ``c-d`` (rows of ``(K, 2)`` arrays) touch, with bounding boxes known to overlap.
+    """Whether pieces ``a-b`` and ``c-d`` (rows of ``(K, 2)`` arrays) touch; their bounding boxes overlap.
 
     Each piece's end points must lie on opposite sides of (or on) the other piece's line; "on" means within
     ``length_tol``. Collinear pieces pass both tests, and their overlapping boxes then mean they overlap.
@@ -424,7 +425,7 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 
 
 def write_profile_svg(path: str | Path, points: ArrayLike) -> None:
-    """Write a profile as an SVG drawing with one path of straight pieces (y up, as :func:`read_profile_svg`)."""
+    """Write a profile as an SVG drawing: one path of straight pieces (y up, as :func:`read_profile_svg`)."""
     pts = np.asarray(points, dtype=float)
     Path(path).write_text(_svg_document([_svg_path(_svg_d(pts), "#1f77b4")], [pts]), encoding="utf-8")
 
@@ -518,7 +519,7 @@ def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, to
     absolute = tolerance * _size(np.array([v[:2] for v in vertices], dtype=float))
     chain = [*vertices, vertices[0]] if closed else vertices
     points = [chain[0][:2]]
-    for (x0, y0, bulge), (x1, y1, _) in zip(chain[:-1], chain[1:], strict=True):
+    for (x0, y0, bulge), (x1, y1, _) in itertools.pairwise(chain):
         if bulge == 0.0 or (x0, y0) == (x1, y1):
             points.append((x1, y1))
             continue

@@ -39,6 +39,7 @@ import importlib
 import math
 import pkgutil
 import re
+import tomllib
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -46,7 +47,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 
 from linkwork.errors import AssemblyError, SpecError
 from linkwork.geometry import line_twist
@@ -160,6 +160,7 @@ def load_spec(path: str | Path) -> LoadedSpec:
     reader = _Reader(source)
     reader.check_keys(table, "", TOP_KEYS)
     name = reader.string(table, "name", "", default=path.stem)
+    reader.string(table, "description", "", default="")  # free text for the reader
     unit = reader.choice(table, "angles", "", ANGLE_UNITS, default="deg")
     reader.degrees = unit == "deg"
     has_loop, has_mech = "loop" in table, "mechanism" in table
@@ -275,6 +276,15 @@ def _show(value: Any) -> str:
     return str(value)
 
 
+def _closest(word: str, choices: Sequence[str], cutoff: float = 0.6) -> str | None:
+    """The choice closest to a mistyped ``word`` (ignoring case), or ``None`` when none is close."""
+    lowered = {choice.lower(): choice for choice in choices}
+    if word.lower() in lowered:
+        return lowered[word.lower()]
+    close = difflib.get_close_matches(word.lower(), list(lowered), n=1, cutoff=cutoff)
+    return lowered[close[0]] if close else None
+
+
 def _key(path: str, key: str | int) -> str:
     """Join a key path: ``loop`` and ``joints`` give ``loop.joints``, then 2 gives ``loop.joints[2]``."""
     if isinstance(key, int):
@@ -303,8 +313,8 @@ class _Reader:
         for key in table:
             if key in allowed:
                 continue
-            close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
-            hint = f'did you mean "{close[0]}"? ' if close else ""
+            close = _closest(key, allowed)
+            hint = f'did you mean "{close}"? ' if close else ""
             elsewhere = _ELSEWHERE.get(key)
             where = f' ("{key}" belongs in {elsewhere})' if elsewhere and not close else ""
             raise self.error(
@@ -332,12 +342,10 @@ class _Reader:
         value = table[key]
         if not isinstance(value, str) or value not in choices:
             quoted = " or ".join(f'"{c}"' for c in choices)
-            close = (
-                difflib.get_close_matches(str(value), choices, n=1, cutoff=0.5)
-                if isinstance(value, str)
-                else []
-            )
-            hint = f' (did you mean "{close[0]}"?)' if close else ""
+            if len(choices) > 2:
+                quoted = "one of " + ", ".join(f'"{c}"' for c in choices)
+            close = _closest(value, choices, cutoff=0.5) if isinstance(value, str) else None
+            hint = f' (did you mean "{close}"?)' if close else ""
             raise self.error(_key(path, key), f"expected {quoted}, got {_show(value)}{hint}")
         return value
 
@@ -440,8 +448,8 @@ class _Reader:
             if not isinstance(value, str):
                 raise self.error(key, f"expected a joint name, got {_show(value)}")
             if value not in names:
-                close = difflib.get_close_matches(value, names, n=1)
-                hint = f'did you mean "{close[0]}"? ' if close else ""
+                close = _closest(value, names)
+                hint = f'did you mean "{close}"? ' if close else ""
                 raise self.error(key, f'unknown joint "{value}"; {hint}joints are {known}')
             return value
 

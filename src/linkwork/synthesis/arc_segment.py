@@ -1,10 +1,10 @@
 """C-segments (Sec. 3.4): constant-curvature arcs of one curvature and one piece length, and m_j pieces each.
 
-The paper averages the radius of curvature (Eq. 18); we average the signed curvature ``1/r`` instead, which stays
-bounded on nearly straight pieces. Eq. (20) lacks its ``1/p``: the mean piece length is the mean over profiles.
+The paper averages the radius of curvature (Eq. 18); we average the signed curvature ``1/r``, which stays
+bounded on nearly straight pieces. Eq. (20) lacks its ``1/p``: the mean piece length is a mean over profiles.
 An instance with ``m_j`` pieces is the polyline of ``m_j`` equal chords ``s_bar`` inscribed in the circle of
-curvature ``kappa``, so its length is ``L_j = m_j s_bar`` (Eq. 19) and it matches a target profile sampled on a
-circle exactly.
+curvature ``kappa``, so its length is ``L_j = m_j s_bar`` (Eq. 19) and it matches a target profile sampled on
+a circle exactly.
 """
 
 from __future__ import annotations

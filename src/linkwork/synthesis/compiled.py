@@ -1,7 +1,7 @@
 """numba-compiled segment errors (Eq. 21) for the search's inner loop.
 
-The same arithmetic as :mod:`~linkwork.synthesis.error_kernels` (the numpy reference), one point at a time. All
-profiles' target points are concatenated into one ``(N, 2)`` array; profile ``j`` starts at row ``offsets[j]``.
+The same arithmetic as :mod:`~linkwork.synthesis.error_kernels` (the numpy reference), point by point. All
+profiles' target points are stacked in one ``(N, 2)`` array; profile ``j`` starts at row ``offsets[j]``.
 """
 
 from __future__ import annotations
@@ -92,7 +92,12 @@ def mean_errors(points: Array, offsets: IntArray, starts: IntArray, pieces: int)
 
 @njit(cache=True)
 def arc_errors(
-    points: Array, offsets: IntArray, starts: IntArray, pieces: IntArray, curvature: float, piece_length: float
+    points: Array,
+    offsets: IntArray,
+    starts: IntArray,
+    pieces: IntArray,
+    curvature: float,
+    piece_length: float,
 ) -> Array:  # pragma: no cover - compiled
     """``(p,)`` errors of the C-segment of ``curvature`` and ``piece_length`` (Eqs. 19, 21)."""
     p = starts.shape[0]

@@ -23,7 +23,7 @@ def joint_angles(joined: Sequence[JoinedProfile], segment_matrix: NDArray[np.int
     """``(q - 1, p)`` relative angle ``sigma_j^i`` at every joint of the joined chain (Sec. 6).
 
     The turn from the direction of the piece entering segmentation point ``k_j^{i+1}`` to that of the piece
-    leaving it, measured on the joined chain (whose pieces are the links either side of the joint). Each row is
+    leaving it, measured on the joined chain (whose pieces are the links either side of the joint). Rows are
     unwrapped about profile 1 so that ranges across ``+-pi`` come out right.
     """
     starts = segment_starts(segment_matrix)[1:]  # (q - 1, p) joint point indices
@@ -44,7 +44,7 @@ def joint_ranges(sigma: Array) -> Array:
     """``(q - 1,)`` range of motion ``max_j sigma_j^i - min_l sigma_l^i`` of each joint (Eq. 34)."""
     if sigma.size == 0:
         return np.zeros(sigma.shape[0])
-    return sigma.max(axis=1) - sigma.min(axis=1)  # type: ignore[no-any-return]
+    return sigma.max(axis=1) - sigma.min(axis=1)
 
 
 def merge_joints(
@@ -58,7 +58,7 @@ def merge_joints(
 ) -> Compound:
     """Merge every joint whose range (Eq. 34) is below ``threshold`` and that touches a C-segment (Sec. 6).
 
-    A merged joint is clamped at its mean angle over the profiles and the chain is joined again. A small-motion
+    A merged joint is clamped at its mean angle over the profiles and the chain is joined again. A low-motion
     joint between two M-segments is not merged (the merged link could not follow the profiles better than one
     M-segment would): a note suggests a design with fewer segments instead.
     """

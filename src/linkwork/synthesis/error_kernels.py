@@ -2,7 +2,7 @@
 
 They compute exactly what :func:`~linkwork.synthesis.mean_segment.fit_mean_segment` and
 :func:`~linkwork.synthesis.arc_segment.fit_arc_segment` compute, without building the fitted shapes: curvature
-and chord sums come from per-profile prefix sums, every C-instance is a prefix of one arc, and the registration
+and chord sums come from per-profile prefix sums, every C-instance is a prefix of one arc, and registration
 error is evaluated in centred coordinates (the translation cancels).
 """
 
@@ -32,7 +32,7 @@ def _aligned_errors(src: Array, tgt: Array) -> Array:
     s = np.where(h > 0.0, cross / safe, 0.0)[:, None]
     rx = c * ax - s * ay - bx
     ry = s * ax + c * ay - by
-    return np.sqrt(np.max(rx * rx + ry * ry, axis=1))  # type: ignore[no-any-return]
+    return np.sqrt(np.max(rx * rx + ry * ry, axis=1))
 
 
 class ProfileTables:
@@ -43,7 +43,7 @@ class ProfileTables:
     points
         The target profiles' points.
     compiled
-        Evaluate with the numba kernels of :mod:`~linkwork.synthesis.compiled` (default); ``False`` uses numpy.
+        Use the numba kernels of :mod:`~linkwork.synthesis.compiled` (default); ``False`` uses numpy.
     """
 
     def __init__(self, points: Sequence[Array], *, compiled: bool = True) -> None:
@@ -52,15 +52,20 @@ class ProfileTables:
         self.stacked = np.ascontiguousarray(np.vstack(self.points))
         self.offsets = np.concatenate([[0], np.cumsum([len(z) for z in self.points])[:-1]]).astype(np.int64)
         self.chord_sum = [
-            np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(z, axis=0), axis=1))]) for z in self.points
+            np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(z, axis=0), axis=1))])
+            for z in self.points
         ]
         # curvature_sum[j][i] = sum of the curvatures of points 1 .. i - 1 of profile j
-        self.curvature_sum = [np.concatenate([[0.0, 0.0], np.cumsum(discrete_curvature(z))]) for z in self.points]
+        self.curvature_sum = [
+            np.concatenate([[0.0, 0.0], np.cumsum(discrete_curvature(z))]) for z in self.points
+        ]
 
     def mean_errors(self, starts: Sequence[int], pieces: int) -> Array:
         """``(p,)`` errors of an M-segment of ``pieces`` pieces from ``starts`` (Eqs. 12-15, 21)."""
         if self.compiled:
-            return compiled.mean_errors(self.stacked, self.offsets, np.asarray(starts, dtype=np.int64), int(pieces))
+            return compiled.mean_errors(
+                self.stacked, self.offsets, np.asarray(starts, dtype=np.int64), int(pieces)
+            )
         z = np.stack([pts[s : s + pieces + 1] for pts, s in zip(self.points, starts, strict=True)])
         first = np.broadcast_to(z[0], z.shape)
         a = z - z.mean(axis=1, keepdims=True)

@@ -16,7 +16,7 @@ def rotation(angle: ArrayLike) -> Array:
 
 
 def chord_angle(points: ArrayLike) -> Array:
-    """Angle ``(...)`` of the chord from the first to the last of ``(..., n, 2)`` points (0 if they coincide)."""
+    """Angle ``(...)`` of the chord from the first to the last of ``(..., n, 2)`` points (0 if equal)."""
     pts = np.asarray(points, dtype=float)
     chord = pts[..., -1, :] - pts[..., 0, :]
     return np.arctan2(chord[..., 1], chord[..., 0])

@@ -8,7 +8,7 @@ Joints held at a fixed relative angle (compound segments, Sec. 6) tie one angle 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,6 +19,7 @@ from linkwork.synthesis.frames import chord_angle, rotation
 from linkwork.synthesis.result import JoinedProfile, Segment, TargetProfile
 
 Array = NDArray[np.float64]
+Fn = Callable[[Array], Array]
 
 #: The closure or end constraint is satisfied to this residual after joining.
 CONSTRAINT_TOL = 1e-12
@@ -106,7 +107,7 @@ def join_profile(
     Parameters
     ----------
     shapes
-        Per segment, its points ``(m_j^e + 1, 2)`` in the local frame; their piece counts sum to the profile's.
+        Per segment, its points ``(m_j^e + 1, 2)`` in the local frame; piece counts sum to the profile's.
     target
         ``(m_j + 1, 2)`` target points.
     start, angles
@@ -177,7 +178,7 @@ def join_profile(
     return JoinedProfile(joints=chain.joints(s, th), points=pts, angles=th, errors=errors)
 
 
-def _polish(residual, jac, constraint, constraint_jac, u: Array) -> Array:  # type: ignore[no-untyped-def]
+def _polish(residual: Fn, jac: Fn, constraint: Fn | None, constraint_jac: Fn | None, u: Array) -> Array:
     """Gauss-Newton steps (with the linearised constraints, KKT form) to the optimum's last digits.
 
     The optimisers stop on the cost, which is quadratic in the unknowns, so their unknowns are good to about
@@ -189,6 +190,7 @@ def _polish(residual, jac, constraint, constraint_jac, u: Array) -> Array:  # ty
         if constraint is None:
             step = np.linalg.lstsq(jm, -r, rcond=None)[0]
         else:
+            assert constraint_jac is not None
             g, gm = constraint(u), constraint_jac(u)
             n = len(u)
             kkt = np.block([[jm.T @ jm, gm.T], [gm, np.zeros((len(g), len(g)))]])
@@ -204,7 +206,7 @@ def _polish(residual, jac, constraint, constraint_jac, u: Array) -> Array:  # ty
     return u
 
 
-def _project(constraint, constraint_jac, u: Array) -> Array:  # type: ignore[no-untyped-def]
+def _project(constraint: Fn, constraint_jac: Fn, u: Array) -> Array:
     """Move ``u`` onto ``constraint(u) = 0`` by minimum-norm Newton steps."""
     for _ in range(50):
         g = constraint(u)
@@ -220,7 +222,7 @@ def _project(constraint, constraint_jac, u: Array) -> Array:  # type: ignore[no-
     )
 
 
-def _constrained(residual, jac, constraint, constraint_jac, u0: Array) -> Array:  # type: ignore[no-untyped-def]
+def _constrained(residual: Fn, jac: Fn, constraint: Fn, constraint_jac: Fn, u0: Array) -> Array:
     """Minimise ``|residual|^2 / 2`` subject to ``constraint = 0``: SLSQP, then an exact projection."""
     u_start = _project(constraint, constraint_jac, u0)
 
@@ -229,7 +231,7 @@ def _constrained(residual, jac, constraint, constraint_jac, u0: Array) -> Array:
         return 0.5 * float(r @ r)
 
     def grad(u: Array) -> Array:
-        return jac(u).T @ residual(u)  # type: ignore[no-any-return]
+        return jac(u).T @ residual(u)
 
     sol = minimize(
         f,

@@ -1,6 +1,6 @@
 """Plain-Python reference of the segment fits (Secs. 3.3, 3.4): loops over points, no numpy batching.
 
-The readable twin of :mod:`~linkwork.synthesis.mean_segment` and :mod:`~linkwork.synthesis.arc_segment`; the tests
+The readable twin of :mod:`~linkwork.synthesis.mean_segment` and :mod:`~linkwork.synthesis.arc_segment`; tests
 check that both agree, and the benchmark times the search with it as the non-vectorised baseline.
 """
 

@@ -8,8 +8,8 @@ References
 ----------
 S. Umeyama, Least-squares estimation of transformation parameters between two point patterns,
 IEEE Trans. Pattern Anal. Mach. Intell. 13 (4) (1991) 376-380.
-K. S. Arun, T. S. Huang, S. D. Blostein, Least-squares fitting of two 3-D point sets, IEEE Trans. Pattern Anal.
-Mach. Intell. 9 (5) (1987) 698-700.
+K. S. Arun, T. S. Huang, S. D. Blostein, Least-squares fitting of two 3-D point sets, IEEE Trans. PAMI
+9 (5) (1987) 698-700.
 """
 
 from __future__ import annotations
@@ -26,7 +26,10 @@ Array = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class PlanarTransform:
-    """``y = scale * R(angle) x + translation``, batched: ``angle (...)``, ``translation (..., 2)``, ``scale (...)``."""
+    """The similarity ``y = scale * R(angle) x + translation``, batched over leading axes.
+
+    Shapes: ``angle (...)``, ``translation (..., 2)``, ``scale (...)``.
+    """
 
     angle: Array
     translation: Array
@@ -74,5 +77,8 @@ def register(source: ArrayLike, target: ArrayLike, *, with_scale: bool = False) 
     else:
         scale = np.ones_like(angle)
     c, s = np.cos(angle) * scale, np.sin(angle) * scale
-    translation = np.stack([my[..., 0] - (c * mx[..., 0] - s * mx[..., 1]), my[..., 1] - (s * mx[..., 0] + c * mx[..., 1])], axis=-1)
+    translation = np.stack(
+        [my[..., 0] - (c * mx[..., 0] - s * mx[..., 1]), my[..., 1] - (s * mx[..., 0] + c * mx[..., 1])],
+        axis=-1,
+    )
     return PlanarTransform(angle=np.asarray(angle), translation=translation, scale=np.asarray(scale))

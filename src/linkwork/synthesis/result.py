@@ -5,10 +5,10 @@ Every class here is a frozen dataclass of plain numpy arrays; :meth:`SynthesisRe
 
 Layout conventions
 ------------------
-* ``p`` profiles, ``q`` segments. The segment matrix and every error matrix have shape ``(q, p)``: row ``e`` is
-  segment ``e``, column ``j`` is profile ``j`` (the transpose of the paper's printed ``p x q`` matrices, Eqs. 11,
-  25), so column ``j`` sums to the piece count ``m_j`` of profile ``j``.
-* Joint ``i`` (0-based) is the revolute joint between segments ``i`` and ``i + 1``; there are ``q - 1`` of them.
+* ``p`` profiles, ``q`` segments. The segment matrix and every error matrix have shape ``(q, p)``: row
+  ``e`` is segment ``e``, column ``j`` is profile ``j`` (the transpose of the paper's printed ``p x q``
+  matrices, Eqs. 11, 25), so column ``j`` sums to the piece count ``m_j`` of profile ``j``.
+* Joint ``i`` (0-based) is the revolute joint between segments ``i`` and ``i + 1``; there are ``q - 1``.
 * A segment's *local frame* puts its first point at the origin and its chord (first point to last point) along
   ``+x``.
 """
@@ -37,7 +37,7 @@ def _points(a: Array) -> list[list[float]]:
 
 
 def _matrix(a: NDArray[Any]) -> list[list[float]]:
-    return np.asarray(a).tolist()  # type: ignore[no-any-return]
+    return np.asarray(a).tolist()
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ class Segment:
     starts
         ``(p,)`` index of the segment's first point on each target profile (``k_j^e - 1``, 0-based).
     shape
-        M-segment: ``(m + 1, 2)`` mean shape in the local frame. C-segment: ``None`` (see :meth:`local_points`).
+        M-segment: ``(m + 1, 2)`` mean shape in the local frame. C-segment: ``None`` (see ``local_points``).
     curvature
         C-segment: the mean signed curvature ``1 / r`` (positive turning left). M-segment: ``None``.
     piece_length
@@ -114,8 +114,10 @@ class Segment:
 
     @property
     def lengths(self) -> Array:
-        """``(p,)`` polyline length of the segment on each profile (``L_j^e = m_j^e s_bar^e``, Eq. 19, for C)."""
-        return np.array([float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) for pts in self.instances])
+        """``(p,)`` polyline length of the segment on each profile (C: ``L_j^e = m_j^e s_bar^e``, Eq. 19)."""
+        return np.array(
+            [float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) for pts in self.instances]
+        )
 
     def local_points(self, j: int) -> Array:
         """The ``(m_j^e + 1, 2)`` points of the instance on profile ``j`` in the segment's local frame."""
@@ -320,7 +322,7 @@ class SynthesisResult:
     stats
         Search statistics and the ranking of design vectors.
     history
-        ``E_max`` after every adjustment iteration, one tuple per initial segment matrix, for the chosen design.
+        ``E_max`` after every adjustment iteration, a tuple per initial segment matrix, for the chosen design.
     """
 
     problem: Problem

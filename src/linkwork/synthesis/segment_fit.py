@@ -41,7 +41,9 @@ class SegmentFitter:
         Use the numpy fits; ``False`` uses the plain-Python reference (the benchmark's baseline).
     """
 
-    def __init__(self, targets: Sequence[TargetProfile], *, cached: bool = True, vectorised: bool = True) -> None:
+    def __init__(
+        self, targets: Sequence[TargetProfile], *, cached: bool = True, vectorised: bool = True
+    ) -> None:
         self.points = [t.points for t in targets]
         self.tables = ProfileTables(self.points)
         self.cached = cached
@@ -64,7 +66,11 @@ class SegmentFitter:
                 self.hits += 1
                 return hit
         if self.vectorised:
-            err = self.tables.mean_errors(key[1], key[2][0]) if kind == "M" else self.tables.arc_errors(*key[1:])
+            err = (
+                self.tables.mean_errors(key[1], key[2][0])
+                if kind == "M"
+                else self.tables.arc_errors(*key[1:])
+            )
         else:
             pieces = self.pieces(starts, counts)
             plain = [[(float(x), float(y)) for x, y in z] for z in pieces]

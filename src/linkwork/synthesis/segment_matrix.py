@@ -1,6 +1,7 @@
 """The segment matrix (Secs. 3.2, 4): design vectors, initial matrices, the adjustment rules and the search.
 
-A segment matrix ``SM`` here has shape ``(q, p)``: ``SM[e, j] = m_j^e`` pieces of segment ``e`` on profile ``j``.
+A segment matrix ``SM`` here has shape ``(q, p)``: ``SM[e, j] = m_j^e``, pieces of segment ``e`` on profile
+``j`` (the transpose of the paper's printed layout).
 It is valid when column ``j`` sums to ``m_j*``, every M-segment row is constant, and every entry is at least
 ``alpha`` (``min_pieces``).
 """
@@ -30,12 +31,14 @@ def check_design(design: str) -> str:
     """Upper-case a design vector such as ``"mcmc"`` and check it has only ``M`` and ``C``."""
     d = design.strip().upper()
     if not d or set(d) - {"M", "C"}:
-        raise SpecError(f"a design vector is a string of M and C, such as 'MCMC'; got {design!r}", key="design")
+        raise SpecError(
+            f"a design vector is a string of M and C, such as 'MCMC'; got {design!r}", key="design"
+        )
     return d
 
 
 def design_vectors(q: int, pieces: Sequence[int]) -> list[str]:
-    """Every design vector of ``q`` segments; all-M only when every profile has the same piece count (Sec. 3.1)."""
+    """Every design vector of ``q`` segments; all-M only when all profiles have one piece count (Sec. 3.1)."""
     if q < 1:
         raise SpecError(f"the number of segments must be at least 1, got {q}", key="segments")
     out = ["".join(v) for v in itertools.product("MC", repeat=q)]
@@ -88,7 +91,7 @@ def initial_segment_matrix(
     """A valid segment matrix with segment sizes in proportion to ``weights`` (``(q,)``, positive).
 
     M-segments take ``alpha`` plus their share of the shortest profile's spare pieces; on each profile the
-    C-segments share what remains (``jitter``, ``(q, p)`` positive factors, varies that share per profile), and
+    C-segments share what remains (``jitter``, ``(q, p)`` positive factors, varies it per profile), and
     the last C-segment takes the remainder, as in Eq. (11).
     """
     q, p = len(design), len(pieces)
@@ -130,8 +133,8 @@ def initial_segment_matrices(
 def adjust(segment_matrix: IntArray, error_matrix: Array, design: str, min_pieces: int) -> IntArray:
     """One adjustment of the segment matrix by the rules of Section 4.
 
-    A C-instance with ``E_j^e < E_bar`` gains a piece, one with ``E_j^e > E_bar`` loses one; an M-segment gains
-    or loses one piece on every profile according to ``E_bar^e`` (Eq. 23) against ``E_bar`` (Eq. 24). No entry may
+    A C-instance with ``E_j^e < E_bar`` gains a piece, one with ``E_j^e > E_bar`` loses one; an M-segment
+    gains or loses one piece on every profile by ``E_bar^e`` (Eq. 23) against ``E_bar`` (Eq. 24). No entry may
     fall below ``alpha``. The last C-segment (the last segment when all are M) is not judged by its error but
     takes whatever keeps every column sum (Eq. 26); if that would push it below ``alpha``, the gains of that
     profile are withdrawn, largest error first, until it fits.

@@ -56,7 +56,9 @@ def _check_problem(problem: Problem) -> None:
     if problem.count < 1:
         raise SpecError("a synthesis problem needs at least one profile", source=src, key="profiles")
     if problem.kind not in ("open", "closed", "fixed-end"):
-        raise SpecError(f"type must be open, closed or fixed-end, got {problem.kind!r}", source=src, key="type")
+        raise SpecError(
+            f"type must be open, closed or fixed-end, got {problem.kind!r}", source=src, key="type"
+        )
     if problem.starts < 1:
         raise SpecError(f"starts must be at least 1, got {problem.starts}", source=src, key="starts")
     if not (problem.merge_below >= 0.0 and math.isfinite(problem.merge_below)):
@@ -152,7 +154,14 @@ def synthesize(
             joined = join_chain(segments, targets, problem.kind)
             joined_e_max = max(float(prof.errors.max()) for prof in joined)
             cand = _Candidate(
-                design, sm, em, segments, joined, joined_e_max, outcome.history, float(outcome.error_matrix.max())
+                design,
+                sm,
+                em,
+                segments,
+                joined,
+                joined_e_max,
+                outcome.history,
+                float(outcome.error_matrix.max()),
             )
             if best is None or cand.rank_key < best.rank_key:
                 best = cand
@@ -175,7 +184,13 @@ def synthesize(
             problem.kind,
         )
     scores = tuple(
-        DesignScore(c.design, c.segment_matrix, float(c.error_matrix.max()), float(c.error_matrix.mean()), c.joined_e_max)
+        DesignScore(
+            c.design,
+            c.segment_matrix,
+            float(c.error_matrix.max()),
+            float(c.error_matrix.mean()),
+            c.joined_e_max,
+        )
         for c in candidates
     )
     stats = SearchStats(

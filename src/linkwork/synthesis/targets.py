@@ -1,4 +1,4 @@
-"""Target profiles (Sec. 2): design polylines resampled at equal arc-length steps of about ``piece_length``."""
+"""Target profiles (Sec. 2): design polylines resampled at equal arc-length steps near ``piece_length``."""
 
 from __future__ import annotations
 
@@ -87,7 +87,9 @@ def target_profile(
         if fewer_err > err:
             break
         m, points, err = m - 1, fewer, fewer_err
-    return TargetProfile(points=points, arc_length=total, pieces=m, target_length=mean_chord(points), name=name)
+    return TargetProfile(
+        points=points, arc_length=total, pieces=m, target_length=mean_chord(points), name=name
+    )
 
 
 def target_profiles(problem: Problem) -> tuple[TargetProfile, ...]:

@@ -1,10 +1,10 @@
-"""Figures of shape-change synthesis, after Shamsudin et al. (2013): design and target profiles (their Fig. 3),
-an M-segment's registration (Fig. 6), a C-segment's arcs (Fig. 7), the chain before and after joining (Fig. 8)
-and after merging joints into compound segments (Fig. 10).
+"""Figures of shape-change synthesis, after Shamsudin et al. (2013): design and target profiles (their
+Fig. 3), an M-segment's registration (Fig. 6), a C-segment's arcs (Fig. 7), the chain before and after joining
+(Fig. 8) and after merging joints into compound segments (Fig. 10).
 
 matplotlib is imported inside the functions (it is an optional extra) and only its object-oriented API is used
-(``matplotlib.figure.Figure``, drawn by the Agg renderer): nothing is ever displayed and no global pyplot state
-is touched. Every figure has equal axes, labelled axes and a legend.
+(``matplotlib.figure.Figure``, drawn by the Agg renderer): nothing is ever displayed and no global pyplot
+state is touched. Every figure has equal axes, labelled axes and a legend.
 
 References
 ----------
@@ -120,7 +120,7 @@ def _draw_targets(ax: Axes, result: SynthesisResult, *, label: bool = True) -> N
 
 
 def plot_profiles(result: SynthesisResult) -> Figure:
-    """Design profiles (solid) and their target profiles (points), segmentation points black (paper's Fig. 3)."""
+    """Design profiles (solid), target profiles (dots) and segmentation points (black) (paper's Fig. 3)."""
     figure, (ax,) = _figure(1, _extent(result.problem.profiles))
     for j, (design, target) in enumerate(zip(result.problem.profiles, result.targets, strict=True)):
         ax.plot(
@@ -146,7 +146,7 @@ def plot_profiles(result: SynthesisResult) -> Figure:
                 markersize=4,
                 label="segmentation points" if e == 0 and j == 0 else None,
             )
-    for j, target in enumerate(result.targets):
+    for target in result.targets:
         ax.plot(*target.points[-1], "o", color="black", markersize=4)
     ax.set_title(f"Design and target profiles (desired piece length {result.problem.piece_length:g})")
     _legend(ax, ncols=2)
@@ -281,31 +281,31 @@ def plot_compound(result: SynthesisResult) -> Figure:
     if compound is None:
         raise ValueError("Expected a result with a compound stage (merge_below > 0), got compound = None")
     figure, axes = _figure(2, _extent([t.points for t in result.targets]))
-    for ax, chains, merged in zip(
-        axes, (result.joined, compound.profiles), ((), compound.merged), strict=True
-    ):
+    merged_per_panel: tuple[tuple[int, ...], ...] = ((), compound.merged)
+    for ax, chains, fused in zip(axes, (result.joined, compound.profiles), merged_per_panel, strict=True):
         _draw_targets(ax, result, label=ax is axes[0])
         for j, chain in enumerate(chains):
-            _draw_chain(ax, chain, _colour(j), f"chain on {_name(result, j)}", merged=merged)
+            _draw_chain(ax, chain, _colour(j), f"chain on {_name(result, j)}", merged=fused)
     # Label every joint with its range of motion (Eq. 34) next to its position on profile 1.
     for i, motion in enumerate(compound.joint_ranges):
         x, y = result.joined[0].joints[i + 1]
-        merged = i in compound.merged
+        is_merged = i in compound.merged
         axes[0].annotate(
             f"{i + 1}: {math.degrees(motion):.1f}°",
             (x, y),
             xytext=(6, 6),
             textcoords="offset points",
             fontsize="small",
-            color="black" if merged else "dimgray",
-            weight="bold" if merged else "normal",
+            color="black" if is_merged else "dimgray",
+            weight="bold" if is_merged else "normal",
         )
     axes[0].set_title(
         f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g}", fontsize="medium"
     )
     merged_list = ", ".join(str(i + 1) for i in compound.merged) or "none"
     axes[1].set_title(
-        f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; E_max = {compound.e_max:.3g}",
+        f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; "
+        f"E_max = {compound.e_max:.3g}",
         fontsize="medium",
     )
     for ax in axes:

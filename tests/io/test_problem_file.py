@@ -1,0 +1,203 @@
+"""Synthesis problem files: a good file becomes a Problem in API units; every mistake is one line naming the
+file and the key."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from linkwork.errors import SpecError
+from linkwork.io.problem import load_problem
+from linkwork.io.profiles import save_profile
+
+GOOD = """
+type = "open"
+profiles = ["a.csv", "sub/b.csv"]
+piece_length = 0.25
+min_pieces = 3
+design = "mcm"
+starts = 2
+merge_below = 30
+seed = 7
+"""
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    x = np.linspace(0.0, 3.0, 31)
+    save_profile(tmp_path / "a.csv", np.column_stack([x, 0.1 * x**2]))
+    (tmp_path / "sub").mkdir()
+    save_profile(tmp_path / "sub" / "b.csv", np.column_stack([1.3 * x, 0.2 * x**2]))
+    t = np.linspace(0.0, 2.0 * math.pi, 41)
+    ring = np.column_stack([np.cos(t), np.sin(t)])
+    ring[-1] = ring[0]
+    save_profile(tmp_path / "ring.csv", ring)
+    save_profile(tmp_path / "open_ring.csv", ring[:-1])
+    return tmp_path
+
+
+def write(folder: Path, text: str) -> Path:
+    path = folder / "problem.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_good_problem_in_api_units(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = write(folder, GOOD)
+    monkeypatch.chdir("/")  # profiles resolve relative to the problem file, not the working folder
+    problem = load_problem(path)
+    assert problem.kind == "open"
+    assert problem.count == 2
+    assert problem.profiles[0].shape == (31, 2)
+    np.testing.assert_allclose(problem.profiles[1][-1], [3.9, 1.8], rtol=0, atol=1e-12)
+    assert problem.piece_length == 0.25
+    assert problem.min_pieces == 3
+    assert problem.design == "MCM"  # letters upper-cased
+    assert problem.segments == 3
+    assert problem.starts == 2
+    assert problem.merge_below == pytest.approx(math.pi / 6, abs=1e-15)  # degrees in the file, radians inside
+    assert problem.seed == 7
+    assert problem.names == ("a", "b")  # file stems by default
+    assert problem.source == path
+    assert problem.mechanize is False
+
+
+def test_auto_design_and_names(folder: Path) -> None:
+    text = GOOD.replace('design = "mcm"', 'design = "auto"\nsegments = 4\nnames = ["cruise", "landing"]')
+    problem = load_problem(write(folder, text))
+    assert problem.design is None
+    assert problem.segments == 4
+    assert problem.names == ("cruise", "landing")
+
+
+def test_closed_problem_accepts_closed_curves(folder: Path) -> None:
+    text = GOOD.replace('type = "open"', 'type = "closed"').replace(
+        '"a.csv", "sub/b.csv"', '"ring.csv", "ring.csv"'
+    )
+    text = text.replace("seed = 7", 'seed = 7\nnames = ["one", "two"]')
+    problem = load_problem(write(folder, text))
+    np.testing.assert_array_equal(problem.profiles[0][0], problem.profiles[0][-1])
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        (
+            "piece_length = 0.25",
+            'piece_length = "abc"',
+            'piece_length: expected a positive number, got "abc"',
+        ),
+        ("piece_length = 0.25", "piece_length = -1", "piece_length: expected a positive number, got -1"),
+        ("piece_length = 0.25", "piece_length = 0", "piece_length: expected a positive number, got 0"),
+        ("piece_length = 0.25", "piece_length = true", "piece_length: expected a positive number, got true"),
+        ("piece_length = 0.25", "piece_length = nan", "piece_length: expected a positive number, got nan"),
+        ("piece_length = 0.25", "", "piece_length: missing; expected a positive number"),
+        ("seed = 7", "seed = 7\ncolour = 'red'", "colour: unknown key; expected one of type, profiles"),
+        ('type = "open"', 'type = "spiral"', 'type: expected one of open, closed, fixed-end, got "spiral"'),
+        (
+            'design = "mcm"',
+            'design = "MXC"',
+            'design: expected a design vector of M and C letters such as "MCMC"',
+        ),
+        ('design = "mcm"', "design = 5", "design: expected a design vector of M and C letters"),
+        ('design = "mcm"', "", "design: missing; expected a design vector"),
+        (
+            'design = "mcm"',
+            'design = "auto"',
+            'segments: missing; design = "auto" needs the number of segments',
+        ),
+        ('design = "mcm"', 'design = "MCM"\nsegments = 4', 'segments: is 4 but design "MCM" has 3 segments'),
+        (
+            'design = "mcm"',
+            'design = "auto"\nsegments = 0',
+            "segments: expected a whole number of segments >= 1",
+        ),
+        ("min_pieces = 3", "min_pieces = 1.5", "min_pieces: expected a whole number of pieces >= 2"),
+        ("min_pieces = 3", "min_pieces = 1", "min_pieces: expected a whole number of pieces >= 2"),
+        ("starts = 2", "starts = 0", "starts: expected a whole number of starts >= 1, got 0"),
+        (
+            "merge_below = 30",
+            "merge_below = 200",
+            "merge_below: expected an angle in degrees, 0 <= merge_below < 180",
+        ),
+        ("merge_below = 30", "merge_below = -1", "merge_below: expected an angle in degrees"),
+        (
+            "merge_below = 30",
+            'merge_below = "5"',
+            'merge_below: expected an angle in degrees, 0 <= merge_below < 180, got "5"',
+        ),
+        ("seed = 7", "seed = -1", "seed: expected a whole number >= 0, got -1"),
+        ("seed = 7", 'seed = 7\nmechanize = "yes"', 'mechanize: expected true or false, got "yes"'),
+        (
+            "seed = 7",
+            'seed = 7\nnames = ["one"]',
+            "names: lists 1 names for 2 profiles; expected one per profile",
+        ),
+        ("seed = 7", 'seed = 7\nnames = ["one", "one"]', "names: repeats a name"),
+        ("seed = 7", 'seed = 7\nnames = ["one", 2]', "names: expected a list of 2 non-empty names"),
+        ('"a.csv", "sub/b.csv"', '"a.csv"', "profiles: lists 1 file(s); expected at least 2 profile files"),
+        (
+            'profiles = ["a.csv", "sub/b.csv"]',
+            'profiles = "a.csv"',
+            'profiles: expected a list of at least 2 profile files, got "a.csv"',
+        ),
+        ('"a.csv", "sub/b.csv"', '"a.csv", "gone.csv"', 'profiles[2]: file "'),
+        ("seed = 7", "seed = 7\n[extra]\nkey = 1", "extra: unknown key"),
+        ('type = "open"', 'type = "open', "not valid TOML"),
+    ],
+)
+def test_bad_key_is_one_line_naming_file_and_key(folder: Path, old: str, new: str, expected: str) -> None:
+    assert old in GOOD
+    path = write(folder, GOOD.replace(old, new))
+    with pytest.raises(SpecError) as info:
+        load_problem(path)
+    message = str(info.value)
+    assert "\n" not in message
+    assert message.startswith(f"{path}: ")
+    assert expected in message
+
+
+def test_the_message_of_the_design_notes(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(folder)
+    write(folder, GOOD.replace("piece_length = 0.25", 'piece_length = "abc"'))
+    with pytest.raises(SpecError) as info:
+        load_problem("problem.toml")
+    assert str(info.value) == 'problem.toml: piece_length: expected a positive number, got "abc"'
+    assert (info.value.source, info.value.key) == ("problem.toml", "piece_length")
+
+
+def test_missing_profile_names_the_file(folder: Path) -> None:
+    path = write(folder, GOOD.replace('"sub/b.csv"', '"sub/gone.csv"'))
+    with pytest.raises(SpecError, match=r"profiles\[2\]: file \".*sub/gone.csv\" not found"):
+        load_problem(path)
+
+
+def test_bad_profile_content_names_the_profile_file(folder: Path) -> None:
+    (folder / "a.csv").write_text("x,y\n0,0\n", encoding="utf-8")
+    with pytest.raises(SpecError) as info:
+        load_problem(write(folder, GOOD))
+    assert (
+        str(info.value) == f"{folder / 'a.csv'}: a single point (0, 0); expected a curve of at least 2 points"
+    )
+
+
+def test_closed_problem_refuses_an_open_curve(folder: Path) -> None:
+    text = GOOD.replace('type = "open"', 'type = "closed"').replace(
+        '"a.csv", "sub/b.csv"', '"ring.csv", "open_ring.csv"'
+    )
+    with pytest.raises(SpecError, match=r'profiles\[2\]: "open_ring.csv" does not return to its first point'):
+        load_problem(write(folder, text))
+
+
+def test_missing_or_unreadable_problem_file(tmp_path: Path) -> None:
+    with pytest.raises(SpecError, match=r"gone.toml: file not found; expected a problem file \(TOML\)$"):
+        load_problem(tmp_path / "gone.toml")
+    with pytest.raises(SpecError, match=r"is a folder; expected a problem file"):
+        load_problem(tmp_path)
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(b"\xff\xfe\x81 = 1")
+    with pytest.raises(SpecError, match=r"binary.toml: "):
+        load_problem(binary)
