@@ -1,6 +1,14 @@
-"""Built-in linkages: named constructors registered in :data:`linkwork.linkages.registry.REGISTRY`."""
+"""Built-in linkages: named constructors registered in :data:`linkwork.linkages.registry.REGISTRY`.
 
-from linkwork.linkages import hedgepeth as _hedgepeth  # noqa: F401  (registers itself)
+Importing this package registers every built-in (each module registers itself on import).
+"""
+
+from linkwork.linkages import bennett as _bennett  # noqa: F401
+from linkwork.linkages import bricard as _bricard  # noqa: F401
+from linkwork.linkages import goldberg as _goldberg  # noqa: F401
+from linkwork.linkages import guest as _guest  # noqa: F401
+from linkwork.linkages import hedgepeth as _hedgepeth  # noqa: F401
+from linkwork.linkages import sarrus as _sarrus  # noqa: F401
 from linkwork.linkages.hedgepeth import deployed_angle, hedgepeth
 from linkwork.linkages.registry import REGISTRY, LinkageEntry, Param, get
 

@@ -75,14 +75,14 @@ def plot_singular_values(path: Path, file: FilePath, branch: int = 0) -> FilePat
     steps = path.step[mask]
     rank = int(path.stats.get("start_rank", s.shape[1]))
     # Left: the non-zero singular values on a linear scale against the step (as the paper's Fig. 15);
-    # right: all of them on a log scale against the drive angle, the null ones at round-off.
+    # right: all of them on a log scale, the null ones at round-off.
     for i in range(min(rank, s.shape[1])):
         axes[0].plot(steps, s[:, i], lw=1.3, label=f"σ{i + 1}")
     axes[0].set_xlabel("step")
     axes[0].set_ylim(0, None)
     for i in range(s.shape[1]):
-        axes[1].semilogy(x, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
-    axes[1].set_xlabel(f"θ{path.drive} (deg)")
+        axes[1].semilogy(steps, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
+    axes[1].set_xlabel(f"step (θ{path.drive} from {x[0]:.4g}° to {x[-1]:.4g}°)")
     axes[1].set_ylim(1e-17, None)
     for ax in axes:
         ax.set_ylabel("singular value")
@@ -90,7 +90,7 @@ def plot_singular_values(path: Path, file: FilePath, branch: int = 0) -> FilePat
     for b in path.bifurcations:
         if b.branch == branch:
             axes[0].axvline(b.step, color="k", lw=0.8, ls="--")
-            axes[1].axvline(np.degrees(b.angles[d]), color="k", lw=0.8, ls="--")
+            axes[1].axvline(b.step, color="k", lw=0.8, ls="--")
     axes[1].legend(fontsize=8, ncol=2)
     fig.suptitle(f"{mech.name}: singular values of the Jacobian along branch {branch}", fontsize=10)
     fig.savefig(file, dpi=120)
