@@ -118,3 +118,46 @@ def test_parallelogram_change_point_is_located_and_both_branches_traced() -> Non
     assert any(br.parent is not None for br in path.branches)
     for br in path.branches:
         assert br.end_reason != "corrector failed"
+
+
+def test_guest_frame_bifurcation_and_both_branches() -> None:
+    """Sec. 6: the rank drops from 5 to 4 on the symmetric path; a symmetry-breaking branch leaves there."""
+    from linkwork.kinematics.closure import hessian, reduce
+    from linkwork.linkages.guest import guest_frame
+
+    mech = guest_frame()
+    path = trace(mech, branches=True, max_steps=3000)
+    assert path.stats["start_rank"] == 5
+    first = path.bifurcations[0]
+    assert first.rank == 4
+    assert first.sigma[4] / first.sigma[0] < 1e-11  # located to round-off
+    # Independent reference: a plain continuation in A with Gauss-Newton (tests/linkages) puts the drop at
+    # A = D = 38.942 deg, B = C = E = F = 18.463 deg for the default proportions (to 1e-3 deg).
+    deg = np.degrees(first.angles)
+    wrapped = (deg + 180.0) % 360.0 - 180.0
+    np.testing.assert_allclose(wrapped, [38.942, 18.463, 18.463, 38.942, 18.463, 18.463], atol=2e-3)
+    # Two branch tangents: both in the kernel of J, both solving the quadratic branching equation.
+    q = mech.q_from_angles(first.angles)
+    J = jacobian(mech, q)
+    U, s, _ = np.linalg.svd(J)
+    left = U[:, 4:]
+    H = reduce(mech, hessian(mech, q))
+    assert len(first.tangents) == 2
+    for t in first.tangents:
+        assert np.linalg.norm(J @ t) < 1e-9
+        assert np.abs(np.einsum("el,eij,i,j->l", left, H, t, t)).max() < 1e-8
+    symmetric = [t for t in first.tangents if abs(t[1] - t[2]) < 1e-9]
+    breaking = [t for t in first.tangents if abs(t[1] - t[2]) > 0.1]
+    assert len(symmetric) == 1 and len(breaking) == 1
+    # The symmetric branch keeps A = D and B = C = E = F all along (no symmetry imposed).
+    main = path.angles[path.branch == 0]
+    np.testing.assert_allclose(main[:, 0], main[:, 3], atol=1e-9)
+    for k in (2, 4, 5):
+        np.testing.assert_allclose(main[:, 1], main[:, k], atol=1e-9)
+    # Branches leave the first bifurcation in both directions and break the symmetry B = C.
+    children = [br for br in path.branches if br.bifurcation == first.id]
+    assert {br.direction for br in children} == {1, -1}
+    for br in children:
+        pts = path.angles[path.branch == br.id]
+        assert np.max(np.abs(pts[:, 1] - pts[:, 2])) > 0.1
+        assert np.all(path.residual[path.branch == br.id] < 1e-12)
