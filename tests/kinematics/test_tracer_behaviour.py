@@ -139,7 +139,7 @@ def test_guest_frame_bifurcation_and_both_branches() -> None:
     # Two branch tangents: both in the kernel of J, both solving the quadratic branching equation.
     q = mech.q_from_angles(first.angles)
     J = jacobian(mech, q)
-    U, s, _ = np.linalg.svd(J)
+    U = np.linalg.svd(J)[0]
     left = U[:, 4:]
     H = reduce(mech, hessian(mech, q))
     assert len(first.tangents) == 2

@@ -249,9 +249,19 @@ def trace(
     queue: list[tuple[int | None, int | None, Array, Array, int]] = []
 
     def run_branch(
-        branch_id: int, u0: Array, t0: Array, basis: Array, paper: bool, h0: float, stop_at_known: bool
+        branch_id: int,
+        u0: Array,
+        t0: Array,
+        basis: Array,
+        paper: bool,
+        h0: float,
+        stop_at_known: bool,
+        step_offset: int = 0,
     ) -> tuple[int, str]:
-        """March one branch to its end, locating bifurcations on the way; returns (steps, end reason)."""
+        """March one branch to its end, locating bifurcations on the way; returns (steps, end reason).
+
+        ``step_offset``: step number of ``u0`` in its branch (1 when the branch opens at a bifurcation point).
+        """
         u, t = u0.copy(), t0.copy()
         u_home = u0.copy()
         n_steps = 0
@@ -306,7 +316,7 @@ def trace(
                 known = _match(found, u_star, periodic)
                 if known is None:
                     bif = _make_bifurcation(
-                        mech, ws, len(found), branch_id, rows.count() - 1, u_star, width, tol, r_path - 1
+                        mech, ws, len(found), branch_id, n_steps + step_offset, u_star, width, tol, r_path - 1
                     )
                     found.append(bif)
                     if branches:
@@ -361,7 +371,7 @@ def trace(
         )
         s_off = float(np.linalg.norm(u1 - u_star))
         start_len = len(rows.u)
-        nb, rb = run_branch(bid, u1, t1, np.ascontiguousarray(U1[:, :r_path]), False, h, True)
+        nb, rb = run_branch(bid, u1, t1, np.ascontiguousarray(U1[:, :r_path]), False, h, True, 1)
         for i in range(start_len, len(rows.u)):
             rows.s[i] = rows.s[i] + s_off
             rows.step[i] = rows.step[i] + 1
