@@ -43,6 +43,13 @@ def synth(
     out: Annotated[Path, typer.Option("--out", "-o", help="Folder to write the results into.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
     html: Annotated[bool, typer.Option("--html", help="Also write an interactive HTML viewer.")] = False,
+    search: Annotated[
+        str,
+        typer.Option(
+            help="'paper': the adjustment rules of Sec. 4; 'refined': then move segmentation points one piece "
+            "at a time while the error matrix improves (never worse than 'paper').",
+        ),
+    ] = "paper",
 ) -> None:
     """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
 
@@ -55,6 +62,8 @@ def synth(
     from linkwork.io.problem import load_problem
     from linkwork.synthesis import synthesize
 
+    if search not in ("paper", "refined"):
+        raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")
     spec = load_problem(problem)
     with Progress(
         TextColumn("[bold]synthesising[/]"),
@@ -69,7 +78,7 @@ def synth(
         def progress(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        result = synthesize(spec, progress=progress)
+        result = synthesize(spec, progress=progress, search=search)  # type: ignore[arg-type]
 
     plots = not no_plots
     if plots and not have_matplotlib():
