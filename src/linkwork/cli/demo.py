@@ -70,7 +70,9 @@ def demo(
     except ImportError:  # pragma: no cover - synthesis not installed
         run_synthesis_example = None  # type: ignore[assignment]
     if run_synthesis_example is not None:
-        run_synthesis_example(out / "synthesis-wing", "wing")
+        from linkwork.cli.synth import print_summary
+
+        print_summary(run_synthesis_example(out / "synthesis-wing", "wing", plots=not no_plots))
         figs_s = sorted(p.name for p in (out / "synthesis-wing").glob("*.png"))
         sections.append(
             (

@@ -182,17 +182,19 @@ def _summary(path) -> None:
     def show(values: np.ndarray) -> list[str]:
         return [f"{np.degrees(v):.4f}" if r else f"{v:.6f}" for v, r in zip(values, revolute, strict=True)]
 
+    def angles_text(values: np.ndarray) -> str:
+        return "  ".join(f"{n}={v}" for n, v in zip(mech.joint_names, show(values), strict=True))
+
     table = Table(title="branches", title_justify="left")
     table.add_column("branch", justify="right")
     table.add_column("from")
     table.add_column("steps", justify="right")
     table.add_column("end")
-    for name in mech.joint_names:
-        table.add_column(f"{name} end", justify="right")
+    table.add_column("joints at the end (deg)", overflow="fold")
     for br in path.branches:
         mask = path.of_branch(br.id)
-        origin = "start" if br.parent is None else f"bif {br.bifurcation} of {br.parent}"
-        table.add_row(str(br.id), origin, str(br.steps), br.end_reason, *show(path.angles[mask][-1]))
+        origin = "start" if br.parent is None else f"bif {br.bifurcation} on {br.parent}"
+        table.add_row(str(br.id), origin, str(br.steps), br.end_reason, angles_text(path.angles[mask][-1]))
     console.print(table)
     mob = rep["mobility_along_path"]
     console.print(
@@ -207,14 +209,13 @@ def _summary(path) -> None:
         bt.add_column("branch", justify="right")
         bt.add_column("step", justify="right")
         bt.add_column("rank", justify="right")
-        bt.add_column("σ_r", justify="right")
+        bt.add_column("σ_r/σ_1", justify="right")
         bt.add_column("branches")
-        for name in mech.joint_names:
-            bt.add_column(name, justify="right")
+        bt.add_column("joints (deg)", overflow="fold")
         for b in path.bifurcations:
-            zero = b.sigma[b.rank] if b.rank < len(b.sigma) else 0.0
+            zero = b.sigma[b.rank] / b.sigma[0] if b.rank < len(b.sigma) else 0.0
             bt.add_row(
                 str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}",
-                f"{len(b.tangents)} ({b.method})", *show(b.angles),
+                f"{len(b.tangents)} ({b.method})", angles_text(b.angles),
             )  # fmt: skip
         console.print(bt)

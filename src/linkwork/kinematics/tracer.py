@@ -325,6 +325,16 @@ def trace(
                                 for direction in (1, -1):
                                     queue.append((branch_id, bif.id, u_star, direction * tb, direction))
                 elif stop_at_known:
+                    # End the branch exactly on the known point (its last row overshot it by part of a step).
+                    before = out_u[count - 2]
+                    diff = found[known].u - before
+                    diff[periodic] = (diff[periodic] + np.pi) % (2.0 * np.pi) - np.pi
+                    point = before + diff  # the same point, in this branch's continuous angles
+                    r_known, _, j_known = ws.evaluate(point)
+                    rows.u[-1][-1] = point
+                    rows.sigma[-1][-1] = np.linalg.svd(j_known, compute_uv=False)[:n_sigma]
+                    rows.res[-1][-1] = r_known
+                    rows.tau[-1][-1] = 0.0
                     return n_steps, f"reached bifurcation {known}"
                 u, t = out_u[count - 1].copy(), out_t[count - 1].copy()
                 h0 = h
