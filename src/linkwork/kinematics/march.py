@@ -178,6 +178,18 @@ def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
 
 
 @njit(cache=True)
+def wrapped_distance(a, b, periodic):
+    """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to (-pi, pi]."""
+    d = 0.0
+    for i in range(a.shape[0]):
+        diff = a[i] - b[i]
+        if periodic[i]:
+            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+        d += diff * diff
+    return np.sqrt(d)
+
+
+@njit(cache=True)
 def march(
     twists,
     loop_joint,
@@ -245,13 +257,7 @@ def march(
     out_s[0] = 0.0
     s_total = 0.0
     basis_try = basis.copy()
-    far = 0.0
-    for a in range(m):
-        diff = u0[a] - u_home[a]
-        if periodic[a]:
-            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
-        far += diff * diff
-    far = np.sqrt(far)
+    far = wrapped_distance(u0, u_home, periodic)
     count = 1
     while count <= max_steps:
         landing = False
@@ -343,14 +349,7 @@ def march(
         if detect and tau_new * out_tau[count - 2] < 0.0:
             return count, SIGN_CHANGE, h
         if check_closed:
-            # distance to the start of the path, angles wrapped to (-pi, pi]
-            d = 0.0
-            for a in range(m):
-                diff = u[a] - u_home[a]
-                if periodic[a]:
-                    diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
-                d += diff * diff
-            d = np.sqrt(d)
+            d = wrapped_distance(u, u_home, periodic)  # to the start of the path
             if d > far:
                 far = d
             if far > 4.0 * hmax and d < 1.5 * h:
