@@ -9,6 +9,7 @@ from linkwork.errors import LinkworkError, SpecError
 from linkwork.kinematics.chains import from_dh
 from linkwork.kinematics.closure import jacobian
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.rank import DEFAULT as DEFAULT_TOL
 from linkwork.kinematics.tracer import trace
 
 DEG = np.pi / 180.0
@@ -161,3 +162,23 @@ def test_guest_frame_bifurcation_and_both_branches() -> None:
         pts = path.angles[path.branch == br.id]
         assert np.max(np.abs(pts[:, 1] - pts[:, 2])) > 0.1
         assert np.all(path.residual[path.branch == br.id] < 1e-12)
+
+
+def test_minimum_of_the_smallest_singular_value_finds_a_change_point_on_its_own() -> None:
+    """The second detector (sigma_r minima) locates the parallelogram's change point without the test function."""
+    from linkwork.kinematics.bifurcation import Workspace, locate_minimum
+
+    mech = parallelogram(60 * DEG)
+    path = trace(mech, drive="O2", until=("O2", np.radians(150.0)), max_step=4 * DEG)
+    crank = 60 * DEG + path.angles[:, 0]
+    k = int(np.argmin(np.abs(crank - np.pi)))  # the path point nearest the change point (crank at 180 deg)
+    ws = Workspace.of(mech)
+    u = mech.u_from_q(mech.q_from_angles(path.angles))
+    tangents = []
+    for i in (k - 1, k + 1):
+        jac = ws.evaluate(u[i])[2]
+        t = np.linalg.svd(jac)[2][-1]
+        tangents.append(t if t @ (u[k + 1] - u[k - 1]) > 0 else -t)
+    u_min, ratio = locate_minimum(ws, u[k - 1], tangents[0], u[k + 1], tangents[1], 3, DEFAULT_TOL)
+    assert ratio < 1e-8  # sigma_3 / sigma_1 vanishes there
+    assert abs(np.sin(60 * DEG + mech.q_from_u(u_min)[0])) < 1e-8  # crank collinear with the ground

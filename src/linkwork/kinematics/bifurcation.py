@@ -300,3 +300,53 @@ def polish(
             break
     a, b = curve(0, x[0]), curve(1, x[1])
     return 0.5 * (a + b), float(np.linalg.norm(a - b))
+
+
+def locate_minimum(
+    ws: Workspace,
+    u_a: Array,
+    t_a: Array,
+    u_b: Array,
+    t_b: Array,
+    r_path: int,
+    tol: Tolerances,
+) -> tuple[Array, float]:
+    """Minimise the smallest non-zero singular value ratio ``sigma_r / sigma_1`` along the branch between
+    points ``a`` and ``b`` (golden section in ``h = t_a . (u - u_a)``, points predicted by the cubic Hermite
+    interpolant and corrected in their hyperplane). Catches rank drops where the test function keeps its sign.
+    Returns the point and the ratio there."""
+    h_b = float(t_a @ (u_b - u_a))
+    m_a, m_b = t_a / (t_a @ t_a), t_b / (t_a @ t_b)
+
+    def point(x: float) -> Array:
+        s = x / h_b
+        guess = (
+            (2 * s**3 - 3 * s**2 + 1) * u_a
+            + (s**3 - 2 * s**2 + s) * h_b * m_a
+            + (-2 * s**3 + 3 * s**2) * u_b
+            + (s**3 - s**2) * h_b * m_b
+        )
+        return correct_on_plane(ws, guess, t_a, tol)[0]
+
+    def ratio(x: float) -> tuple[float, Array]:
+        u = point(x)
+        _, _, jac = ws.evaluate(u)
+        s = np.linalg.svd(jac, compute_uv=False)
+        return float(s[r_path - 1] / s[0]), u
+
+    golden = (np.sqrt(5.0) - 1.0) / 2.0
+    lo, hi = 0.0, h_b
+    x1, x2 = hi - golden * (hi - lo), lo + golden * (hi - lo)
+    (f1, u1), (f2, u2) = ratio(x1), ratio(x2)
+    for _ in range(80):
+        if abs(hi - lo) < tol.locate:
+            break
+        if f1 < f2:
+            hi, x2, f2, u2 = x2, x1, f1, u1
+            x1 = hi - golden * (hi - lo)
+            f1, u1 = ratio(x1)
+        else:
+            lo, x1, f1, u1 = x1, x2, f2, u2
+            x2 = lo + golden * (hi - lo)
+            f2, u2 = ratio(x2)
+    return (u1, f1) if f1 < f2 else (u2, f2)

@@ -17,7 +17,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
-from linkwork.kinematics.bifurcation import Workspace, branch_tangents, correct_on_plane, locate, polish
+from linkwork.kinematics.bifurcation import (
+    Workspace,
+    branch_tangents,
+    correct_on_plane,
+    locate,
+    locate_minimum,
+    polish,
+)
 from linkwork.kinematics.march import FAILED, SIGN_CHANGE, STOP_REASONS, march
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
@@ -296,6 +303,28 @@ def trace(
             rows.step.append(n_steps + np.arange(begin, count) - begin + (0 if first else 1))
             n_steps += count - 1
             budget[0] -= count - 1
+            # Rank drops where the test function keeps its sign: local minima of sigma_r / sigma_1.
+            if r_path >= 1 and count >= 3:
+                ratio = out_sigma[:count, r_path - 1] / out_sigma[:count, 0]
+                for k in range(1, count - 1):
+                    if not (ratio[k] <= ratio[k - 1] and ratio[k] < ratio[k + 1] and ratio[k] < 1e-2):
+                        continue
+                    if out_tau[k - 1] * out_tau[k] < 0.0 or out_tau[k] * out_tau[k + 1] < 0.0:
+                        continue  # a sign change: located by the test function
+                    u_min, r_min = locate_minimum(
+                        ws, out_u[k - 1], out_t[k - 1], out_u[k + 1], out_t[k + 1], r_path, tol
+                    )
+                    if r_min <= tol.loose and _match(found, u_min, periodic) is None:
+                        step_k = n_steps - (count - 1) + k + step_offset
+                        bif = _make_bifurcation(
+                            mech, ws, len(found), branch_id, step_k, u_min, 0.0, tol, r_path - 1
+                        )
+                        found.append(bif)
+                        if branches:
+                            for tb in bif.tangents_u:  # type: ignore[attr-defined]
+                                if abs(tb @ out_t[k]) < 0.99:
+                                    for direction in (1, -1):
+                                        queue.append((branch_id, bif.id, u_min, direction * tb, direction))
             first = False
             if progress:
                 progress(count - 1, f"branch {branch_id}")
