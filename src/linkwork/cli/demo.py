@@ -23,13 +23,14 @@ def demo(
     import linkwork as lw
     from linkwork.cli.trace import summary, write_trace_outputs
     from linkwork.linkages import deployed_angle
+    from linkwork.viz.viewer import write_synthesis_viewer
 
     sections: list[tuple[str, str, Path, list[str]]] = []
 
     console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Fig. 12)")
     hexagon = lw.load("hedgepeth", n=6)
     path = lw.trace(hexagon, until=("A", deployed_angle(6)), steps=200)
-    figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots)
+    figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots, html=True)
     summary(path)
     a = np.degrees(path.angles[-1])
     sections.append(
@@ -51,7 +52,7 @@ def demo(
         frame = None
     if frame is not None:
         path = lw.trace(frame, branches=True, max_steps=6000)
-        figs = write_trace_outputs(path, out / "guest-frame", plots=not no_plots)
+        figs = write_trace_outputs(path, out / "guest-frame", plots=not no_plots, html=True)
         summary(path)
         sections.append(
             (
@@ -72,7 +73,9 @@ def demo(
     if run_synthesis_example is not None:
         from linkwork.cli.synth import print_summary
 
-        print_summary(run_synthesis_example(out / "synthesis-wing", "wing", plots=not no_plots))
+        result = run_synthesis_example(out / "synthesis-wing", "wing", plots=not no_plots)
+        write_synthesis_viewer(result, out / "synthesis-wing" / "viewer.html")
+        print_summary(result)
         figs_s = sorted(p.name for p in (out / "synthesis-wing").glob("*.png"))
         sections.append(
             (
@@ -86,21 +89,40 @@ def demo(
     console.print(f"\nopen {out / 'index.html'} to see every result")
 
 
+#: What each section's interactive viewer lets a reader do.
+VIEWER_HINTS = {
+    "hexagon": "drag the slider from the folded bundle to the deployed hexagon",
+    "guest-frame": "follow branch 0 to a bifurcation point, then take another branch from the panel",
+    "synthesis-wing": "slide across the three wing profiles",
+}
+
+
 def _write_index(out: Path, sections: list[tuple[str, str, Path, list[str]]]) -> None:
-    """A plain, self-contained index.html linking every file written."""
+    """A plain, self-contained index.html linking every file written, each interactive viewer first."""
     parts = [
         "<!doctype html><html><head><meta charset='utf-8'><title>linkwork demo</title>",
         "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}"
-        "img{max-width:100%;border:1px solid #ddd;margin:.5em 0}</style></head><body>",
+        "img{max-width:100%;border:1px solid #ddd;margin:.5em 0}"
+        ".viewer{display:inline-block;background:#1f5f9e;color:#fff;padding:.4em .9em;border-radius:4px;"
+        "text-decoration:none;font-weight:600}</style></head><body>",
         "<h1>linkwork demo</h1>",
     ]
     for title, text, folder, figures in sections:
         rel = folder.relative_to(out)
         files = sorted(p.name for p in folder.iterdir() if p.is_file())
-        parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p><p>files: ")
+        parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p>")
+        if (folder / "viewer.html").is_file():
+            hint = VIEWER_HINTS.get(str(rel), "drag the slider along the path")
+            parts.append(
+                f"<p><a class='viewer' href='{rel}/viewer.html'>Open the interactive viewer</a> "
+                f"&nbsp;{html.escape(hint)}.</p>"
+            )
+        parts.append("<p>files: ")
         parts.append(", ".join(f"<a href='{rel}/{html.escape(f)}'>{html.escape(f)}</a>" for f in files))
         parts.append("</p>")
         for fig in figures:
+            if fig.endswith(".html"):
+                continue
             parts.append(f"<img src='{rel}/{html.escape(fig)}' alt='{html.escape(fig)}'>")
     parts.append("</body></html>")
     (out / "index.html").write_text("\n".join(parts))

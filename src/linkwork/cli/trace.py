@@ -77,7 +77,10 @@ def trace(
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
     html: Annotated[
-        bool, typer.Option("--html", help="Interactive viewer (not available in this version).")
+        bool,
+        typer.Option(
+            "--html", help="Also write viewer.html: the interactive 3-D viewer (one self-contained file)."
+        ),
     ] = False,
 ) -> None:
     """Trace a closed-loop linkage: path.csv, report.json and figures in --out."""
@@ -137,10 +140,8 @@ def trace(
             branches=branches,
             progress=report,
         )
-    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots)
+    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html)
     _summary(path)
-    if html:
-        console.print("[yellow]--html: the interactive viewer is not available in this version[/]")
     written = ["path.csv", "report.json", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
 
@@ -150,8 +151,9 @@ def summary(path) -> None:
     _summary(path)
 
 
-def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True) -> list[Path]:
-    """Write path.csv, report.json and (if matplotlib is there) the figures into ``out``, all or nothing."""
+def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True, html: bool = False) -> list[Path]:
+    """Write path.csv, report.json, (if matplotlib is there) the figures and, with ``html``, the interactive
+    viewer ``viewer.html`` into ``out``, all or nothing. Returns the figures and the viewer written."""
     from linkwork.io.results import write_path_csv, write_report_json
 
     figures: list[Path] = []
@@ -165,6 +167,10 @@ def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True) -> l
                 figures = write_trace_figures(path, stage)
             else:
                 console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
+        if html:
+            from linkwork.viz.viewer import write_trace_viewer
+
+            figures.append(write_trace_viewer(path, stage / "viewer.html"))
     return [Path(out) / f.name for f in figures]
 
 

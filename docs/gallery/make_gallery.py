@@ -1,0 +1,108 @@
+"""Reproduce the papers' figures: ``python docs/gallery/make_gallery.py`` (writes the PNGs next to this file).
+
+Gan & Pellegrino (2006): Figs. 9-13, 15, 16. Shamsudin et al. (2013): Figs. 3, 6, 7, 8, 10 (seat example).
+Needs the ``viz`` extra (matplotlib, pillow). Takes about 15 s.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+
+from linkwork.kinematics.tracer import trace
+from linkwork.linkages import deployed_angle, hedgepeth
+from linkwork.linkages.guest import guest_frame
+from linkwork.viz.snapshots import deployment_sequence
+from linkwork.viz.trace_plots import plot_angles, plot_singular_values
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+
+
+def eq13_theta_b(theta_a: np.ndarray) -> np.ndarray:
+    """Eq. (13): theta_B of the symmetric square (theta_A = theta_C, theta_B = theta_D), radians."""
+    c, s = np.cos(theta_a), np.sin(theta_a)
+    r3 = np.sqrt(3.0)
+    num = 2 * r3 * c**2 - 3 * s * c + 3 * s - 4 * r3 * c + 2 * r3
+    den = -(c**2) - 2 * r3 * s * c + 2 * r3 * s - c + 2
+    return np.mod(np.arctan2(num, den), 2 * np.pi)  # the branch starting at 0 in the bundle
+
+
+def fig09(out: Path) -> Path:
+    """theta_A against theta_B of the symmetric square: traced (couplings A = C, B = D) and Eq. (13)."""
+    import matplotlib.pyplot as plt
+
+    path = trace(hedgepeth(4, couple=True), until=("A", deployed_angle(4)), steps=200)
+    a, b = np.degrees(path.angles[:, 0]), np.degrees(path.angles[:, 1])
+    fine = np.linspace(0.0, deployed_angle(4), 400)
+    fig, ax = plt.subplots(figsize=(5.0, 4.0), layout="constrained")
+    ax.plot(np.degrees(fine), np.degrees(eq13_theta_b(fine)), "-", color="0.6", lw=4, label="Eq. (13)")
+    ax.plot(a[::8], b[::8], "o", ms=3.5, color="C0", label="traced, 200 steps")
+    ax.set_xlabel("θA (deg)")
+    ax.set_ylabel("θB (deg)")
+    ax.set_title("Hedgepeth square, symmetric (θA = θC, θB = θD)", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+    gap = np.max(np.abs(np.degrees(eq13_theta_b(path.angles[:, 0])) - b))
+    print(f"  Fig. 9: largest |theta_B - Eq. (13)| along the path = {gap:.2e} deg")
+    return out
+
+
+def line_plot(plot, path, out: Path, **kwargs) -> Path:
+    """Call a trace_plots function (which also writes an SVG) and keep only the PNG."""
+    plot(path, out, **kwargs)
+    out.with_suffix(".svg").unlink(missing_ok=True)
+    return out
+
+
+def main() -> None:
+    started = time.perf_counter()
+    written = [fig09(HERE / "fig09_square_symmetric.png")]
+
+    square = trace(hedgepeth(4), until=("A", deployed_angle(4)), steps=200)  # no symmetry assumed
+    written.append(line_plot(plot_angles, square, HERE / "fig10_square_angles.png"))
+    written.append(deployment_sequence(square, HERE / "fig11_square_sequence.png", dpi=80))
+
+    hexagon = trace(hedgepeth(6), until=("A", deployed_angle(6)), steps=200)
+    written.append(line_plot(plot_angles, hexagon, HERE / "fig12_hexagon_angles.png"))
+    written.append(deployment_sequence(hexagon, HERE / "fig13_hexagon_sequence.png", dpi=80))
+
+    frame = trace(guest_frame(), branches=True, max_steps=6000)
+    written.append(line_plot(plot_singular_values, frame, HERE / "fig15_guest_singular_values.png", branch=0))
+    # Branch 1 leaves the first bifurcation point of branch 0: the symmetry-breaking path.
+    written.append(deployment_sequence(frame, HERE / "fig16_guest_symmetry_breaking.png", branch=1, dpi=80))
+
+    from linkwork.io.problem import load_problem
+    from linkwork.synthesis import synthesize
+    from linkwork.viz.synthesis_plots import write_synthesis_figures
+
+    result = synthesize(load_problem(ROOT / "examples" / "seat" / "problem.toml"))
+    names = {
+        "profiles": "synth_fig03_profiles.png",
+        "m_segment": "synth_fig06_m_segment.png",
+        "c_segment": "synth_fig07_c_segment.png",
+        "chain": "synth_fig08_chain.png",
+        "compound": "synth_fig10_compound.png",
+    }
+    with tempfile.TemporaryDirectory() as tmp:
+        for file in write_synthesis_figures(result, tmp):
+            if file.suffix == ".png" and file.stem in names:
+                written.append(Path(shutil.copy(file, HERE / names[file.stem])))
+    for file in written:
+        print(f"  {file.name}: {file.stat().st_size / 1024:.0f} kB")
+    print(f"{len(written)} figures in {time.perf_counter() - started:.1f} s")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

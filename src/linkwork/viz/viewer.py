@@ -1,0 +1,473 @@
+"""Interactive viewers: one self-contained HTML file per result, that a browser opens offline.
+
+:func:`write_trace_viewer` shows a traced path: the linkage's solids in 3-D (a small canvas renderer, no library),
+a slider along the path, a play button, a branch selector, and the hinge-angle and singular-value plots linked to
+the slider. :func:`write_synthesis_viewer` shows a synthesised chain posed on every target profile.
+
+Everything the page needs is inlined: the script and style from ``viewer_assets/``, and the data as JSON with the
+bulky arrays as little-endian base64. The page fetches nothing, from no host. The trace viewer sends each body's
+mesh once (reference configuration) and its 3x4 pose per path point, so a path of ``N`` points over ``b`` bodies
+costs ``48 N b`` bytes before base64.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import math
+import re
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path as FilePath
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.closure import body_poses
+
+if TYPE_CHECKING:
+    from linkwork.kinematics.mechanism import Mechanism
+    from linkwork.kinematics.tracer import Bifurcation, Path
+    from linkwork.synthesis.result import SynthesisResult
+
+#: Joint colours of the plots and labels (matplotlib's tab10, so the viewer matches the PNG figures).
+JOINT_COLORS = (
+    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf",
+)  # fmt: skip
+
+#: Points per viewer above which each branch is thinned evenly (ends and bifurcation points always kept).
+MAX_POINTS = 20000
+
+#: Two path points closer than this (radians, per joint) are the same configuration (bifurcation visits):
+#: a branch leaves a located point after a polish that may move it by a few 1e-6.
+SAME_POINT = 1e-5
+
+DATA_ID = "linkwork-data"
+"""The ``id`` of the ``<script type="application/json">`` element holding a viewer's data."""
+
+
+@dataclass(frozen=True)
+class Part:
+    """A triangle mesh fixed to one body, in the reference configuration: what the 3-D view draws."""
+
+    body: int
+    name: str
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    color: str
+
+
+# ----------------------------------------------------------------------------------------------- encoding
+
+
+def _packed(values: Any, dtype: str) -> dict[str, Any]:
+    """A numpy array as ``{"dtype", "shape", "b64"}``, little-endian, for ``decode`` in the page's script."""
+    arr = np.ascontiguousarray(np.asarray(values), dtype=np.dtype(dtype).newbyteorder("<"))
+    return {"dtype": dtype, "shape": list(arr.shape), "b64": base64.b64encode(arr.tobytes()).decode("ascii")}
+
+
+def unpack(entry: dict[str, Any]) -> NDArray[Any]:
+    """Inverse of the page's packing: the numpy array of a ``{"dtype", "shape", "b64"}`` entry (for tests)."""
+    raw = base64.b64decode(entry["b64"])
+    return np.frombuffer(raw, dtype=np.dtype(entry["dtype"]).newbyteorder("<")).reshape(entry["shape"])
+
+
+def _asset(name: str) -> str:
+    return (resources.files("linkwork.viz") / "viewer_assets" / name).read_text(encoding="utf-8")
+
+
+def _page(template: str, title: str, data: dict[str, Any], scripts: list[str]) -> str:
+    """Fill an HTML template: ``{{TITLE}}``, ``{{CSS}}``, ``{{DATA}}`` and ``{{JS}}``, in one pass."""
+    from linkwork import __version__
+
+    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
+    # Inside <script>, only "</" can end the element early; "<\/" is the same string to JSON.
+    payload = payload.replace("</", "<\\/")
+    values = {
+        "TITLE": _escape(title),
+        "CSS": _asset("viewer.css"),
+        "DATA": payload,
+        "JS": "\n".join(_asset(s) for s in scripts).replace("</script", "<\\/script"),
+        "VERSION": __version__,
+    }
+    return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], _asset(template))
+
+
+def _escape(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
+
+
+def _write(file: str | FilePath, text: str) -> FilePath:
+    file = FilePath(file)
+    file.parent.mkdir(parents=True, exist_ok=True)
+    file.write_text(text, encoding="utf-8")
+    return file
+
+
+# ----------------------------------------------------------------------------------------------- geometry
+
+
+def linkage_parts(mech: Mechanism) -> list[Part]:
+    """The solids of every body and the hinge pins (:mod:`linkwork.viz.solids`), each fixed to one body.
+
+    A pin moves with the body after its joint, as :func:`linkwork.viz.solids.place` moves it.
+    """
+    from linkwork.viz.solids import body_meshes, hinge_pins
+
+    index = {name: i for i, name in enumerate(mech.bodies)}
+    parts = [
+        Part(index[name], name, mesh.vertices, mesh.faces, _hex(mesh.color))
+        for name, mesh in body_meshes(mech).items()
+    ]
+    for pin in hinge_pins(mech):
+        after = mech.joint_bodies[mech.index(pin.name)][1]
+        parts.append(Part(index[after], f"pin {pin.name}", pin.vertices, pin.faces, _hex(pin.color)))
+    return parts
+
+
+def _hex(color: Any) -> str:
+    """A colour as ``#rrggbb`` from a hex string or an RGB(A) tuple in 0..1."""
+    if isinstance(color, str):
+        return color if color.startswith("#") else "#888888"
+    rgb = [min(255, max(0, round(255 * float(c)))) for c in tuple(color)[:3]]
+    return "#{:02x}{:02x}{:02x}".format(*rgb)
+
+
+def joint_labels(mech: Mechanism, parts: list[Part]) -> list[tuple[int, NDArray[np.float64]]]:
+    """Where to label each joint: ``(body, point)`` at the reference, the centre of its pin if it has one,
+    else the point of its axis nearest the origin (:func:`linkwork.viz.solids.joint_lines`)."""
+    from linkwork.viz.solids import joint_lines
+
+    points, _ = joint_lines(mech)
+    pins = {p.name: p for p in parts if p.name.startswith("pin ")}
+    out = []
+    for j, name in enumerate(mech.joint_names):
+        pin = pins.get(f"pin {name}")
+        if pin is not None:
+            out.append((pin.body, pin.vertices.mean(axis=0)))
+        else:
+            out.append((mech.bodies.index(mech.joint_bodies[j][1]), points[j]))
+    return out
+
+
+def _pose_rows(mech: Mechanism, angles: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(N, b, 12)``: for each point and body, the rows of its rotation then its translation."""
+    out = np.empty((len(angles), len(mech.bodies), 12))
+    for i, a in enumerate(angles):
+        poses = body_poses(mech, mech.q_from_angles(a))
+        for b, name in enumerate(mech.bodies):
+            T = poses[name]
+            out[i, b, :9] = T[:3, :3].ravel()
+            out[i, b, 9:] = T[:3, 3]
+    return out
+
+
+def _centres(parts: list[Part], poses: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(N, 3)`` the mean of the bodies' mesh centroids at every pose: what the view follows when centred."""
+    bodies = [p for p in parts if not p.name.startswith("pin ")] or parts
+    if not bodies:
+        return np.zeros((len(poses), 3))
+    out = np.zeros((len(poses), 3))
+    for part in bodies:
+        c = part.vertices.mean(axis=0)
+        R = poses[:, part.body, :9].reshape(-1, 3, 3)
+        out += R @ c + poses[:, part.body, 9:]
+    return out / len(bodies)
+
+
+def _bounds(parts: list[Part], poses: NDArray[np.float64], shift: NDArray[np.float64]) -> dict[str, Any]:
+    """Box and bounding sphere of every part at (a sample of) every pose, each pose moved by ``-shift``."""
+    pick = np.unique(np.linspace(0, len(poses) - 1, min(len(poses), 300)).astype(int))
+    sample, offset = poses[pick], shift[pick]
+    clouds = []
+    for part in parts:
+        R = sample[:, part.body, :9].reshape(-1, 3, 3)
+        t = sample[:, part.body, 9:] - offset
+        clouds.append((np.einsum("kij,vj->kvi", R, part.vertices) + t[:, None, :]).reshape(-1, 3))
+    cloud = np.concatenate(clouds) if clouds else np.zeros((1, 3))
+    lo, hi = cloud.min(axis=0), cloud.max(axis=0)
+    centre = (lo + hi) / 2
+    radius = float(np.max(np.linalg.norm(cloud - centre, axis=1)))
+    return {"center": centre.tolist(), "radius": max(radius, 1e-9), "min": lo.tolist(), "max": hi.tolist()}
+
+
+# ----------------------------------------------------------------------------------------------- trace viewer
+
+
+def _kept_points(path: Path, max_points: int, must: set[int]) -> list[NDArray[np.int64]]:
+    """Per branch, the indices of its points sent to the page, in path order: all of them, or thinned evenly
+    when the path has more than ``max_points`` (ends and the points in ``must`` kept)."""
+    n = len(path.branch)
+    out = []
+    for br in path.branches:
+        idx = np.flatnonzero(path.of_branch(br.id))
+        if n > max_points and len(idx) > 2:
+            share = max(2, round(max_points * len(idx) / n))
+            chosen = set(idx[np.unique(np.linspace(0, len(idx) - 1, share).round().astype(int))].tolist())
+            idx = np.array(sorted(chosen | (must & set(idx.tolist()))), dtype=np.int64)
+        out.append(idx)
+    return out
+
+
+def _same(a: NDArray[np.float64], b: NDArray[np.float64], revolute: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Rows of ``a`` that are configuration ``b`` (revolute joints compared modulo a full turn)."""
+    d = a - b
+    d[:, revolute] = (d[:, revolute] + np.pi) % (2 * np.pi) - np.pi
+    return np.all(np.abs(d) < SAME_POINT, axis=1)
+
+
+def _visits(path: Path, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Indices of the points at a bifurcation point: where branches leave or reach it, and the point of the
+    branch it was found on at its step (the point is located between two steps, not inserted into it)."""
+    same = set(np.flatnonzero(_same(path.angles, bif.angles, revolute)).tolist())
+    on = np.flatnonzero(path.of_branch(bif.branch) & (path.step == bif.step))
+    same |= set(on[:1].tolist())
+    for br in path.branches:
+        if br.bifurcation == bif.id:
+            same |= set(np.flatnonzero(path.of_branch(br.id))[:1].tolist())
+    return np.array(sorted(same), dtype=np.int64)
+
+
+def trace_viewer_data(
+    path: Path, *, title: str | None = None, max_points: int = MAX_POINTS
+) -> dict[str, Any]:
+    """Everything the trace viewer page shows, as JSON-ready data (angles in degrees).
+
+    Parameters
+    ----------
+    path
+        A traced path, one branch or several.
+    title
+        Heading of the page; the mechanism's name by default.
+    max_points
+        Above this many points, each branch is thinned evenly (its ends and bifurcation points are kept).
+    """
+    mech = path.mechanism
+    revolute = np.array([t == "R" for t in mech.joint_types])
+    # Every place the path passes through each bifurcation point: where it was found, where branches leave
+    # it and where branches end on it. The page offers a jump between them.
+    visits_all = [_visits(path, b, revolute) for b in path.bifurcations]
+    per_branch = _kept_points(path, max_points, {int(i) for v in visits_all for i in v})
+    keep = np.concatenate(per_branch) if per_branch else np.zeros(0, dtype=np.int64)
+    # Where each kept point lands: (branch index, row within the branch).
+    where = {int(k): (bi, row) for bi, idx in enumerate(per_branch) for row, k in enumerate(idx)}
+    angles = path.angles[keep]
+    starts = np.cumsum([0] + [len(idx) for idx in per_branch])
+    branches = [
+        {
+            "id": br.id,
+            "parent": br.parent,
+            "bifurcation": br.bifurcation,
+            "direction": br.direction,
+            "steps": br.steps,
+            "end": br.end_reason,
+            "start": int(starts[bi]),
+            "count": len(per_branch[bi]),
+        }
+        for bi, br in enumerate(path.branches)
+    ]
+    bifurcations = []
+    for b, visits in zip(path.bifurcations, visits_all, strict=True):
+        seen = [list(where[int(k)]) for k in visits if int(k) in where]
+        bifurcations.append(
+            {
+                "id": b.id,
+                "branch": b.branch,
+                "step": b.step,
+                "rank": b.rank,
+                "method": b.method,
+                "tangents": len(b.tangents),
+                "angles": _display(mech, b.angles).tolist(),
+                "visits": seen,
+            }
+        )
+
+    parts = linkage_parts(mech)
+    poses = _pose_rows(mech, angles)
+    labels = joint_labels(mech, parts)
+    centres = _centres(parts, poses)
+    display = _display(mech, angles)
+    drive = mech.index(path.drive) if path.drive in mech.joint_names else 0
+    return {
+        "kind": "trace",
+        "title": title or mech.name,
+        "mechanism": mech.name,
+        "drive": drive,
+        "planar": bool(mech.planar),
+        "joints": [
+            {
+                "name": name,
+                "type": kind,
+                "color": JOINT_COLORS[j % len(JOINT_COLORS)],
+                "dash": j // len(JOINT_COLORS) + (j % 4),
+                "body": labels[j][0],
+                "point": labels[j][1].tolist(),
+            }
+            for j, (name, kind) in enumerate(zip(mech.joint_names, mech.joint_types, strict=True))
+        ],
+        "bodies": list(mech.bodies),
+        "parts": [
+            {
+                "body": p.body,
+                "name": p.name,
+                "color": p.color,
+                "vertices": _packed(p.vertices, "f4"),
+                "faces": _packed(p.faces, "u2" if len(p.vertices) < 65536 else "u4"),
+            }
+            for p in parts
+        ],
+        "bounds": {
+            "fixed": _bounds(parts, poses, np.zeros_like(centres)),
+            "centred": _bounds(parts, poses, centres),
+        },
+        "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
+        "centres": _packed(centres, "f4"),
+        "points": len(keep),
+        "points_traced": len(path.branch),
+        "poses": _packed(poses, "f4"),
+        "angles": _packed(display, "f4"),
+        "sigma": _packed(path.sigma[keep], "f8"),
+        "rank": _packed(path.rank[keep], "i4"),
+        "step": _packed(path.step[keep], "i4"),
+        "arclength": _packed(np.degrees(path.arclength[keep]), "f4"),
+        "residual": _packed(path.residual[keep], "f4"),
+        "unknowns": mech.n_unknowns,
+        "branches": branches,
+        "bifurcations": bifurcations,
+    }
+
+
+def _display(mech: Mechanism, values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Joint values in the units users read: degrees for revolute joints, lengths for prismatic ones."""
+    out = np.array(values, dtype=float, copy=True)
+    revolute = np.array([t == "R" for t in mech.joint_types])
+    out[..., revolute] = np.degrees(out[..., revolute])
+    return out
+
+
+def write_trace_viewer(
+    path: Path, file: str | FilePath, *, title: str | None = None, max_points: int = MAX_POINTS
+) -> FilePath:
+    """Write the interactive viewer of a traced path: one self-contained HTML file that works offline.
+
+    The page shows the linkage in 3-D at a point of the path (drag to orbit, wheel to zoom), a slider along the
+    path and a play button, a branch selector when the path has several branches, and the hinge angles
+    (degrees) and the Jacobian's singular values against the step along the branch, with a cursor that follows
+    the slider and the bifurcation points marked. See ``docs/viewer.md``.
+
+    Parameters
+    ----------
+    path
+        A traced path (:func:`linkwork.trace`).
+    file
+        The HTML file to write (its folder is created).
+    title
+        Heading of the page; the mechanism's name by default.
+    max_points
+        Above this many points, each branch is thinned evenly (its ends and bifurcation points are kept).
+
+    Returns
+    -------
+    The path of the file written.
+    """
+    data = trace_viewer_data(path, title=title, max_points=max_points)
+    page = _page("trace.html", data["title"], data, ["common.js", "scene.js", "trace.js"])
+    return _write(file, page)
+
+
+# ----------------------------------------------------------------------------------------------- synthesis viewer
+
+
+def joint_turns(points: NDArray[np.float64], joints: list[int]) -> NDArray[np.float64]:
+    """Relative angle (degrees) at each joint of a posed chain: the turn from the piece arriving at the joint
+    point to the piece leaving it (positive to the left)."""
+    pts = np.asarray(points, dtype=float)
+    out = []
+    for k in joints:
+        a, b = pts[k] - pts[k - 1], pts[k + 1] - pts[k]
+        out.append(math.degrees(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b)))
+    return np.array(out)
+
+
+def synthesis_viewer_data(result: SynthesisResult, *, title: str | None = None) -> dict[str, Any]:
+    """Everything the synthesis viewer page shows, as JSON-ready data (angles in degrees)."""
+
+    def chain(profiles: Any) -> list[dict[str, Any]]:
+        return [
+            {
+                "joints": np.asarray(prof.joints).tolist(),
+                "points": np.asarray(prof.points).tolist(),
+                "angles": np.degrees(prof.angles).tolist(),
+                "errors": np.asarray(prof.errors).tolist(),
+                "turns": joint_turns(
+                    prof.points, [int(seg.starts[j]) for seg in result.segments[1:]]
+                ).tolist(),
+            }
+            for j, prof in enumerate(profiles)
+        ]
+
+    segments = [
+        {
+            "kind": seg.kind,
+            "pieces": [int(m) for m in seg.pieces],
+            "starts": [int(k) for k in seg.starts],
+            "radius": None if seg.radius is None or math.isinf(seg.radius) else float(seg.radius),
+            "lengths": [float(v) for v in seg.lengths],
+        }
+        for seg in result.segments
+    ]
+    compound = result.compound
+    return {
+        "kind": "synthesis",
+        "title": title or f"Shape-change synthesis: design {result.design}",
+        "profile_kind": result.problem.kind,
+        "design": result.design,
+        "e_max": float(result.e_max),
+        "e_mean": float(result.e_mean),
+        "joined_e_max": float(result.joined_e_max),
+        "piece_length": float(result.problem.piece_length),
+        "targets": [
+            {
+                "name": t.name or f"profile {j + 1}",
+                "points": np.asarray(t.points).tolist(),
+                "arc_length": float(t.arc_length),
+                "pieces": int(t.pieces),
+            }
+            for j, t in enumerate(result.targets)
+        ],
+        "segments": segments,
+        "joined": chain(result.joined),
+        "joined_errors": np.asarray(result.joined_error_matrix).tolist(),
+        "compound": None
+        if compound is None
+        else {
+            "merged": [int(i) for i in compound.merged],
+            "merge_below": math.degrees(compound.threshold),
+            "joint_ranges": np.degrees(compound.joint_ranges).tolist(),
+            "joint_angles": np.degrees(compound.joint_angles).tolist(),
+            "e_max": float(compound.e_max),
+            "errors": np.asarray(compound.error_matrix).tolist(),
+            "profiles": chain(compound.profiles),
+            "notes": list(compound.notes),
+        },
+    }
+
+
+def write_synthesis_viewer(
+    result: SynthesisResult, file: str | FilePath, *, title: str | None = None
+) -> FilePath:
+    """Write the interactive viewer of a synthesis result: one self-contained HTML file that works offline.
+
+    The page draws the target profiles and the joined chain posed on one of them, with a slider (and a play
+    button) across the profiles, the segments coloured by type (M rigid, C constant curvature), the joints,
+    and the error of every segment on the profile shown. See ``docs/viewer.md``.
+
+    Returns
+    -------
+    The path of the file written.
+    """
+    data = synthesis_viewer_data(result, title=title)
+    page = _page("synthesis.html", data["title"], data, ["common.js", "synthesis.js"])
+    return _write(file, page)
