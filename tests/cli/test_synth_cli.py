@@ -206,9 +206,11 @@ def test_summary_table_and_figures(problem: Path, tmp_path: Path) -> None:
         "E_max",
         "E_mean",
         "Joint ranges (merge below 5 deg)",
-        "viewer comes in a later release",
+        "viewer.html",
     ):
         assert text in result.output
+    viewer = (out / "viewer.html").read_text(encoding="utf-8")
+    assert "<canvas" in viewer and "https://" not in viewer  # the synthesis viewer, self-contained
     for stem in ("profiles", "m_segment", "c_segment", "chain"):
         for suffix in (".png", ".svg"):
             figure = out / f"{stem}{suffix}"

@@ -30,7 +30,7 @@ def demo(
     console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Fig. 12)")
     hexagon = lw.load("hedgepeth", n=6)
     path = lw.trace(hexagon, until=("A", deployed_angle(6)), steps=200)
-    figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots, html=True)
+    figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots, html=True, animate=not no_plots)
     summary(path)
     a = np.degrees(path.angles[-1])
     sections.append(
@@ -52,7 +52,9 @@ def demo(
         frame = None
     if frame is not None:
         path = lw.trace(frame, branches=True, max_steps=6000)
-        figs = write_trace_outputs(path, out / "guest-frame", plots=not no_plots, html=True)
+        figs = write_trace_outputs(
+            path, out / "guest-frame", plots=not no_plots, html=True, animate=not no_plots
+        )
         summary(path)
         sections.append(
             (

@@ -86,10 +86,12 @@ def synth(
         plots = False
     with staged_output(out) as stage:
         written = write_synthesis_outputs(result, stage, plots=plots)
+        if html:
+            from linkwork.viz.viewer import write_synthesis_viewer
+
+            written.append(write_synthesis_viewer(result, stage / "viewer.html"))
     print_summary(result)
     console.print(f"wrote {len(written)} files to {out}/: " + ", ".join(path.name for path in written))
-    if html:
-        console.print("note: --html: the interactive HTML viewer comes in a later release")
 
 
 def write_synthesis_outputs(result: SynthesisResult, folder: Path, *, plots: bool = True) -> list[Path]:

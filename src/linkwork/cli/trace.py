@@ -76,6 +76,9 @@ def trace(
     ] = False,
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
+    animate: Annotated[
+        bool, typer.Option("--animate", help="Also write motion.gif, an animation of every branch.")
+    ] = False,
     html: Annotated[
         bool,
         typer.Option(
@@ -140,7 +143,7 @@ def trace(
             branches=branches,
             progress=report,
         )
-    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html)
+    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
     _summary(path)
     written = ["path.csv", "report.json", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
@@ -151,9 +154,13 @@ def summary(path) -> None:
     _summary(path)
 
 
-def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True, html: bool = False) -> list[Path]:
-    """Write path.csv, report.json, (if matplotlib is there) the figures and, with ``html``, the interactive
-    viewer ``viewer.html`` into ``out``, all or nothing. Returns the figures and the viewer written."""
+def write_trace_outputs(
+    path, out: Path, assembly=None, plots: bool = True, html: bool = False, animate: bool = False
+) -> list[Path]:
+    """Write path.csv, report.json, (if matplotlib is there) the figures and the deployment sequence of the
+    first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
+    (``motion.gif``), and with ``html`` the interactive viewer ``viewer.html`` into ``out``, all or nothing.
+    Returns the figures, animation and viewer written."""
     from linkwork.io.results import write_path_csv, write_report_json
 
     figures: list[Path] = []
@@ -162,9 +169,16 @@ def write_trace_outputs(path, out: Path, assembly=None, plots: bool = True, html
         write_report_json(path, stage / "report.json", assembly)
         if plots:
             if have_matplotlib():
+                from linkwork.viz.snapshots import deployment_sequence
                 from linkwork.viz.trace_plots import write_trace_figures
 
                 figures = write_trace_figures(path, stage)
+                figures.append(deployment_sequence(path, stage / "sequence.png"))
+                if animate:
+                    from linkwork.viz.animate import animate_path
+
+                    motion = animate_path(path, stage / "motion.gif")
+                    figures += [f for f in (motion.gif, motion.mp4) if f is not None]
             else:
                 console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
         if html:
