@@ -35,11 +35,13 @@ def demo(
     a = np.degrees(path.angles[-1])
     sections.append(
         (
-            "Hedgepeth's hexagon, bundle to hexagon",
+            "Hedgepeth's hexagon (Sec. 5, Fig. 12): from the bundle to Eq. (10)'s deployed angle",
             f"200 equal steps of θA from the folded bundle to Eq. (10)'s deployed angle "
             f"{np.degrees(deployed_angle(6)):.4f}°; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
             f"B = D = F = {a[1]:.4f}° at the end (max |A - C| along the path "
-            f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°).",
+            f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°). The rods follow the "
+            "paper's printed Sec. 3 geometry, which for n >= 6 does not open into a flat hexagon: an open "
+            "question documented in docs/linkages.md.",
             out / "hexagon",
             [f.name for f in figs],
         )
@@ -93,7 +95,7 @@ def demo(
 
 #: What each section's interactive viewer lets a reader do.
 VIEWER_HINTS = {
-    "hexagon": "drag the slider from the folded bundle to the deployed hexagon",
+    "hexagon": "drag the slider from the folded bundle to Eq. (10)'s deployed angle",
     "guest-frame": "follow branch 0 to a bifurcation point, then take another branch from the panel",
     "synthesis-wing": "slide across the three wing profiles",
 }
