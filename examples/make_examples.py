@@ -321,6 +321,33 @@ seed = 1
 
 SETS = {"wing": wing, "closed": closed, "fixed-end": fixed_end, "seat": seat}
 
+# Sets that also get a ``mechanize.toml`` (the problem with ``mechanize = true``), and the design they fix if any:
+# the wing's best 5-segment design CCCMC has 9 bodies and no dyad set passes; MCMC mechanizes in under a second.
+MECHANIZE = {
+    "wing": 'design = "MCMC"           # the best 5-segment design CCCMC has 9 bodies; MCMC mechanizes in under a second',
+    "seat": None,
+}
+
+
+def write_mechanize(folder: Path, name: str, design_line: str | None) -> None:
+    """Write ``mechanize.toml``: ``problem.toml`` with ``mechanize = true`` (and, for some sets, a fixed design)."""
+    lines = (folder / "problem.toml").read_text(encoding="utf-8").splitlines()
+    header = [
+        f"# linkwork synth problem with mechanization: `linkwork synth examples/{name}/mechanize.toml` adds the binary links",
+        f"# that bring the chain to one degree of freedom (see docs/examples/{name}-mechanism.md).",
+    ]
+    body = []
+    for line in lines[1:]:
+        if design_line is not None and line.startswith("design = "):
+            body.append(design_line)
+            continue
+        if design_line is not None and line.startswith("segments = "):
+            continue
+        body.append(line)
+        if line.startswith("seed = "):
+            body.append("mechanize = true")
+    (folder / "mechanize.toml").write_text("\n".join(header + body) + "\n", encoding="utf-8")
+
 
 def main(root: Path = ROOT) -> None:
     """Write every example set into ``root/examples/`` and copy it to ``root/src/linkwork/data/examples/``."""
@@ -331,6 +358,8 @@ def main(root: Path = ROOT) -> None:
             shutil.rmtree(folder)
         folder.mkdir(parents=True)
         lengths = make(folder)
+        if name in MECHANIZE:
+            write_mechanize(folder, name, MECHANIZE[name])
         shutil.rmtree(bundled / name, ignore_errors=True)
         shutil.copytree(folder, bundled / name)
         summary = ", ".join(f"{key} {value:.4f}" for key, value in lengths.items())

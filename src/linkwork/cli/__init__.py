@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import typer
 
-from linkwork.cli import demo, linkages, synth, trace
+from linkwork.cli import demo, linkages, mechanize, synth, trace
 
 app = typer.Typer(
     name="linkwork",
@@ -21,6 +21,7 @@ app.command("trace")(trace.trace)
 app.command("linkages")(linkages.linkages)
 app.command("show")(linkages.show)
 app.command("synth")(synth.synth)
+app.command("mechanize")(mechanize.mechanize)
 app.command("demo")(demo.demo)
 
 

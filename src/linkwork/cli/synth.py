@@ -84,13 +84,23 @@ def synth(
     if plots and not have_matplotlib():
         console.print("note: matplotlib is not installed (pip install 'linkwork[viz]'): no figures drawn")
         plots = False
+    found = None
     with staged_output(out) as stage:
         written = write_synthesis_outputs(result, stage, plots=plots)
         if html:
             from linkwork.viz.viewer import write_synthesis_viewer
 
             written.append(write_synthesis_viewer(result, stage / "viewer.html"))
+        if spec.mechanize:
+            from linkwork.cli.mechanize import mechanize_into
+
+            found, more = mechanize_into(result, stage, plots=plots)
+            written += more
     print_summary(result)
+    if found is not None:
+        from linkwork.cli.mechanize import print_mechanization
+
+        print_mechanization(found)
     console.print(f"wrote {len(written)} files to {out}/: " + ", ".join(path.name for path in written))
 
 

@@ -1,0 +1,254 @@
+"""Assembly: the chain plus its binary links as one planar :class:`~linkwork.kinematics.mechanism.Mechanism`.
+
+The reference configuration of the mechanism is profile 1 (every joint at displacement 0 there), so the spec
+file written by :func:`spec_text` starts on profile 1 and ``linkwork trace`` runs it as it is. Every joint's
+displacement on every profile (the *ideal* configurations, where the chain sits exactly as joined) is known
+from the bodies' displacements; the verification compares the traced motion with them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.mechanization.chain import ShapeChain, apply, relative
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class BinaryLink:
+    """An RR dyad (binary link) or an RPR actuator added to the chain.
+
+    Attributes
+    ----------
+    name
+        ``D1``, ``D2``, ... (dyads) or ``A1`` (prismatic actuator).
+    kind
+        ``"RR"`` or ``"RPR"``.
+    anchor
+        The body the fixed end is pivoted on (``"ground"`` or a chain body).
+    body
+        The chain body the moving end is pivoted on.
+    centre
+        ``(2,)`` the anchor pivot (the centre point) on profile 1.
+    circle
+        ``(2,)`` the moving pivot (the circle point) on profile 1.
+    structural_error
+        How far the moving pivot's positions are from one circle about ``centre`` (0 for an exact dyad).
+    transmission
+        Smallest transmission angle over the profiles, radians (90 degrees is best).
+    via
+        The chain joint (or, for the root's four-bar, the other link) that with this link places the body.
+    """
+
+    name: str
+    kind: str
+    anchor: str
+    body: str
+    centre: Array
+    circle: Array
+    structural_error: float = 0.0
+    transmission: float = math.pi / 2
+    via: str | None = None
+
+    @property
+    def length(self) -> float:
+        """Link length (RR) or the actuator's length on profile 1 (RPR)."""
+        return float(np.linalg.norm(self.circle - self.centre))
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready: lengths as given, angles in degrees."""
+        return {
+            "name": self.name,
+            "type": self.kind,
+            "anchor": self.anchor,
+            "body": self.body,
+            "fixed_pivot": [float(v) for v in self.centre],
+            "moving_pivot": [float(v) for v in self.circle],
+            "length": self.length,
+            "structural_error": float(self.structural_error),
+            "transmission_deg": math.degrees(self.transmission),
+            "joints": self.joint_names(),
+        }
+
+    def joint_names(self) -> list[str]:
+        """The link's joints, anchor side first."""
+        if self.kind == "RR":
+            return [f"{self.name}a", f"{self.name}m"]
+        return [f"{self.name}a", f"{self.name}s", f"{self.name}m"]
+
+
+@dataclass(frozen=True)
+class Design:
+    """A mechanized chain: the chain, the binary links, and the drive joint(s).
+
+    Attributes
+    ----------
+    chain
+        The shape chain.
+    links
+        The binary links added, in the order they were chosen.
+    drive
+        The name of the driven joint.
+    dof
+        The degrees of freedom asked for.
+    notes
+        How the design was found (root body, candidates tried, ...).
+    """
+
+    chain: ShapeChain
+    links: tuple[BinaryLink, ...]
+    drive: str
+    dof: int = 1
+    name: str = "mechanized chain"
+    notes: tuple[str, ...] = field(default=())
+
+    def displacements(self) -> dict[str, Array]:
+        """``(p, 3)`` displacement of every body (chain bodies and link bodies) on every profile."""
+        p = self.chain.count
+        disp: dict[str, Array] = {"ground": np.zeros((p, 3))}
+        disp.update({b.name: b.displacements for b in self.chain.bodies})
+        for link in self.links:
+            ga, gb = disp[link.anchor], disp[link.body]
+            rel = relative(ga, gb)
+            # the moving pivot and fixed pivot as seen from the anchor (profile-1 coordinates)
+            m = np.array([apply(r, link.circle) for r in rel])
+            d = m - link.centre
+            phi = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+            phi = phi - phi[0]
+            c = link.centre
+            if link.kind == "RR":
+                rot = np.array([[ga_pose(c, a)] for a in phi]).reshape(p, 3)
+                disp[f"{link.name}"] = _compose(ga, rot)
+            else:
+                rot = np.array([ga_pose(c, a) for a in phi])
+                dist = np.linalg.norm(d, axis=1)
+                u0 = d[0] / dist[0]
+                slide = np.column_stack([np.outer(dist - dist[0], u0), np.zeros(p)])
+                disp[f"{link.name}c"] = _compose(ga, rot)
+                disp[f"{link.name}r"] = _compose(
+                    ga, np.array([_then(r, s) for r, s in zip(rot, slide, strict=True)])
+                )
+        return disp
+
+    def joint_specs(self) -> list[dict[str, object]]:
+        """Joints for :meth:`Mechanism.from_joints` (profile-1 positions)."""
+        out: list[dict[str, object]] = []
+        for jt in self.chain.joints:
+            entry: dict[str, object] = {"name": jt.name, "type": jt.kind, "bodies": list(jt.bodies)}
+            entry["point"] = [float(jt.point[0]), float(jt.point[1])]
+            entry["direction"] = [0.0, 0.0, 1.0] if jt.kind == "R" else [float(v) for v in jt.direction]  # type: ignore[union-attr]
+            out.append(entry)
+        for link in self.links:
+            c, m = [float(v) for v in link.centre], [float(v) for v in link.circle]
+            if link.kind == "RR":
+                out.append(
+                    {
+                        "name": f"{link.name}a",
+                        "type": "R",
+                        "bodies": [link.anchor, link.name],
+                        "point": c,
+                        "direction": [0.0, 0.0, 1.0],
+                    }
+                )
+                out.append(
+                    {
+                        "name": f"{link.name}m",
+                        "type": "R",
+                        "bodies": [link.name, link.body],
+                        "point": m,
+                        "direction": [0.0, 0.0, 1.0],
+                    }
+                )
+            else:
+                u = (link.circle - link.centre) / link.length
+                cyl, rod = f"{link.name}c", f"{link.name}r"
+                out.append(
+                    {
+                        "name": f"{link.name}a",
+                        "type": "R",
+                        "bodies": [link.anchor, cyl],
+                        "point": c,
+                        "direction": [0.0, 0.0, 1.0],
+                    }
+                )
+                out.append(
+                    {
+                        "name": f"{link.name}s",
+                        "type": "P",
+                        "bodies": [cyl, rod],
+                        "point": c,
+                        "direction": [float(u[0]), float(u[1])],
+                    }
+                )
+                out.append(
+                    {
+                        "name": f"{link.name}m",
+                        "type": "R",
+                        "bodies": [rod, link.body],
+                        "point": m,
+                        "direction": [0.0, 0.0, 1.0],
+                    }
+                )
+        return out
+
+    def mechanism(self) -> Mechanism:
+        """The planar mechanism, reference configuration = profile 1."""
+        return Mechanism.from_joints(self.name, self.joint_specs(), planar=True, meta={"form": "mechanism"})
+
+    def joint_names(self) -> list[str]:
+        """Joint names in mechanism order."""
+        return [str(j["name"]) for j in self.joint_specs()]
+
+    def ideal_values(self) -> Array:
+        """``(p, n)`` every joint's displacement on every profile (radians or lengths), joints in order."""
+        disp = self.displacements()
+        cols = []
+        for spec in self.joint_specs():
+            pair: list[str] = spec["bodies"]  # type: ignore[assignment]
+            rel = relative(disp[pair[0]], disp[pair[1]])
+            if spec["type"] == "R":
+                v = np.unwrap(rel[:, 2])
+            else:
+                v = rel[:, :2] @ np.asarray(spec["direction"], dtype=float)
+            cols.append(v - v[0])
+        return np.column_stack(cols)
+
+
+def ga_pose(centre: Array, angle: float) -> Array:
+    """Displacement ``(x, y, angle)`` of a rotation by ``angle`` about ``centre``."""
+    c, s = math.cos(angle), math.sin(angle)
+    t = centre - np.array([c * centre[0] - s * centre[1], s * centre[0] + c * centre[1]])
+    return np.array([t[0], t[1], angle])
+
+
+def _then(first: Array, second: Array) -> Array:
+    """``first`` composed with ``second`` (``second`` applied first, both displacements)."""
+    from linkwork.mechanization.chain import pose_matrix, pose_of
+
+    return pose_of(pose_matrix(first) @ pose_matrix(second))
+
+
+def _compose(outer: Array, inner: Array) -> Array:
+    return np.array([_then(a, b) for a, b in zip(outer, inner, strict=True)])
+
+
+def spec_text(design: Design) -> str:
+    """The ``[mechanism]`` spec file (TOML) of the design, starting on profile 1, with a header."""
+    from linkwork.io.spec import dump_spec
+
+    text = dump_spec(design.mechanism())
+    header = [
+        f"# {design.name}: mechanized shape-changing chain written by linkwork mechanize.",
+        "# Bodies s<e> are M-segments; s<e>a / s<e>b are the first and last pieces of C-segment e, joined by the",
+        "# arc slide S<e> (a revolute joint at the centre of the arc = a curved prismatic joint; prismatic when",
+        "# the arc is straight). J<i> joins segments i and i + 1. D<k> are the added binary links (D<k>a the",
+        "# fixed pivot, D<k>m the moving pivot), A<k> prismatic actuators. The start is profile 1.",
+        f"# drive: {design.drive}  (see mechanization.json for its value on every profile)",
+    ]
+    return "\n".join(header) + "\n" + text

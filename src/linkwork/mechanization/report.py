@@ -1,0 +1,80 @@
+"""``mechanization.json`` and ``mechanism.toml``: what a mechanized design is, in file units (degrees)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from linkwork.mechanization.assemble import spec_text
+from linkwork.mechanization.mechanize import Mechanization
+
+
+def _value(kind: str, value: float) -> float:
+    return math.degrees(value) if kind == "R" else float(value)
+
+
+def mechanization_dict(result: Mechanization) -> dict[str, Any]:
+    """The ``mechanization.json`` contract: ``dof``, ``drive``, ``dyads`` and per profile ``drive_value``,
+    ``angles`` {joint: degrees (lengths for prismatic joints)} and ``e_max``; angles in degrees."""
+    design, check = result.design, result.verification
+    mech = design.mechanism()
+    kinds = dict(zip(mech.joint_names, mech.joint_types, strict=True))
+    d_kind = kinds[design.drive]
+    profiles = []
+    for j, state in enumerate(check.states):
+        profiles.append(
+            {
+                "profile": j + 1,
+                "drive_value": _value(d_kind, state.drive_value),
+                "angles": {
+                    name: _value(kinds[name], float(v))
+                    for name, v in zip(mech.joint_names, state.values, strict=True)
+                },
+                "e_max": state.e_max,
+                "joined_e_max": float(design.chain.joined_errors[j]),
+                "deviation": state.deviation,
+            }
+        )
+    return {
+        "name": design.name,
+        "dof": check.dof,
+        "rank": check.rank,
+        "drive": design.drive,
+        "drive_type": d_kind,
+        "drive_unit": "deg" if d_kind == "R" else "length",
+        "joints": [{"name": n, "type": kinds[n]} for n in mech.joint_names],
+        "bodies": [b.name for b in design.chain.bodies],
+        "dyads": [link.to_dict() for link in design.links],
+        "profiles": profiles,
+        "e_max": max(s.e_max for s in check.states),
+        "max_condition": check.max_condition,
+        "verification": {
+            "passed": check.passed,
+            "checks": [
+                "dof from the Jacobian rank",
+                "order (monotonic drive)",
+                "branch (no singular configuration)",
+                "circuit (same assembly mode at every profile)",
+            ],
+            "attempts": result.attempts,
+            "rejected": list(result.rejected),
+        },
+        "notes": list(design.notes),
+        "seconds": result.seconds,
+        "trace_command": f"linkwork trace mechanism.toml --drive {design.drive} --until {design.drive}=<drive_value>",
+    }
+
+
+def write_mechanization(result: Mechanization, folder: str | Path) -> list[Path]:
+    """Write ``mechanism.toml`` and ``mechanization.json`` into ``folder``; returns their paths."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    spec = folder / "mechanism.toml"
+    spec.write_text(spec_text(result.design), encoding="utf-8")
+    report = folder / "mechanization.json"
+    report.write_text(
+        json.dumps(mechanization_dict(result), indent=2, allow_nan=False) + "\n", encoding="utf-8"
+    )
+    return [spec, report]

@@ -1,0 +1,441 @@
+"""The search for binary links: candidate pivots on the links and on the ground, ranked (Sec. 7).
+
+The chain's bodies are constrained one after another from a *root* body (Assur-group build-up):
+
+* the root is guided by two RR dyads to the ground, a four-bar whose crank is the drive (or, for a fixed-end
+  chain, it is already pinned to the ground and its pin is the crank);
+* every further body, reached through a chain joint from a body already placed, gets one RR dyad to the ground
+  (or to a placed body): with the chain joint it forms an RRR (or RRP) dyad, placed once its neighbour is;
+* a body joined to two placed bodies (the far end of a fixed-end or closed chain) needs no link.
+
+For every body the candidate moving pivots are points of the body (its outline, and offsets from it along the
+normal); each has its centre point by rigid-body guidance (:mod:`linkwork.mechanization.guidance`); the pivot
+pairs are ranked by structural error, the smallest transmission angle over the profiles and the link-length
+ratio. Candidates whose fixed pivot leaves the allowed region, whose assembly mode changes between profiles
+(the transmission changes sign) or whose transmission angle is below the limit are dropped.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.errors import LinkworkError
+from linkwork.mechanization import guidance
+from linkwork.mechanization.assemble import BinaryLink
+from linkwork.mechanization.chain import ShapeChain, apply, relative
+
+Array = NDArray[np.float64]
+
+
+class MechanizationError(LinkworkError):
+    """No design passes: says which body or which check stopped every candidate."""
+
+
+@dataclass(frozen=True)
+class MechanizeOptions:
+    """What the designer may choose (all optional).
+
+    Attributes
+    ----------
+    dof
+        Degrees of freedom (number of actuators) of the mechanism; 1 by default.
+    ground_region
+        ``(xmin, ymin, xmax, ymax)``: fixed pivots on the ground must lie in it. Default: the box of the
+        profiles grown by ``margin`` of their size on every side.
+    margin
+        See ``ground_region``.
+    link_offset
+        Moving pivots may sit off the chain, along its normal, up to this multiple of the body's length.
+    anchors
+        ``"ground"``: every dyad to the ground; ``"any"``: also between links (to a body already placed);
+        ``"auto"``: try ``"ground"`` first, then ``"any"``.
+    min_transmission
+        Radians: dyads whose transmission angle drops below this on a profile are dropped.
+    max_link
+        Longest link, as a multiple of the profiles' size.
+    root
+        The body guided first (default: the body with the longest outline).
+    drive
+        The driven joint (default: the crank of the root, else a chain joint that moves monotonically).
+    actuator
+        ``"revolute"``: the drive is a revolute joint; ``"prismatic"``: add a linear actuator (RPR) between the
+        ground (``ground_region``) and the root and drive its slider.
+    candidates
+        Moving-pivot candidates along each body (times 7 offsets).
+    attempts
+        Designs traced at most per root and anchor choice.
+    time_limit
+        Seconds after which the search stops with the best reason it has.
+    """
+
+    dof: int = 1
+    ground_region: tuple[float, float, float, float] | None = None
+    margin: float = 0.25
+    link_offset: float = 1.5
+    anchors: str = "auto"
+    min_transmission: float = math.radians(15.0)
+    max_link: float = 1.5
+    root: str | None = None
+    drive: str | None = None
+    actuator: str = "revolute"
+    candidates: int = 9
+    attempts: int = 6
+    time_limit: float = 60.0
+
+    def region(self, chain: ShapeChain) -> tuple[float, float, float, float]:
+        """The ground region in use."""
+        if self.ground_region is not None:
+            return tuple(float(v) for v in self.ground_region)  # type: ignore[return-value]
+        pts = np.vstack(chain.targets)
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        pad = self.margin * chain.size
+        return (float(lo[0] - pad), float(lo[1] - pad), float(hi[0] + pad), float(hi[1] + pad))
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A ranked RR dyad for one body: the link, and its score (higher is better)."""
+
+    link: BinaryLink
+    score: float
+    quality: Array = field(default_factory=lambda: np.zeros(0))
+
+
+@dataclass(frozen=True)
+class Step:
+    """One body to constrain: the body, the chain joint it is reached through, and its ranked candidates."""
+
+    body: str
+    via: str | None
+    candidates: tuple[Candidate, ...]
+    links: int = 1
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The build-up order and the candidates of every step; ``root_pairs`` rank the root's four-bars."""
+
+    root: str
+    pinned_root: str | None
+    root_pairs: tuple[tuple[Candidate, Candidate, float], ...]
+    steps: tuple[Step, ...]
+    free: tuple[str, ...]
+    paired: tuple[str, ...]
+
+
+def _moving_pivots(chain: ShapeChain, body: str, count: int, offset: float) -> Array:
+    """Candidate moving pivots on ``body`` (profile-1 coordinates): outline points and normal offsets."""
+    pts = chain.body(body).outline
+    if len(pts) < 2:
+        return pts.copy()
+    idx = np.unique(np.linspace(0, len(pts) - 1, count).round().astype(int))
+    length = float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
+    tangent = np.gradient(pts, axis=0)[idx]
+    tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+    out = [pts[idx] + h * offset * length * normal for h in (0.0, 1 / 3, -1 / 3, 2 / 3, -2 / 3, 1.0, -1.0)]
+    return np.vstack(out)
+
+
+def _guide(rel: Array, m: Array) -> guidance.Dyad | None:
+    """The dyad of moving pivot ``m`` for the relative positions ``rel`` (exact for p = 3)."""
+    try:
+        return guidance.centre_point(rel, m)
+    except LinkworkError:
+        return None
+
+
+def _free_directions(chain: ShapeChain, body: str, via: str | None, m: Array) -> Array | None:
+    """``(p, 2)`` the direction the moving pivot may move in when the body's neighbour is held (unit)."""
+    if via is None:
+        return None
+    jt = next(j for j in chain.joints if j.name == via)
+    g = chain.body(body).displacements
+    p = chain.count
+    if jt.kind == "P":
+        other = jt.bodies[0] if jt.bodies[1] == body else jt.bodies[1]
+        go = chain.body(other).displacements if other != "ground" else np.zeros((p, 3))
+        assert jt.direction is not None
+        d = np.array([apply(np.array([0.0, 0.0, x[2]]), jt.direction) for x in go])
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
+    pm = np.array([apply(x, m) for x in g])
+    pj = np.array([apply(x, jt.point) for x in g])
+    r = pm - pj
+    n = np.linalg.norm(r, axis=1, keepdims=True)
+    if np.any(n < 1e-9 * chain.size):
+        return np.full((p, 2), np.nan)
+    return np.column_stack([-r[:, 1], r[:, 0]]) / n
+
+
+def _quality(link_dir: Array, free: Array | None) -> Array:
+    """Sine of the transmission angle on every profile (signed), 1 when there is no neighbour."""
+    if free is None:
+        return np.ones(len(link_dir))
+    return np.sum(link_dir * free, axis=1)
+
+
+def body_candidates(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    anchors: Sequence[str],
+    options: MechanizeOptions,
+    name: str = "D",
+) -> list[Candidate]:
+    """Ranked RR dyads guiding ``body`` relative to each anchor (best first)."""
+    p = chain.count
+    xmin, ymin, xmax, ymax = options.region(chain)
+    out: list[Candidate] = []
+    g_body = chain.body(body).displacements
+    limit = math.sin(options.min_transmission)
+    for anchor in anchors:
+        g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+        rel = relative(g_anchor, g_body)
+        pivots = _pivot_candidates(chain, body, rel, options)
+        for m, dyad in pivots:
+            c = dyad.centre_point
+            r = dyad.radius
+            if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
+                continue
+            if anchor == "ground" and not (xmin <= c[0] <= xmax and ymin <= c[1] <= ymax):
+                continue
+            world_m = np.array([apply(x, m) for x in g_body])
+            world_c = np.array([apply(x, c) for x in g_anchor])
+            u = world_m - world_c
+            u /= np.linalg.norm(u, axis=1, keepdims=True)
+            free = _free_directions(chain, body, via, m)
+            if free is not None and np.any(~np.isfinite(free)):
+                continue
+            s = _quality(u, free)
+            if free is not None and (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0))):
+                continue
+            mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+            ratio = abs(math.log(r / (0.5 * chain.size)))
+            score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
+            link = BinaryLink(
+                name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via
+            )
+            out.append(Candidate(link, score, s))
+    out.sort(key=lambda cand: -cand.score)
+    return out
+
+
+def _pivot_candidates(
+    chain: ShapeChain, body: str, rel: Array, options: MechanizeOptions
+) -> list[tuple[Array, guidance.Dyad]]:
+    """Moving pivots and their dyads: any point (p <= 3), the circle-point curve (4), Burmester points (5)."""
+    p = len(rel)
+    grid = _moving_pivots(chain, body, options.candidates, options.link_offset)
+    out: list[tuple[Array, guidance.Dyad]] = []
+    if p <= 3:
+        for m in grid:
+            d = _guide(rel, m)
+            if d is not None:
+                out.append((m, d))
+    elif p == 4:
+        circle, _ = guidance.circle_point_curve(rel, rays=90, origin=grid.mean(axis=0), reach=chain.size)
+        for m in circle:
+            out.append((m, guidance.centre_point(rel, m)))
+    elif p == 5:
+        out = [(d.circle_point, d) for d in guidance.burmester_points(rel)]
+    else:
+        for m in grid:
+            d = guidance.fit_circle_point(rel, m)
+            out.append((d.circle_point, d))
+    return out
+
+
+def _adjacent(chain: ShapeChain, body: str) -> list[tuple[str, str]]:
+    """``(joint, other body)`` for every chain joint of ``body``."""
+    out = []
+    for j in chain.joints:
+        if body in j.bodies:
+            other = j.bodies[1] if j.bodies[0] == body else j.bodies[0]
+            out.append((j.name, other))
+    return out
+
+
+def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
+    """Bodies to try as the root: the ground-pinned body, the designer's, or every body (longest first)."""
+    names = [b.name for b in chain.bodies]
+    if options.root is not None and options.root not in names:
+        raise MechanizationError(
+            f"mechanize: unknown root body {options.root!r}; bodies are {', '.join(names)}"
+        )
+    pinned = [j for j in chain.joints if "ground" in j.bodies]
+    if pinned:
+        return [pinned[0].bodies[1] if pinned[0].bodies[0] == "ground" else pinned[0].bodies[0]]
+    if options.root is not None:
+        return [options.root]
+    return sorted(
+        names, key=lambda b: -float(np.sum(np.linalg.norm(np.diff(chain.body(b).outline, axis=0), axis=1)))
+    )
+
+
+def plan(chain: ShapeChain, root: str, options: MechanizeOptions) -> Plan:
+    """Order the bodies from ``root`` and rank every body's candidate dyads (``options.anchors`` is
+    ``"ground"`` or ``"any"``).
+
+    Raises
+    ------
+    MechanizationError
+        When a body has no acceptable dyad, naming it and the checks.
+    """
+    pinned = [j for j in chain.joints if "ground" in j.bodies]
+    return _plan_from(chain, root, pinned[0].name if pinned else None, options)
+
+
+def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: MechanizeOptions) -> Plan:
+    """The plan with ``root`` guided first."""
+    placed = ["ground", root]
+    order: list[tuple[str, str]] = []
+    paired: list[str] = []
+    queue = [root]
+    while queue:
+        body = queue.pop(0)
+        for joint, other in _adjacent(chain, body):
+            if other in placed:
+                continue
+            # a body joined to a second placed (or ground-pinned) body closes an RRR dyad with this one
+            closing = [(jn, o2) for jn, o2 in _adjacent(chain, other) if o2 != body and o2 in placed]
+            placed.append(other)
+            queue.append(other)
+            if closing:
+                paired.append(other)
+                continue
+            order.append((other, joint))
+    # (dof - 1) bodies at the far end stay without a link: their chain joints are the extra inputs
+    extra = max(0, options.dof - 1)
+    free = tuple(b for b, _ in order[len(order) - extra :]) if extra else ()
+    order = order[: len(order) - extra] if extra else order
+    steps = []
+    done = ["ground", root]
+    deferred: str | None = None
+    for body, via in order:
+        anchors = ["ground"]
+        if options.anchors == "any":
+            adjacent = {o for _, o in _adjacent(chain, body)}
+            anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
+        if deferred is not None:
+            # the body before had no dyad: this one takes two, and the pair is placed together
+            cands = body_candidates(chain, body, None, anchors, options)
+            if len(cands) >= 2:
+                steps.append(Step(body, None, tuple(cands), 2))
+                done += [deferred, body]
+                deferred = None
+                continue
+        else:
+            cands = body_candidates(chain, body, via, anchors, options)
+            if cands:
+                steps.append(Step(body, via, tuple(cands)))
+                done.append(body)
+                continue
+            deferred = body
+            continue
+        raise MechanizationError(
+            f"mechanize: no dyad can guide body {deferred or body} (root {root}): every candidate pivot leaves "
+            f"the ground region, is too long, has a transmission angle below "
+            f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
+            "(try a larger ground region or link offset)"
+        )
+    if deferred is not None:
+        raise MechanizationError(
+            f"mechanize: no dyad can guide body {deferred} (root {root}), the last body placed from it "
+            f"(transmission angle below {math.degrees(options.min_transmission):.0f} deg or a change of "
+            "assembly mode between profiles; try a larger ground region or link offset)"
+        )
+    pairs: list[tuple[Candidate, Candidate, float]] = []
+    if pinned_root is None:
+        pairs = _root_pairs(chain, root, options)
+        if not pairs:
+            raise MechanizationError(
+                f"mechanize: no four-bar guides the root body {root} through the profiles with its crank turning "
+                f"one way and transmission angles above {math.degrees(options.min_transmission):.0f} deg "
+                "(try another root, a larger ground region or link offset)"
+            )
+    return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
+
+
+def _root_pairs(
+    chain: ShapeChain, root: str, options: MechanizeOptions
+) -> list[tuple[Candidate, Candidate, float]]:
+    """Four-bars guiding the root: pairs of dyads ranked by the smaller transmission angle and link ratio."""
+    singles = body_candidates(chain, root, None, ["ground"], options)[:60]
+    g = chain.body(root).displacements
+    limit = math.sin(options.min_transmission)
+    out = []
+    for i, a in enumerate(singles):
+        wa = np.array([apply(x, a.link.circle) for x in g])
+        ca = a.link.centre
+        phi = np.unwrap(np.arctan2(wa[:, 1] - ca[1], wa[:, 0] - ca[0]))
+        dphi = np.diff(phi)
+        if not (np.all(dphi > 1e-6) or np.all(dphi < -1e-6)):
+            continue  # the crank must turn one way through the profiles (order)
+        for b in singles[i + 1 :]:
+            wb = np.array([apply(x, b.link.circle) for x in g])
+            coupler = wb - wa
+            n = np.linalg.norm(coupler, axis=1)
+            if np.any(n < 0.05 * chain.size):
+                continue
+            perp = np.column_stack([-coupler[:, 1], coupler[:, 0]]) / n[:, None]
+            ub = (wb - b.link.centre) / b.link.length
+            ua = (wa - ca) / a.link.length
+            s_b = np.sum(ub * perp, axis=1)  # transmission at the rocker
+            s_a = np.sum(ua * perp, axis=1)  # crank against coupler: away from the crank's dead centre
+            ok = all(np.all(np.abs(s) >= limit) and (np.all(s > 0) or np.all(s < 0)) for s in (s_a, s_b))
+            if not ok:
+                continue
+            mu = math.degrees(float(np.arcsin(min(1.0, float(min(np.abs(s_a).min(), np.abs(s_b).min()))))))
+            lengths = [a.link.length, b.link.length, float(n[0])]
+            ratio = max(lengths) / min(lengths)
+            out.append((a, b, mu - 10.0 * math.log(ratio)))
+    out.sort(key=lambda t: -t[2])
+    return out[:40]
+
+
+def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) -> BinaryLink:
+    """A linear actuator (RPR) from the ground region to ``body`` whose length changes monotonically.
+
+    Ranked by the stroke relative to the length (larger is better, up to a stroke of half the length), and by
+    how squarely the actuator pushes on its pivot's path (the cosine of the angle between the actuator and the
+    pivot's motion between profiles).
+
+    Raises
+    ------
+    MechanizationError
+        When no pivot pair on the ground and the body has a monotonic length.
+    """
+    xmin, ymin, xmax, ymax = options.region(chain)
+    grid = np.array([(x, y) for x in np.linspace(xmin, xmax, 9) for y in np.linspace(ymin, ymax, 9)])
+    g = chain.body(body).displacements
+    best, best_score = None, -math.inf
+    for m in _moving_pivots(chain, body, options.candidates, options.link_offset):
+        w = np.array([apply(x, m) for x in g])
+        travel = np.diff(w, axis=0)
+        for c in grid:
+            length = np.linalg.norm(w - c, axis=1)
+            if length.min() < 0.05 * chain.size or length.max() > options.max_link * chain.size:
+                continue
+            dl = np.diff(length)
+            if not (np.all(dl > 0) or np.all(dl < 0)):
+                continue
+            stroke = abs(length[-1] - length[0]) / length.min()
+            u = (w[:-1] + w[1:]) / 2 - c
+            u /= np.linalg.norm(u, axis=1, keepdims=True)
+            t = travel / np.maximum(np.linalg.norm(travel, axis=1, keepdims=True), 1e-300)
+            push = float(np.min(np.abs(np.sum(u * t, axis=1))))
+            score = min(stroke, 0.5) + push
+            if score > best_score:
+                best, best_score = (c, m, push), score
+    if best is None:
+        raise MechanizationError(
+            f"mechanize: no linear actuator from the ground region to body {body} changes length one way "
+            "through the profiles (enlarge the ground region)"
+        )
+    c, m, push = best
+    return BinaryLink("A1", "RPR", "ground", body, c, m, 0.0, float(np.arcsin(min(1.0, push))))

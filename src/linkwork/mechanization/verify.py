@@ -1,0 +1,313 @@
+"""Verification of a mechanized design with the kinematic core: DOF from the Jacobian rank, then a trace.
+
+For one degree of freedom the drive is traced from profile 1 (the reference configuration) to the drive value
+of every later profile, exactly as ``linkwork trace mechanism.toml --drive D --until D=value`` does, and the
+design is rejected with the reason when
+
+* **order defect**: the drive's values on the profiles are not monotonic, or the drive turns back on the way;
+* **branch defect**: the path meets a singular configuration (a bifurcation, or a drop of the Jacobian rank)
+  between profiles, or the corrector fails;
+* **circuit defect**: at a profile's drive value the mechanism is in another assembly mode than the profile's
+  configuration (the traced joint values differ from the chain's).
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.closure import body_poses, jacobian
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.rank import numerical_rank
+from linkwork.kinematics.tracer import Path as TracedPath
+from linkwork.kinematics.tracer import trace
+from linkwork.mechanization.assemble import Design, spec_text
+from linkwork.mechanization.chain import pose_of, wrap
+
+Array = NDArray[np.float64]
+
+#: A traced configuration matches the profile's when every joint agrees to this (radians or length / size).
+SAME_CONFIGURATION = 1e-6
+
+
+@dataclass(frozen=True)
+class ProfileState:
+    """The mechanism on one profile.
+
+    Attributes
+    ----------
+    drive_value
+        The drive's displacement from profile 1 (radians, or a length for a prismatic drive).
+    values
+        ``(n,)`` every joint's displacement from profile 1 as traced (radians or lengths).
+    e_max
+        Largest distance from the mechanism's chain to the target profile.
+    deviation
+        Largest difference between the traced joint values and the chain's (0 for an exact design).
+    """
+
+    drive_value: float
+    values: Array
+    e_max: float
+    deviation: float
+
+
+@dataclass(frozen=True)
+class Verification:
+    """The outcome of :func:`verify`.
+
+    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"`` or ``"circuit"``
+    with ``reason`` one line; ``culprit`` names the body or link to change.
+    """
+
+    passed: bool
+    defect: str | None
+    reason: str
+    dof: int
+    rank: int
+    drive: str
+    states: tuple[ProfileState, ...] = ()
+    max_condition: float = float("nan")
+    culprit: str | None = None
+    paths: tuple[TracedPath, ...] = field(default=())
+
+
+def loaded_mechanism(design: Design) -> Mechanism:
+    """The mechanism exactly as ``linkwork trace`` reads it from the written ``mechanism.toml``."""
+    from linkwork.io.spec import load_spec
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "mechanism.toml"
+        path.write_text(spec_text(design), encoding="utf-8")
+        return load_spec(path).mechanism
+
+
+def chain_displacements(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
+    """``(x, y, angle)`` displacement of every body of the mechanism at joint displacements ``values``."""
+    poses = body_poses(mech, values)
+    return {name: pose_of(g[np.ix_([0, 1, 3], [0, 1, 3])]) for name, g in poses.items()}
+
+
+def _difference(mech: Mechanism, a: Array, b: Array, size: float) -> Array:
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    revolute = np.array([t == "R" for t in mech.joint_types])
+    d = np.where(revolute, wrap(d), d / size)
+    return np.abs(d)
+
+
+def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: int = 1500) -> Verification:
+    """Check a design: DOF from the Jacobian rank; for one DOF, trace the drive through every profile in order.
+
+    Parameters
+    ----------
+    design
+        The mechanized chain.
+    max_step
+        Largest tracing step (radians), as ``linkwork trace --max-step`` (default 2 degrees).
+    max_steps
+        Step budget of each trace (a passing design's path is the same as with the CLI's larger budget).
+    """
+    mech = loaded_mechanism(design)
+    chain = design.chain
+    ideal = design.ideal_values()
+    names = list(mech.joint_names)
+    sigma = np.linalg.svd(jacobian(mech, np.zeros(mech.n_joints)), compute_uv=False)
+    rank = numerical_rank(sigma)
+    dof = mech.n_unknowns - rank
+    drive = design.drive
+    d = names.index(drive)
+    v = ideal[:, d]
+
+    def state(values: Array, j: int) -> ProfileState:
+        disp = chain_displacements(design, mech, values)
+        e = float(np.max(chain.errors(disp, j)))
+        dev = float(np.max(_difference(mech, values, ideal[j], chain.size)))
+        return ProfileState(float(values[d]), np.asarray(values, dtype=float), e, dev)
+
+    if dof != design.dof:
+        return Verification(
+            False,
+            "dof",
+            f"the mechanism has {dof} degrees of freedom (Jacobian rank {rank}), expected {design.dof}",
+            dof,
+            rank,
+            drive,
+        )
+    if dof != 1:
+        fixed = tuple(state(ideal[j], j) for j in range(chain.count))
+        return Verification(True, None, "", dof, rank, drive, fixed)
+    steps = np.diff(v)
+    if not (np.all(steps > 0) or np.all(steps < 0)):
+        order = ", ".join(f"{x:.4g}" for x in (np.degrees(v) if mech.joint_types[d] == "R" else v))
+        return Verification(
+            False,
+            "order",
+            f"order defect: the drive {drive} is not monotonic over the profiles ({order})",
+            dof,
+            rank,
+            drive,
+            culprit="drive",
+        )
+    states: list[ProfileState] = [state(np.zeros(mech.n_joints), 0)]
+    paths = []
+    max_cond = 1.0
+    for j in range(1, chain.count):
+        path = trace(mech, drive=drive, until=(drive, float(v[j])), max_step=max_step, max_steps=max_steps)
+        paths.append(path)
+        max_cond = max(max_cond, path.max_condition)
+        where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
+        end = path.branches[0].end_reason
+        if path.bifurcations:
+            b = path.bifurcations[0]
+            return Verification(
+                False,
+                "branch",
+                f"branch defect: a singular configuration (rank {b.rank}) {where}, "
+                f"drive {drive} = {_show(mech, d, b.angles[d])}",
+                dof,
+                rank,
+                drive,
+                tuple(states),
+                max_cond,
+                _culprit(design, mech, path),
+                tuple(paths),
+            )
+        if np.any(path.rank < rank):
+            k = int(np.flatnonzero(path.rank < rank)[0])
+            return Verification(
+                False,
+                "branch",
+                f"branch defect: the Jacobian loses rank {where}, drive {drive} = "
+                f"{_show(mech, d, path.angles[k, d])}",
+                dof,
+                rank,
+                drive,
+                tuple(states),
+                max_cond,
+                _culprit(design, mech, path),
+                tuple(paths),
+            )
+        if end != "reached target":
+            defect = "order" if "turning" in end else "branch"
+            return Verification(
+                False,
+                defect,
+                f"{defect} defect: the trace {where} stopped ({end}) before the drive "
+                f"{drive} reached {_show(mech, d, v[j])}",
+                dof,
+                rank,
+                drive,
+                tuple(states),
+                max_cond,
+                _culprit(design, mech, path),
+                tuple(paths),
+            )
+        dv = np.diff(path.angles[:, d])
+        if np.any(dv * np.sign(v[j]) < -1e-12):
+            return Verification(
+                False,
+                "order",
+                f"order defect: the drive {drive} turns back {where}",
+                dof,
+                rank,
+                drive,
+                tuple(states),
+                max_cond,
+                "drive",
+                tuple(paths),
+            )
+        st = state(path.angles[-1], j)
+        structural = max((link.structural_error for link in design.links), default=0.0)
+        if structural <= 1e-9 * chain.size:
+            wrong = st.deviation > SAME_CONFIGURATION
+        else:  # least-squares links: the profile's configuration is not on the mechanism; judge by the shape
+            wrong = st.e_max > chain.joined_errors[j] + 5.0 * structural + 1e-9 * chain.size
+        if wrong:
+            worst = names[int(np.argmax(_difference(mech, path.angles[-1], ideal[j], chain.size)))]
+            return Verification(
+                False,
+                "circuit",
+                f"circuit defect: at the drive value of profile {j + 1} the "
+                f"mechanism is in another assembly mode (joint {worst} differs)",
+                dof,
+                rank,
+                drive,
+                tuple(states),
+                max_cond,
+                _circuit_culprit(design, mech, path.angles[-1], j),
+                tuple(paths),
+            )
+        states.append(st)
+    return Verification(True, None, "", dof, rank, drive, tuple(states), max_cond, None, tuple(paths))
+
+
+def _show(mech: Mechanism, d: int, value: float) -> str:
+    return f"{math.degrees(value):.4g} deg" if mech.joint_types[d] == "R" else f"{value:.4g}"
+
+
+def _circuit_culprit(design: Design, mech: Mechanism, values: Array, j: int) -> str | None:
+    """The first added link (in build order) whose moving body is not where the profile puts it."""
+    disp = chain_displacements(design, mech, values)
+    tol = SAME_CONFIGURATION * design.chain.size
+    for link in design.links:
+        ideal = design.chain.body(link.body).displacements[j]
+        if (
+            np.max(np.abs(disp[link.body][:2] - ideal[:2])) > tol
+            or abs(wrap(disp[link.body][2] - ideal[2])) > 1e-6
+        ):
+            return link.name
+    return design.links[0].name if design.links else None
+
+
+def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
+    """Sine of every RR link's transmission angle at joint displacements ``values`` (0: a dead centre).
+
+    The angle at the moving pivot between the link and the line to the point that, with the link, places the
+    body: the body's chain joint ``via``, or the other root link's moving pivot.
+    """
+    from linkwork.mechanization.chain import apply
+
+    disp = chain_displacements(design, mech, values)
+    joints = {jt.name: jt for jt in design.chain.joints}
+    links = {link.name: link for link in design.links}
+    out: dict[str, float] = {}
+    for link in design.links:
+        if link.kind != "RR" or link.via is None:
+            continue
+        m = apply(disp[link.body], link.circle)
+        c = apply(disp[link.name], link.centre)
+        u = (m - c) / max(float(np.linalg.norm(m - c)), 1e-300)
+        if link.via in joints:
+            jt = joints[link.via]
+            if jt.kind == "P":
+                other = jt.bodies[0] if jt.bodies[1] == link.body else jt.bodies[1]
+                d = apply(np.array([0.0, 0.0, disp[other][2]]), jt.direction)  # type: ignore[arg-type]
+                out[link.name] = abs(float(u @ d))
+                continue
+            pj = apply(disp[link.body], jt.point)
+        else:
+            partner = links[link.via]
+            pj = apply(disp[link.body], partner.circle)
+        r = m - pj
+        nr = float(np.linalg.norm(r))
+        out[link.name] = abs(float(u @ np.array([-r[1], r[0]]) / nr)) if nr > 0 else 0.0
+    return out
+
+
+def _culprit(design: Design, mech: Mechanism, path: TracedPath) -> str | None:
+    """The RR link nearest a dead centre on the path (at the drive's turning point when there is one)."""
+    d = mech.index(design.drive)
+    drive = path.angles[:, d]
+    turn = np.flatnonzero(np.diff(np.sign(np.diff(drive))) != 0)
+    rows = [int(turn[0]) + 1] if turn.size else range(0, len(drive), max(1, len(drive) // 40))
+    worst, name = math.inf, None
+    for k in rows:
+        for link, s in link_transmissions(design, mech, path.angles[k]).items():
+            if s < worst:
+                worst, name = s, link
+    return name

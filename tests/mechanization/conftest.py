@@ -1,0 +1,33 @@
+"""Shared fixtures: a known four-bar whose coupler provides textbook guidance positions."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+GROUND_A = np.array([0.0, 0.0])
+GROUND_D = np.array([4.0, 0.0])
+CRANK, COUPLER, ROCKER = 1.5, 3.2, 3.0
+
+
+def coupler_pose(
+    phi: float,
+    *,
+    crank: float = CRANK,
+    coupler: float = COUPLER,
+    rocker: float = ROCKER,
+    ground_d: np.ndarray = GROUND_D,
+) -> np.ndarray:
+    """Pose ``(x, y, angle)`` of the coupler frame (origin at B, x towards C) at crank angle ``phi``."""
+    b = GROUND_A + crank * np.array([np.cos(phi), np.sin(phi)])
+    d = float(np.linalg.norm(ground_d - b))
+    towards = np.arctan2(*(ground_d - b)[::-1])
+    gamma = np.arccos((coupler**2 + d * d - rocker**2) / (2 * coupler * d))
+    c = b + coupler * np.array([np.cos(towards + gamma), np.sin(towards + gamma)])
+    return np.array([b[0], b[1], np.arctan2(*(c - b)[::-1])])
+
+
+@pytest.fixture
+def four_bar_poses() -> np.ndarray:
+    """Five coupler poses of the four-bar A(0,0)-B-C-D(4,0) at crank angles 40..110 degrees."""
+    return np.array([coupler_pose(p) for p in np.radians([40.0, 55.0, 70.0, 90.0, 110.0])])

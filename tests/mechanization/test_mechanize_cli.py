@@ -1,0 +1,53 @@
+"""`linkwork mechanize DIR` on a synth output folder of the wing (mechanize.toml variant)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import typer
+from typer.testing import CliRunner
+
+from linkwork.cli.mechanize import mechanize
+from linkwork.cli.synth import write_synthesis_outputs
+from linkwork.io.problem import load_problem
+from linkwork.synthesis import synthesize
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _synth_folder(tmp_path: Path) -> Path:
+    folder = tmp_path / "wing"
+    problem = folder / "problem"
+    shutil.copytree(EXAMPLES / "wing", problem)
+    shutil.copy(problem / "mechanize.toml", problem / "problem.toml")
+    write_synthesis_outputs(synthesize(load_problem(problem / "problem.toml")), folder, plots=False)
+    return folder
+
+
+def _app() -> typer.Typer:
+    app = typer.Typer()
+    app.command()(mechanize)
+    return app
+
+
+def test_mechanize_command_writes_the_mechanism_and_report(tmp_path: Path) -> None:
+    folder = _synth_folder(tmp_path)
+    run = CliRunner().invoke(_app(), [str(folder), "--no-plots"])
+    assert run.exit_code == 0, run.output
+    report = json.loads((folder / "mechanization.json").read_text())
+    chain = json.loads((folder / "chain.json").read_text())
+    assert report["dof"] == 1
+    assert (folder / "mechanism.toml").is_file()
+    for j, profile in enumerate(report["profiles"]):
+        # exact three-position guidance: the wing's shape error is the joined chain's (chord ~1)
+        assert abs(profile["e_max"] - max(chain["joined"]["error_matrix"][e][j] for e in range(4))) <= 1e-9
+
+
+def test_bad_option_is_one_line_and_exit_code_2(tmp_path: Path) -> None:
+    folder = _synth_folder(tmp_path)
+    run = CliRunner().invoke(_app(), [str(folder), "--ground-region", "1,2,3"])
+    assert run.exit_code == 2
+    assert "--ground-region" in run.output
+    assert not (folder / "mechanization.json").exists()
