@@ -129,8 +129,9 @@ def write_synthesis_outputs(result: SynthesisResult, folder: Path, *, plots: boo
     return written
 
 
-def example_problem(name: str = "wing") -> Path:
-    """The ``problem.toml`` of a bundled example (one of :data:`EXAMPLES`).
+def example_problem(name: str = "wing", file: str = "problem.toml") -> Path:
+    """The problem file (``problem.toml``, or ``mechanize.toml`` for wing and seat) of a bundled example (one of
+    :data:`EXAMPLES`).
 
     Raises
     ------
@@ -139,13 +140,15 @@ def example_problem(name: str = "wing") -> Path:
     """
     if name not in EXAMPLES:
         raise SpecError(f'unknown example "{name}"; expected one of {", ".join(EXAMPLES)}', key="example")
-    path = Path(str(resources.files("linkwork.data") / "examples" / name / "problem.toml"))
+    path = Path(str(resources.files("linkwork.data") / "examples" / name / file))
     if not path.is_file():
         raise SpecError(f"the bundled example is missing ({path}); reinstall linkwork", key="example")
     return path
 
 
-def run_synthesis_example(out_dir: Path, name: str = "wing", *, plots: bool = True) -> SynthesisResult:
+def run_synthesis_example(
+    out_dir: Path, name: str = "wing", *, plots: bool = True, file: str = "problem.toml"
+) -> SynthesisResult:
     """Run a bundled synthesis example and write its inputs and outputs into ``out_dir``.
 
     ``out_dir/problem/`` receives a copy of the example's problem file and profiles (so ``linkwork synth
@@ -160,16 +163,24 @@ def run_synthesis_example(out_dir: Path, name: str = "wing", *, plots: bool = Tr
         One of :data:`EXAMPLES`.
     plots
         Draw the figures (skipped anyway when matplotlib is not installed).
+    file
+        The example's problem file; ``mechanize.toml`` also mechanizes the chain (mechanism.toml,
+        mechanization.json, figures).
     """
     from linkwork.io.problem import load_problem
     from linkwork.synthesis import synthesize
 
-    problem_file = example_problem(name)
-    result = synthesize(load_problem(problem_file))
+    problem_file = example_problem(name, file)
+    problem = load_problem(problem_file)
+    result = synthesize(problem)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     shutil.copytree(problem_file.parent, out_dir / "problem", dirs_exist_ok=True)
     write_synthesis_outputs(result, out_dir, plots=plots and have_matplotlib())
+    if problem.mechanize:
+        from linkwork.cli.mechanize import mechanize_into
+
+        mechanize_into(result, out_dir, plots=plots and have_matplotlib())
     return result
 
 
