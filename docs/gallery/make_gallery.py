@@ -1,6 +1,6 @@
 """Reproduce the papers' figures: ``python docs/gallery/make_gallery.py`` (writes the PNGs next to this file).
 
-Gan & Pellegrino (2006): Figs. 9-13, 15, 16. Shamsudin et al. (2013): Figs. 3, 6, 7, 8, 10 (seat example).
+Gan & Pellegrino (2006): Figs. 9-13, 15, 16. Shamsudin et al. (2013): Figs. 3, 6, 7, 8, 10, 13 (via 8 and 10), 14 (seat example).
 Needs the ``viz`` extra (matplotlib, pillow). Takes about 15 s.
 """
 
@@ -99,6 +99,15 @@ def main() -> None:
         for file in write_synthesis_figures(result, tmp):
             if file.suffix == ".png" and file.stem in names:
                 written.append(Path(shutil.copy(file, HERE / names[file.stem])))
+    # Fig. 14: the seat chain mechanized to one degree of freedom (examples/seat/mechanize.toml).
+    from linkwork.cli.mechanize import mechanize_into
+
+    seat = synthesize(load_problem(ROOT / "examples" / "seat" / "mechanize.toml"))
+    with tempfile.TemporaryDirectory() as tmp:
+        mechanize_into(seat, Path(tmp), plots=True)
+        written.append(
+            Path(shutil.copy(Path(tmp) / "mechanism.png", HERE / "synth_fig14_seat_mechanism.png"))
+        )
     for file in written:
         print(f"  {file.name}: {file.stat().st_size / 1024:.0f} kB")
     print(f"{len(written)} figures in {time.perf_counter() - started:.1f} s")
