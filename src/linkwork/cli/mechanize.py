@@ -191,6 +191,9 @@ def print_mechanization(found: Mechanization) -> None:
             str(j + 1), f"{value:.6f}", f"{state.e_max:.4f}", f"{design.chain.joined_errors[j]:.4f}"
         )
     console.print(states)
+    if not check.traced:
+        console.print(f"{check.reason} ({found.seconds:.1f} s)")
+        return
     console.print(
         f"verified: no circuit, branch or order defect ({found.attempts} designs traced, {found.seconds:.1f} s)"
     )

@@ -52,11 +52,19 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
         "max_condition": check.max_condition,
         "verification": {
             "passed": check.passed,
+            "traced": check.traced,
+            "status": "traced" if check.traced else check.reason,
             "checks": [
                 "dof from the Jacobian rank",
                 "order (monotonic drive)",
                 "branch (no singular configuration)",
                 "circuit (same assembly mode at every profile)",
+            ]
+            if check.traced
+            else [
+                "dof from the Jacobian rank",
+                "closure of every profile's configuration",
+                "full Jacobian rank at every profile",
             ],
             "attempts": result.attempts,
             "rejected": list(result.rejected),

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.kinematics.closure import body_poses, jacobian
+from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.kinematics.tracer import Path as TracedPath
@@ -33,6 +33,9 @@ Array = NDArray[np.float64]
 
 #: A traced configuration matches the profile's when every joint agrees to this (radians or length / size).
 SAME_CONFIGURATION = 1e-6
+
+#: A profile's configuration closes the loops when the closure residual's norm is below this (times the size).
+CLOSES = 1e-9
 
 
 @dataclass(frozen=True)
@@ -61,8 +64,10 @@ class ProfileState:
 class Verification:
     """The outcome of :func:`verify`.
 
-    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"`` or ``"circuit"``
-    with ``reason`` one line; ``culprit`` names the body or link to change.
+    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"``, ``"circuit"`` or
+    ``"closure"`` with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
+    when the motion was not traced (more than one DOF: the tracer follows one-parameter paths); a design that
+    passes untraced says so in ``reason`` (``"not traced: dof 2 ..."``).
     """
 
     passed: bool
@@ -75,6 +80,7 @@ class Verification:
     max_condition: float = float("nan")
     culprit: str | None = None
     paths: tuple[TracedPath, ...] = field(default=())
+    traced: bool = True
 
 
 def loaded_mechanism(design: Design) -> Mechanism:
@@ -102,6 +108,10 @@ def _difference(mech: Mechanism, a: Array, b: Array, size: float) -> Array:
 
 def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: int = 1500) -> Verification:
     """Check a design: DOF from the Jacobian rank; for one DOF, trace the drive through every profile in order.
+
+    With more than one DOF nothing is traced (``traced`` is ``False``): every profile's configuration must close
+    the loops (residual below ``CLOSES`` times the size) where the Jacobian keeps its rank; ``max_condition`` is
+    then the largest condition number at the profiles.
 
     Parameters
     ----------
@@ -139,8 +149,42 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
             drive,
         )
     if dof != 1:
+        # the tracer follows one-parameter paths: with several inputs nothing is traced, and the report says so;
+        # what is checked is that every profile's configuration closes the loops with the Jacobian's full rank
+        max_cond = 1.0
+        for j in range(chain.count):
+            residual = float(np.linalg.norm(closure_residual(mech, ideal[j])))
+            if residual > CLOSES * max(chain.size, 1.0):
+                return Verification(
+                    False,
+                    "closure",
+                    f"the configuration of profile {j + 1} does not close the loops (residual {residual:.3g}): "
+                    "least-squares links are only verified by tracing, with one DOF",
+                    dof,
+                    rank,
+                    drive,
+                    traced=False,
+                )
+            spectrum = np.linalg.svd(jacobian(mech, ideal[j]), compute_uv=False)
+            at = numerical_rank(spectrum)
+            if at > 0:
+                max_cond = max(max_cond, float(spectrum[0] / spectrum[at - 1]))
+            if at < rank:
+                return Verification(
+                    False,
+                    "branch",
+                    f"branch defect: the Jacobian loses rank at profile {j + 1} ({at} < {rank})",
+                    dof,
+                    rank,
+                    drive,
+                    traced=False,
+                )
         fixed = tuple(state(ideal[j], j) for j in range(chain.count))
-        return Verification(True, None, "", dof, rank, drive, fixed)
+        note = (
+            f"not traced: dof {dof} (the tracer follows one-parameter paths; checked: every profile's "
+            "configuration closes the loops with full Jacobian rank)"
+        )
+        return Verification(True, None, note, dof, rank, drive, fixed, max_cond, traced=False)
     steps = np.diff(v)
     if not (np.all(steps > 0) or np.all(steps < 0)):
         order = ", ".join(f"{x:.4g}" for x in (np.degrees(v) if mech.joint_types[d] == "R" else v))
