@@ -198,8 +198,15 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
             culprit="drive",
         )
     states: list[ProfileState] = [state(np.zeros(mech.n_joints), 0)]
-    paths = []
+    paths: list[TracedPath] = []
     max_cond = 1.0
+
+    def reject(defect: str, reason: str, culprit: str | None) -> Verification:
+        """A failed verification with everything traced so far."""
+        return Verification(
+            False, defect, reason, dof, rank, drive, tuple(states), max_cond, culprit, tuple(paths)
+        )
+
     for j in range(1, chain.count):
         path = trace(mech, drive=drive, until=(drive, float(v[j])), max_step=max_step, max_steps=max_steps)
         paths.append(path)
@@ -208,62 +215,34 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
         end = path.branches[0].end_reason
         if path.bifurcations:
             b = path.bifurcations[0]
-            return Verification(
-                False,
+            return reject(
                 "branch",
                 f"branch defect: a singular configuration (rank {b.rank}) {where}, "
                 f"drive {drive} = {_show(mech, d, b.angles[d])}",
-                dof,
-                rank,
-                drive,
-                tuple(states),
-                max_cond,
                 _culprit(design, mech, path),
-                tuple(paths),
             )
         if np.any(path.rank < rank):
             k = int(np.flatnonzero(path.rank < rank)[0])
-            return Verification(
-                False,
+            return reject(
                 "branch",
                 f"branch defect: the Jacobian loses rank {where}, drive {drive} = "
                 f"{_show(mech, d, path.angles[k, d])}",
-                dof,
-                rank,
-                drive,
-                tuple(states),
-                max_cond,
                 _culprit(design, mech, path),
-                tuple(paths),
             )
         if end != "reached target":
             defect = "order" if "turning" in end else "branch"
-            return Verification(
-                False,
+            return reject(
                 defect,
                 f"{defect} defect: the trace {where} stopped ({end}) before the drive "
                 f"{drive} reached {_show(mech, d, v[j])}",
-                dof,
-                rank,
-                drive,
-                tuple(states),
-                max_cond,
                 _culprit(design, mech, path),
-                tuple(paths),
             )
         dv = np.diff(path.angles[:, d])
         if np.any(dv * np.sign(v[j]) < -1e-12):
-            return Verification(
-                False,
+            return reject(
                 "order",
                 f"order defect: the drive {drive} turns back {where}",
-                dof,
-                rank,
-                drive,
-                tuple(states),
-                max_cond,
                 "drive",
-                tuple(paths),
             )
         st = state(path.angles[-1], j)
         structural = max((link.structural_error for link in design.links), default=0.0)
@@ -273,18 +252,11 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
             wrong = st.e_max > chain.joined_errors[j] + 5.0 * structural + 1e-9 * chain.size
         if wrong:
             worst = names[int(np.argmax(_difference(mech, path.angles[-1], ideal[j], chain.size)))]
-            return Verification(
-                False,
+            return reject(
                 "circuit",
                 f"circuit defect: at the drive value of profile {j + 1} the "
                 f"mechanism is in another assembly mode (joint {worst} differs)",
-                dof,
-                rank,
-                drive,
-                tuple(states),
-                max_cond,
                 _circuit_culprit(design, mech, path.angles[-1], j),
-                tuple(paths),
             )
         states.append(st)
     return Verification(True, None, "", dof, rank, drive, tuple(states), max_cond, None, tuple(paths))
