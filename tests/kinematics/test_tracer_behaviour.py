@@ -68,6 +68,20 @@ def test_landing_on_until_is_exact_in_adaptive_mode() -> None:
     assert steps.max() <= 3 * DEG * 1.01
 
 
+@pytest.mark.parametrize("target_deg", [20.0, -20.0])
+def test_paper_mode_steps_towards_a_target_on_either_side_of_the_start(target_deg: float) -> None:
+    # Regression: equal drive steps towards a target below the start once marched the wrong way until the budget.
+    a1, a2, t1 = 30 * DEG, 80 * DEG, 60 * DEG
+    mech = bennett(a1, a2, t1)
+    path = trace(mech, until=("A", t1 + target_deg * DEG), steps=10)
+    assert path.branches[0].end_reason == "reached target"
+    np.testing.assert_allclose(np.diff(path.angles[:, 0]), target_deg * DEG / 10, atol=1e-14)
+    k = np.sin((a2 + a1) / 2) / np.sin((a2 - a1) / 2)
+    th = path.angles
+    rel = np.sin(th[:, 0] / 2) * np.sin(th[:, 1] / 2) - k * np.cos(th[:, 0] / 2) * np.cos(th[:, 1] / 2)
+    assert np.max(np.abs(rel)) < 1e-10
+
+
 def test_step_budget_is_reported() -> None:
     mech = bennett(30 * DEG, 80 * DEG, 60 * DEG)
     path = trace(mech, max_steps=7)

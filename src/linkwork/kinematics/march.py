@@ -230,7 +230,8 @@ def march(
 
     ``u_home`` is where the path began (for closed-path detection across several calls).
 
-    ``paper``: fixed steps of ``h0`` in the drive unknown, corrector with the drive held (the paper's mode);
+    ``paper``: fixed steps of ``h0`` in the drive unknown (signed: negative steps move the drive down), corrector
+    with the drive held (the paper's mode);
     otherwise adaptive arclength steps in ``[hmin, hmax]`` with the minimum-norm corrector. Returns
     ``(count, code, h)``: rows written, the stop code and the last step length.
     """
@@ -352,7 +353,7 @@ def march(
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
             if d > far:
                 far = d
-            if far > 4.0 * hmax and d < 1.5 * h:
+            if far > 4.0 * hmax and d < 1.5 * abs(h):
                 for a in range(m):
                     diff = u_home[a] - u[a]
                     if periodic[a]:

@@ -386,7 +386,8 @@ def trace(
     paper = steps is not None
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
     basis0 = np.ascontiguousarray(U0[:, :r_path])
-    n0, reason0 = run_branch(0, np.zeros(m), t_start, basis0.copy(), paper, abs(h_start), False)
+    # Paper mode keeps the sign: equal drive steps towards a target below the start value are negative.
+    n0, reason0 = run_branch(0, np.zeros(m), t_start, basis0.copy(), paper, h_start, False)
     branch_list.append(Branch(0, None, None, 1, n0, reason0))
     if branches and target is None and reason0 != STOP_REASONS[2]:
         # The start is in the middle of its branch: trace the other direction too.

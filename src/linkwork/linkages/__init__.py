@@ -8,8 +8,10 @@ from linkwork.linkages import bricard as _bricard  # noqa: F401
 from linkwork.linkages import goldberg as _goldberg  # noqa: F401
 from linkwork.linkages import guest as _guest  # noqa: F401
 from linkwork.linkages import hedgepeth as _hedgepeth  # noqa: F401
+from linkwork.linkages import hedgepeth_rods as _hedgepeth_rods  # noqa: F401
 from linkwork.linkages import sarrus as _sarrus  # noqa: F401
 from linkwork.linkages.hedgepeth import deployed_angle, hedgepeth
+from linkwork.linkages.hedgepeth_rods import hedgepeth_rods
 from linkwork.linkages.registry import REGISTRY, LinkageEntry, Param, get
 
-__all__ = ["REGISTRY", "LinkageEntry", "Param", "deployed_angle", "get", "hedgepeth"]
+__all__ = ["REGISTRY", "LinkageEntry", "Param", "deployed_angle", "get", "hedgepeth", "hedgepeth_rods"]

@@ -64,7 +64,7 @@ def hedgepeth(n: int = 6, couple: bool | None = None) -> Mechanism:
     for k in range(n):
         sign = 1.0 if k % 2 == 0 else -1.0
         rods.append({"phi": sign * g["phi"], "omega": sign * g["omega"], "psi": sign * g["psi"], "v": v})
-    names = [_joint_name(k) for k in range(n)]
+    names = [joint_name(k) for k in range(n)]
     meta = {"linkage": "hedgepeth", "n": n, "deployed_A": deployed_angle(n)}
     mech, _ = from_rods(f"Hedgepeth hoop n={n}", rods, [0.0] * n, joint_names=names, meta=meta)
     if couple if couple is not None else n >= 8:
@@ -72,7 +72,7 @@ def hedgepeth(n: int = 6, couple: bool | None = None) -> Mechanism:
     return mech
 
 
-def _joint_name(k: int) -> str:
+def joint_name(k: int) -> str:
     """A, B, ..., Z, then A1, B1, ...: short names for large hoops."""
     letter = chr(ord("A") + k % 26)
     return letter if k < 26 else f"{letter}{k // 26}"

@@ -10,6 +10,9 @@ describe) and moved rigidly by :func:`linkwork.kinematics.closure.body_poses`. T
   the hinge axis whose normal lies in the rod's plane of symmetry, so the end section is an isosceles triangle and
   the cut makes ``180/n`` degrees with the rod (the paper's cut angle). A documented simplification: the paper's
   rods are cut this way too, but its exact door-hinge offsets are not given.
+* ``"hedgepeth-rods"``: the same rods as built (:mod:`linkwork.linkages.hedgepeth_rods`): pie-slice sections
+  tiling a regular n-gon in the bundle, ends mitred at ``180/n``, each pin along the edge where a mitre meets the
+  side face that carries the door hinge.
 * ``"guest-frame"``: square-section rods turned 45 degrees (section diagonals horizontal and vertical), corners
   mitred by the vertical bisecting planes, short sides cut by the plane ``y = 0`` (Sec. 6; ``docs/linkages.md``).
 * anything else (spec files, Bennett, Bricard, Sarrus, Goldberg, synthesised mechanisms): round bars between the
@@ -351,6 +354,8 @@ def _drawing(mech: Mechanism) -> tuple[dict[str, Mesh], list[Mesh]]:
     designed = None
     if style == "hedgepeth" and "rods" in mech.meta:
         designed = _hedgepeth_design(mech)
+    elif style == "hedgepeth-rods":
+        designed = _hedgepeth_rods_design(mech)
     elif style == "guest-frame":
         designed = _guest_design(mech)
     if designed is not None:
@@ -515,6 +520,49 @@ def _hedgepeth_design(mech: Mechanism) -> tuple[dict[str, Mesh], list[Mesh], Arr
         )
     bodies = {name: bodies[name] for name in mech.bodies}
     return bodies, pins, origins, axes
+
+
+def _hedgepeth_rods_design(mech: Mechanism) -> tuple[dict[str, Mesh], list[Mesh], Array, Array] | None:
+    """The mitred triangular rods of :mod:`linkwork.linkages.hedgepeth_rods`, in the folded bundle.
+
+    Rod ``i`` is the prism of isosceles section (apex on the apex line, equal sides ``width`` at ``+-180/n``
+    from the section's axis) between the mitre planes ``x cos(beta) +- y sin(beta) = ...`` of its body frame; the
+    pins run along the hinge edges from the apex to the base corner of the end section.
+    """
+    from linkwork.linkages.hedgepeth_rods import hinge_edge, rod_frame, start_face_sign
+
+    n = int(mech.meta.get("n", mech.n_joints))
+    if n != mech.n_joints or len(mech.bodies) != n:
+        return None
+    width = float(mech.meta.get("width", ROD_WIDTH))
+    beta = np.pi / n
+    corner = width * np.array([np.sin(beta), np.cos(beta)])
+    bodies: dict[str, Mesh] = {}
+    points, axes = np.zeros((n, 3)), np.zeros((n, 3))
+    pins = []
+    for i in range(n):
+        F = rod_frame(n, i)
+        R, o = F[:3, :3], F[:3, 3]
+        section = (
+            o + np.array([[0.0, 0.0, 0.0], [0.0, corner[0], corner[1]], [0.0, -corner[0], corner[1]]]) @ R.T
+        )
+        start = (o, R @ np.array([np.cos(beta), np.sin(beta), 0.0]))
+        end = (o + R[:, 0], R @ np.array([np.cos(beta), -np.sin(beta), 0.0]))
+        vertices = cut_prism(section, R[:, 0], start, end)
+        bodies[mech.joint_bodies[i][1]] = Mesh(
+            vertices, prism_faces(3), color=ROD_COLORS[i % 2], kind="rod", name=mech.joint_bodies[i][1]
+        )
+        sign = start_face_sign(i)
+        edge = R @ hinge_edge(n, sign)
+        length = width / float(hinge_edge(n, sign) @ np.array([0.0, 0.0, 1.0])) * np.cos(beta)
+        points[i], axes[i] = o, -sign * edge
+        pins.append(
+            cylinder(
+                o, o + length * edge, 0.06 * width, color=PIN_COLOR, kind="pin", name=mech.joint_names[i]
+            )
+        )
+    bodies = {name: bodies[name] for name in mech.bodies}
+    return bodies, pins, points, axes
 
 
 def _rz(angle: float) -> Array:
