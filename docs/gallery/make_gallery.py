@@ -1,7 +1,7 @@
 """Reproduce the papers' figures: ``python docs/gallery/make_gallery.py`` (writes the PNGs next to this file).
 
 Gan & Pellegrino (2006): Figs. 9-13, 15, 16. Shamsudin et al. (2013): Figs. 3, 6, 7, 8, 10, 13 (via 8 and 10), 14 (seat example).
-Needs the ``viz`` extra (matplotlib, pillow). Takes about 15 s.
+Needs the ``viz`` extra (matplotlib, pillow). Takes about 20 s.
 """
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ matplotlib.use("Agg")
 import numpy as np
 
 from linkwork.kinematics.tracer import trace
-from linkwork.linkages import deployed_angle, hedgepeth
+from linkwork.linkages import hedgepeth_rods
+from linkwork.linkages.hedgepeth_rods import deployed_angles
 from linkwork.linkages.guest import guest_frame
 from linkwork.viz.snapshots import deployment_sequence
 from linkwork.viz.trace_plots import plot_angles, plot_singular_values
@@ -29,21 +30,27 @@ ROOT = HERE.parents[1]
 
 
 def eq13_theta_b(theta_a: np.ndarray) -> np.ndarray:
-    """Eq. (13): theta_B of the symmetric square (theta_A = theta_C, theta_B = theta_D), radians."""
-    c, s = np.cos(theta_a), np.sin(theta_a)
+    """Eq. (13) in the sense in which the hoop deploys: theta_B of the symmetric square, radians.
+
+    The printed matrices turn the hinges the other way (the square is flat at their theta_A = -120 deg), so the
+    deploying branch is ``-Eq13(-theta_A)``; Eq. (13) is an arctan (theta_B modulo 180 deg), unwrapped here to
+    the branch that starts at 0 in the bundle.
+    """
+    c, s = np.cos(-theta_a), np.sin(-theta_a)
     r3 = np.sqrt(3.0)
     num = 2 * r3 * c**2 - 3 * s * c + 3 * s - 4 * r3 * c + 2 * r3
     den = -(c**2) - 2 * r3 * s * c + 2 * r3 * s - c + 2
-    return np.mod(np.arctan2(num, den), 2 * np.pi)  # the branch starting at 0 in the bundle
+    return -np.unwrap(2.0 * np.arctan(num / den)) / 2.0
 
 
 def fig09(out: Path) -> Path:
     """theta_A against theta_B of the symmetric square: traced (couplings A = C, B = D) and Eq. (13)."""
     import matplotlib.pyplot as plt
 
-    path = trace(hedgepeth(4, couple=True), until=("A", deployed_angle(4)), steps=200)
+    deployed = deployed_angles(4)[0]
+    path = trace(hedgepeth_rods(4, couple=True), until=("A", deployed), steps=200)
     a, b = np.degrees(path.angles[:, 0]), np.degrees(path.angles[:, 1])
-    fine = np.linspace(0.0, deployed_angle(4), 400)
+    fine = np.linspace(1e-6, deployed, 400)
     fig, ax = plt.subplots(figsize=(5.0, 4.0), layout="constrained")
     ax.plot(np.degrees(fine), np.degrees(eq13_theta_b(fine)), "-", color="0.6", lw=4, label="Eq. (13)")
     ax.plot(a[::8], b[::8], "o", ms=3.5, color="C0", label="traced, 200 steps")
@@ -54,7 +61,7 @@ def fig09(out: Path) -> Path:
     ax.legend(fontsize=8)
     fig.savefig(out, dpi=100)
     plt.close(fig)
-    gap = np.max(np.abs(np.degrees(eq13_theta_b(path.angles[:, 0])) - b))
+    gap = np.max(np.abs(np.degrees(eq13_theta_b(path.angles[1:, 0])) - b[1:]))
     print(f"  Fig. 9: largest |theta_B - Eq. (13)| along the path = {gap:.2e} deg")
     return out
 
@@ -70,11 +77,12 @@ def main() -> None:
     started = time.perf_counter()
     written = [fig09(HERE / "fig09_square_symmetric.png")]
 
-    square = trace(hedgepeth(4), until=("A", deployed_angle(4)), steps=200)  # no symmetry assumed
+    # The hoops as built from their rods (docs/linkages.md: the printed Sec. 3 rods do not open flat for n >= 6).
+    square = trace(hedgepeth_rods(4), until=("A", deployed_angles(4)[0]), steps=200)  # no symmetry assumed
     written.append(line_plot(plot_angles, square, HERE / "fig10_square_angles.png"))
     written.append(deployment_sequence(square, HERE / "fig11_square_sequence.png", dpi=80))
 
-    hexagon = trace(hedgepeth(6), until=("A", deployed_angle(6)), steps=200)
+    hexagon = trace(hedgepeth_rods(6), until=("A", deployed_angles(6)[0]), steps=200)
     written.append(line_plot(plot_angles, hexagon, HERE / "fig12_hexagon_angles.png"))
     written.append(deployment_sequence(hexagon, HERE / "fig13_hexagon_sequence.png", dpi=80))
 

@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import itertools
+import re
+import subprocess
+import sys
 import time
 from pathlib import Path as FilePath
+from typing import Any
 
 import matplotlib
 import numpy as np
 import pytest
+from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError
 from linkwork.kinematics.tracer import Path, trace
@@ -78,15 +84,92 @@ def test_all_branches_are_animated_in_turn(guest: Path) -> None:
     assert len(idx) <= 30 + len(set(branches))  # at most one extra frame per branch from rounding
 
 
-def test_gif_is_written_and_mp4_skip_is_reported(
+def decoded_mp4(path: FilePath) -> tuple[tuple[int, int], list[NDArray[np.int64]]]:
+    """The frame size ``(width, height)`` and the RGB frames of a video, decoded by ffmpeg into a stream of
+    binary PPM images (``P6 width height 255`` then the pixels, one after another)."""
+    ffmpeg = animate.find_ffmpeg()
+    assert ffmpeg is not None
+    cmd = [ffmpeg, "-v", "error", "-i", str(path), "-f", "image2pipe", "-c:v", "ppm", "-"]
+    data = subprocess.run(cmd, capture_output=True, check=True).stdout
+    sizes, frames, at = set(), [], 0
+    header = re.compile(rb"P6\s+(\d+)\s+(\d+)\s+255\s")
+    while at < len(data):
+        m = header.match(data, at)
+        assert m is not None, f"not a PPM frame at byte {at}"
+        w, h = int(m[1]), int(m[2])
+        pixels = np.frombuffer(data, dtype=np.uint8, count=w * h * 3, offset=m.end())
+        frames.append(pixels.reshape(h, w, 3).astype(np.int64))
+        sizes.add((w, h))
+        at = m.end() + w * h * 3
+    assert len(sizes) == 1  # every frame the same size
+    return sizes.pop(), frames
+
+
+def test_mp4_decodes_to_the_frames_written(
     guest: Path, tmp_path: FilePath, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    written: list[NDArray[np.uint8]] = []
+    write_mp4 = animate.write_mp4
+
+    def keep(images: list[NDArray[np.uint8]], *args: Any) -> FilePath:
+        written.extend(images)
+        return write_mp4(images, *args)
+
+    monkeypatch.setattr(animate, "write_mp4", keep)
+    started = time.perf_counter()
+    # An odd size: the MP4 is cropped to even sides (yuv420p); with ffmpeg found, an .mp4 name writes no GIF.
+    result = animate_path(guest, tmp_path / "guest.mp4", branch=0, max_frames=6, size=161)
+    elapsed = time.perf_counter() - started
+    assert result.mp4 == tmp_path / "guest.mp4" and result.gif is None and result.mp4_skipped == ""
+    assert not (tmp_path / "guest.gif").exists()
+    assert result.frames == len(written) == 6  # exact count
+    assert written[0].shape == (161, 161, 3)  # exact: the rendered frames
+    size, frames = decoded_mp4(result.mp4)
+    assert size == (160, 160)  # exact: even sides
+    assert len(frames) == result.frames  # exact: every frame written is in the file, no more
+    for k, frame in enumerate(frames):
+        errors = [np.mean(np.abs(frame - img[:160, :160])) for img in written]
+        assert errors[k] < 2.5  # mean grey levels: H.264 + yuv420p of the frame written ...
+        assert int(np.argmin(errors)) == k  # ... and closer to it than to any other (frames in order)
+    for a, b in itertools.pairwise(frames):
+        assert np.mean(np.abs(a - b)) > 1.0  # the drawing moves between consecutive frames
+    assert result.mp4.stat().st_size < 200_000  # bytes
+    assert elapsed < 10.0  # seconds
+
+
+def test_ffmpeg_on_path_comes_first(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(animate.shutil, "which", lambda name: f"/opt/bin/{name}")
+    assert animate.find_ffmpeg() == "/opt/bin/ffmpeg"
+
+
+def test_imageio_ffmpeg_binary_is_the_fallback(monkeypatch: pytest.MonkeyPatch) -> None:
+    import imageio_ffmpeg
+
+    monkeypatch.setattr(animate.shutil, "which", lambda name: None)
+    monkeypatch.delenv("IMAGEIO_FFMPEG_EXE", raising=False)
+    exe = animate.find_ffmpeg()
+    assert exe is not None and exe == imageio_ffmpeg.get_ffmpeg_exe()
+    assert FilePath(exe).is_file()
+
+
+@pytest.mark.parametrize("missing", ["package", "binary"])
+def test_gif_is_written_and_mp4_skip_is_reported(
+    guest: Path, tmp_path: FilePath, monkeypatch: pytest.MonkeyPatch, missing: str
 ) -> None:
     from PIL import Image
 
     monkeypatch.setattr(animate.shutil, "which", lambda name: None)
-    result = animate_path(guest, tmp_path / "guest.gif", branch=0, max_frames=6, size=160)
-    assert result.mp4 is None and "ffmpeg" in result.mp4_skipped
-    assert result.gif is not None and result.gif.read_bytes()[:6] == b"GIF89a"  # exact header
+    if missing == "package":
+        monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)  # import fails
+    else:
+        # imageio-ffmpeg returns this variable's path untested: a file that is not there.
+        monkeypatch.setenv("IMAGEIO_FFMPEG_EXE", str(tmp_path / "no-ffmpeg"))
+    assert animate.find_ffmpeg() is None
+    result = animate_path(guest, tmp_path / "guest.mp4", branch=0, max_frames=6, size=160)
+    assert result.mp4 is None and not (tmp_path / "guest.mp4").exists()
+    assert "ffmpeg is not on PATH" in result.mp4_skipped and "imageio-ffmpeg" in result.mp4_skipped
+    assert result.gif == tmp_path / "guest.gif"  # something is always written
+    assert result.gif.read_bytes()[:6] == b"GIF89a"  # exact header
     with Image.open(result.gif) as im:
         assert im.n_frames == result.frames == 6  # exact count
         im.seek(0)
@@ -95,3 +178,19 @@ def test_gif_is_written_and_mp4_skip_is_reported(
         last = np.asarray(im.convert("RGB")).astype(int)
     assert np.mean(np.abs(first - last)) > 1.0  # the drawing changes (mean grey-level difference)
     assert result.gif.stat().st_size < 3_000_000  # bytes
+
+
+def test_failing_ffmpeg_leaves_no_mp4(
+    guest: Path, tmp_path: FilePath, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A stand-in ffmpeg that reads the frames, writes half a file to its output argument and fails.
+    fake = tmp_path / "ffmpeg"
+    fake.write_text(
+        '#!/bin/sh\nfor a in "$@"; do last="$a"; done\ncat > /dev/null\n'
+        'printf half > "$last"\necho "encoder exploded" >&2\nexit 1\n'
+    )
+    fake.chmod(0o755)
+    monkeypatch.setattr(animate, "find_ffmpeg", lambda: str(fake))
+    with pytest.raises(LinkworkError, match=r"ffmpeg failed writing guest\.mp4: encoder exploded"):
+        animate_path(guest, tmp_path / "out" / "guest.mp4", branch=0, max_frames=3, size=80)
+    assert list((tmp_path / "out").iterdir()) == []  # exact: no half-written .mp4 (and no GIF)

@@ -100,6 +100,68 @@ def test_poses_are_the_cores_body_poses(guest_path: lw.Path, guest_page: Path) -
             np.testing.assert_allclose(poses[i, b, 9:], ref[name][:3, 3], rtol=0, atol=F32)
 
 
+def _steadied(data: dict) -> np.ndarray:
+    """The body poses the page draws in its "steady" view: each point's whole-mechanism motion times the poses."""
+    S, poses = unpack(data["steady"]), unpack(data["poses"])
+    R, t = poses[:, :, :9].reshape(*poses.shape[:2], 3, 3), poses[:, :, 9:]
+    SR = S[:, :9].reshape(-1, 3, 3)
+    np.testing.assert_allclose(SR @ SR.transpose(0, 2, 1), np.broadcast_to(np.eye(3), SR.shape), atol=1e-5)
+    np.testing.assert_allclose(np.linalg.det(SR), 1.0, atol=1e-5)
+    return np.concatenate(
+        [(SR[:, None] @ R).reshape(*poses.shape[:2], 9), np.einsum("nij,nbj->nbi", SR, t) + S[:, None, 9:]],
+        axis=2,
+    )
+
+
+def test_steady_view_stands_the_bundle_up_and_lays_the_hexagon_level(tmp_path: Path) -> None:
+    from linkwork.linkages.hedgepeth_rods import deployed_angles, rod_frame
+
+    path = lw.trace(lw.load("hedgepeth-rods", n=6), until=("A", deployed_angles(6)[0]), steps=60)
+    data = page_data(write_trace_viewer(path, tmp_path / "viewer.html").read_text(encoding="utf-8"))
+    steadied = _steadied(data)
+    # The rods' apex points (start of each rod's frame) in the steady view, first and last point.
+    apexes = [
+        np.array(
+            [
+                P[:3, :3] @ rod_frame(6, i)[:3, 3] + P[:3, 3]
+                for i, P in enumerate(
+                    [np.vstack([np.c_[row[:9].reshape(3, 3), row[9:]], [0, 0, 0, 1]]) for row in steadied[k]]
+                )
+            ]
+        )
+        for k in (0, -1)
+    ]
+    flat = apexes[1]
+    assert np.ptp(flat[:, 2]) < 1e-5, "the deployed hexagon lies level"
+    bundle_axis = apexes[0][1] - apexes[0][0]  # consecutive apex points of the bundle: along its axis
+    assert abs(bundle_axis[2]) / np.linalg.norm(bundle_axis) > 0.999, "the bundle stands upright"
+    # No drifting: the centroid of all the rods' vertices stays at the origin.
+    from linkwork.viz.solids import body_meshes
+
+    meshes = body_meshes(path.mechanism)
+    for row in steadied:
+        cloud = [
+            m.vertices @ r[:9].reshape(3, 3).T + r[9:] for m, r in zip(meshes.values(), row, strict=True)
+        ]
+        assert np.linalg.norm(np.concatenate(cloud).mean(axis=0)) < 1e-5
+
+
+def test_steady_view_starts_each_branch_where_its_parent_is(guest_path: lw.Path, guest_page: Path) -> None:
+    data = page_data(guest_page.read_text(encoding="utf-8"))
+    steadied = _steadied(data)
+    angles = np.radians(unpack(data["angles"]))
+    by_id = {b["id"]: b for b in data["branches"]}
+    for b in data["branches"]:
+        if b["parent"] is None:
+            continue
+        parent = by_id[b["parent"]]
+        rows = np.arange(parent["start"], parent["start"] + parent["count"])
+        d = np.angle(np.exp(1j * (angles[rows] - angles[b["start"]])))
+        k = rows[np.argmin(np.linalg.norm(d, axis=1))]
+        gap = np.abs(steadied[b["start"]] - steadied[k]).max()
+        assert gap < 0.05, f"branch {b['id']} jumps by {gap:.3f} when it leaves its parent"
+
+
 def test_long_paths_are_thinned_keeping_ends_and_bifurcation_points(
     guest_path: lw.Path, tmp_path: Path
 ) -> None:

@@ -295,10 +295,10 @@ def state(browser: Browser) -> dict[str, Any]:
 
 
 def test_hexagon_viewer_slider_moves_the_drawing(browser: Browser, tmp_path: Path) -> None:
-    from linkwork.linkages import deployed_angle
+    from linkwork.linkages.hedgepeth_rods import deployed_angles
 
-    mech = lw.load("hedgepeth", n=6)
-    path = lw.trace(mech, until=("A", deployed_angle(6)), steps=60)
+    mech = lw.load("hedgepeth-rods", n=6)  # the hoop that opens from the bundle into the flat hexagon
+    path = lw.trace(mech, until=("A", deployed_angles(6)[0]), steps=60)
     page = write_trace_viewer(path, tmp_path / "viewer.html")
     mark = len(browser.events)
     browser.open(page)
@@ -321,7 +321,7 @@ def test_hexagon_viewer_slider_moves_the_drawing(browser: Browser, tmp_path: Pat
     assert canvas(browser)[0] not in (h0, h1)
     assert canvas(browser, "plot-angles")[0] != plot0, "the plot cursor did not follow the slider"
     shown = browser.js("document.getElementById('stage-caption').textContent")
-    assert f"A = {np.degrees(deployed_angle(6)):.2f}°" in shown
+    assert f"A = {np.degrees(deployed_angles(6)[0]):.2f}°" in shown
     browser.screenshot(tmp_path / "hexagon-deployed.png")
     # Orbit with the mouse.
     box = browser.js(
@@ -407,6 +407,55 @@ def test_synthesis_viewer_slider_across_profiles(browser: Browser, tmp_path: Pat
     assert browser.js("window.linkworkViewer.state().profile") == 1
     assert canvas(browser)[0] != h0, "the drawing did not change with the profile"
     browser.screenshot(tmp_path / "synthesis-wing.png")
+    browser.events[:mark] = []
+    assert browser.errors() == []
+    assert_offline(browser)
+
+
+def test_demo_index_shows_every_result_and_its_hexagon_opens_flat(browser: Browser, tmp_path: Path) -> None:
+    """The newcomer's path: ``linkwork demo``, open index.html, open the hexagon's viewer, drag it to the end."""
+    import csv
+    import re
+
+    from typer.testing import CliRunner
+
+    from linkwork.cli import app
+    from linkwork.linkages.hedgepeth_rods import deployed_angles
+
+    out = tmp_path / "demo"
+    result = CliRunner().invoke(app, ["demo", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    index = out / "index.html"
+    links = re.findall(r"(?:href|src)='([^']+)'", index.read_text(encoding="utf-8"))
+    assert len(links) > 30
+    missing = [link for link in links if not (out / link).is_file()]
+    assert missing == [], f"index.html links files that are not there: {missing}"
+    for section in ("hexagon", "guest-frame", "synthesis-wing", "mechanism-wing"):
+        assert any(link.startswith(f"{section}/") for link in links), section
+    # The hexagon ends on the flat hexagon (the rods' closed form).
+    with (out / "hexagon" / "path.csv").open(encoding="utf-8") as f:
+        last = list(csv.DictReader(f))[-1]
+    inner, outer = np.degrees(deployed_angles(6))
+    assert float(last["A"]) == pytest.approx(inner, abs=1e-9)
+    assert float(last["B"]) == pytest.approx(outer, abs=1e-9)
+    # In the browser: every picture loads, nothing errs, nothing leaves the machine.
+    mark = len(browser.events)
+    browser.open(index)
+    browser.js(
+        "Promise.all([...document.images].map(i => i.complete ? 0 : new Promise(r => { i.onload = i.onerror = r; })))"
+    )
+    broken = browser.js("[...document.images].filter(i => !(i.naturalWidth > 0)).map(i => i.src)")
+    assert broken == []
+    assert browser.js("document.images.length") >= 10
+    browser.screenshot(tmp_path / "demo-index.png")
+    viewers = browser.js("[...document.querySelectorAll('a.viewer')].map(a => a.href)")
+    assert len(viewers) == 3
+    browser.open(out / "hexagon" / "viewer.html")
+    browser.js("document.getElementById('slider').focus()")
+    browser.key("End", 35)
+    shown = browser.js("document.getElementById('stage-caption').textContent")
+    assert f"A = {inner:.2f}°" in shown
+    browser.screenshot(tmp_path / "demo-hexagon-deployed.png")
     browser.events[:mark] = []
     assert browser.errors() == []
     assert_offline(browser)

@@ -16,32 +16,34 @@ def demo(
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("linkwork-demo"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
 ) -> None:
-    """Deploy Hedgepeth's hexagon (Fig. 12), follow Guest's frame through its bifurcations (Figs. 15-16), and
-    synthesise a morphing wing; write everything with an index.html into --out."""
+    """Deploy Hedgepeth's hexagon from the bundle to the flat hexagon (Figs. 12-13), follow Guest's frame
+    through its bifurcations (Figs. 15-16), synthesise and mechanize a morphing wing; write everything with an
+    index.html into --out."""
     import numpy as np
 
     import linkwork as lw
     from linkwork.cli.trace import summary, write_trace_outputs
-    from linkwork.linkages import deployed_angle
+    from linkwork.linkages.hedgepeth_rods import deployed_angles
     from linkwork.viz.viewer import write_synthesis_viewer
 
     sections: list[tuple[str, str, Path, list[str]]] = []
 
-    console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Fig. 12)")
-    hexagon = lw.load("hedgepeth", n=6)
-    path = lw.trace(hexagon, until=("A", deployed_angle(6)), steps=200)
+    console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)")
+    hexagon = lw.load("hedgepeth-rods", n=6)
+    inner, outer = deployed_angles(6)
+    path = lw.trace(hexagon, until=("A", inner), steps=200)
     figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots, html=True, animate=not no_plots)
     summary(path)
     a = np.degrees(path.angles[-1])
     sections.append(
         (
-            "Hedgepeth's hexagon (Sec. 5, Fig. 12): from the bundle to Eq. (10)'s deployed angle",
-            f"200 equal steps of θA from the folded bundle to Eq. (10)'s deployed angle "
-            f"{np.degrees(deployed_angle(6)):.4f}°; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
-            f"B = D = F = {a[1]:.4f}° at the end (max |A - C| along the path "
-            f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°). The rods follow the "
-            "paper's printed Sec. 3 geometry, which for n >= 6 does not open into a flat hexagon: an open "
-            "question documented in docs/linkages.md.",
+            "Hedgepeth's hexagon (Sec. 5, Figs. 12-13): from the bundle to the flat hexagon",
+            f"The hoop built from its six mitred triangular rods, in 200 equal steps of θA from the folded "
+            f"bundle to the flat hexagon; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
+            f"B = D = F = {a[1]:.4f}° at the end (closed form {np.degrees(inner):.4f}° and "
+            f"{np.degrees(outer):.4f}°; max |A - C| along the path "
+            f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°). Eq. (10)'s 87.0067° "
+            "cannot be a flat hexagon: see docs/linkages.md.",
             out / "hexagon",
             [f.name for f in figs],
         )
@@ -115,7 +117,7 @@ def demo(
 
 #: What each section's interactive viewer lets a reader do.
 VIEWER_HINTS = {
-    "hexagon": "drag the slider from the folded bundle to Eq. (10)'s deployed angle",
+    "hexagon": "drag the slider from the folded bundle to the flat hexagon",
     "guest-frame": "follow branch 0 to a bifurcation point, then take another branch from the panel",
     "synthesis-wing": "slide across the three wing profiles",
 }
@@ -126,7 +128,7 @@ def _write_index(out: Path, sections: list[tuple[str, str, Path, list[str]]]) ->
     parts = [
         "<!doctype html><html><head><meta charset='utf-8'><title>linkwork demo</title>",
         "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em}"
-        "img{max-width:100%;border:1px solid #ddd;margin:.5em 0}"
+        "img,video{max-width:100%;border:1px solid #ddd;margin:.5em 0}"
         ".viewer{display:inline-block;background:#1f5f9e;color:#fff;padding:.4em .9em;border-radius:4px;"
         "text-decoration:none;font-weight:600}</style></head><body>",
         "<h1>linkwork demo</h1>",
@@ -145,8 +147,12 @@ def _write_index(out: Path, sections: list[tuple[str, str, Path, list[str]]]) ->
         parts.append(", ".join(f"<a href='{rel}/{html.escape(f)}'>{html.escape(f)}</a>" for f in files))
         parts.append("</p>")
         for fig in figures:
-            if fig.endswith(".html"):
-                continue
-            parts.append(f"<img src='{rel}/{html.escape(fig)}' alt='{html.escape(fig)}'>")
+            if fig.endswith(".html") or (fig.endswith(".mp4") and fig[:-4] + ".gif" in figures):
+                continue  # the viewer has its own button; an MP4 next to its GIF is linked under "files"
+            src = f"{rel}/{html.escape(fig)}"
+            if fig.endswith(".mp4"):
+                parts.append(f"<video src='{src}' controls loop muted></video>")
+            else:
+                parts.append(f"<img src='{src}' alt='{html.escape(fig)}'>")
     parts.append("</body></html>")
     (out / "index.html").write_text("\n".join(parts))

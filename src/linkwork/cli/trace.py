@@ -77,7 +77,11 @@ def trace(
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
     animate: Annotated[
-        bool, typer.Option("--animate", help="Also write motion.gif, an animation of every branch.")
+        bool,
+        typer.Option(
+            "--animate",
+            help="Also write motion.gif and motion.mp4 (with ffmpeg), an animation of every branch.",
+        ),
     ] = False,
     html: Annotated[
         bool,
@@ -159,8 +163,8 @@ def write_trace_outputs(
 ) -> list[Path]:
     """Write path.csv, report.json, (if matplotlib is there) the figures and the deployment sequence of the
     first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
-    (``motion.gif``), and with ``html`` the interactive viewer ``viewer.html`` into ``out``, all or nothing.
-    Returns the figures, animation and viewer written."""
+    (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
+    ``viewer.html`` into ``out``, all or nothing. Returns the figures, animation and viewer written."""
     from linkwork.io.results import write_path_csv, write_report_json
 
     figures: list[Path] = []

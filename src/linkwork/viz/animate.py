@@ -1,12 +1,14 @@
 """Animations of a traced motion: the shaded solids of :mod:`linkwork.viz.snapshots`, frame by frame, as GIF/MP4.
 
-GIF frames are written with pillow; an MP4 is also written when an ``ffmpeg`` executable is on ``PATH`` (and
-skipped, with the reason recorded in the result, when it is not). matplotlib and pillow are imported inside the
-functions.
+GIF frames are written with pillow; an MP4 is also written when an ffmpeg executable is found
+(:func:`find_ffmpeg`: ``ffmpeg`` on ``PATH``, else the static binary of the ``imageio-ffmpeg`` package of the
+``viz`` extra) and skipped, with the reason recorded in the result, when none is. matplotlib, pillow and
+imageio-ffmpeg are imported inside the functions.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from collections.abc import Sequence
@@ -131,17 +133,36 @@ def animate_configurations(
     angles = np.atleast_2d(np.asarray(angles, dtype=float))
     moves_arr = steady_transforms(mech, angles) if moves is None else np.asarray(moves, dtype=float)
     images = render_frames(mech, angles, moves_arr, labels=labels, view=view, size=size)
-    ffmpeg = shutil.which("ffmpeg")
+    ffmpeg = find_ffmpeg()
     gif = mp4 = None
     skipped = ""
     out.parent.mkdir(parents=True, exist_ok=True)
     if suffix == ".gif" or ffmpeg is None:
         gif = write_gif(images, out.with_suffix(".gif"), fps)
     if ffmpeg is None:
-        skipped = "ffmpeg is not on PATH: MP4 skipped"
+        skipped = (
+            "ffmpeg is not on PATH and no imageio-ffmpeg binary was found (pip install imageio-ffmpeg): "
+            "MP4 skipped"
+        )
     else:
         mp4 = write_mp4(images, out.with_suffix(".mp4"), fps, ffmpeg)
     return Animation(gif=gif, mp4=mp4, frames=len(images), mp4_skipped=skipped)
+
+
+def find_ffmpeg() -> str | None:
+    """The ffmpeg executable to write MP4s with: ``ffmpeg`` on ``PATH`` first, else the static binary shipped
+    in the ``imageio-ffmpeg`` wheel (``imageio_ffmpeg.get_ffmpeg_exe()``, which honours ``IMAGEIO_FFMPEG_EXE``)
+    if that package imports and the file exists, else None."""
+    on_path = shutil.which("ffmpeg")
+    if on_path is not None:
+        return on_path
+    try:
+        import imageio_ffmpeg
+
+        exe = imageio_ffmpeg.get_ffmpeg_exe()
+    except (ImportError, RuntimeError):  # not installed, or no binary for this platform
+        return None
+    return exe if exe and os.path.isfile(exe) and os.access(exe, os.X_OK) else None
 
 
 def render_frames(

@@ -121,28 +121,47 @@ def steady_transforms(mech: Mechanism, angles: ArrayLike) -> Array:
     flattest (most spread-out) configuration points up (+z). Consecutive rows should be close: pass the whole
     branch and pick frames afterwards.
     """
+    clouds = mesh_clouds(mech, angles)
+    moves = follow(clouds)
+    return np.einsum("ij,njk->nik", leveling(clouds, moves), moves)
+
+
+def mesh_clouds(mech: Mechanism, angles: ArrayLike) -> Array:
+    """``(N, V, 3)`` every body mesh's vertices at each configuration (the cloud the steadying fits)."""
     angles = np.atleast_2d(np.asarray(angles, dtype=float))
     bodies = body_meshes(mech)
-    clouds = np.array([np.concatenate([m.vertices for m in place(mech, bodies, [], row)]) for row in angles])
-    out = np.zeros((len(angles), 4, 4))
-    prev = None
+    return np.array([np.concatenate([m.vertices for m in place(mech, bodies, [], row)]) for row in angles])
+
+
+def follow(clouds: Array, reference: Array | None = None) -> Array:
+    """``(N, 4, 4)``: each cloud fitted onto the previous one as moved; the first one onto ``reference`` (a cloud
+    already placed, e.g. the same configuration on a parent branch) or, without one, centred at the origin."""
+    out = np.zeros((len(clouds), 4, 4))
+    prev = reference
     for k, cloud in enumerate(clouds):
-        centre = np.eye(4)
-        centre[:3, 3] = -cloud.mean(axis=0)
-        T = centre if prev is None else _fit(cloud, prev)
+        if prev is None:
+            T = np.eye(4)
+            T[:3, 3] = -cloud.mean(axis=0)
+        else:
+            T = _fit(cloud, prev)
         out[k] = T
         prev = cloud @ T[:3, :3].T + T[:3, 3]
-    # Level the most spread-out configuration: its least principal direction becomes +z.
+    return out
+
+
+def leveling(clouds: Array, moves: Array) -> Array:
+    """A 4x4 rotation turning the most spread-out of the moved clouds so that its least principal direction is
+    +z (a deployed hoop lies level)."""
     spreads = [np.linalg.svd(c - c.mean(axis=0), compute_uv=False) for c in clouds]
     k = int(np.argmax([s[0] * s[1] for s in spreads]))
-    moved = clouds[k] @ out[k][:3, :3].T + out[k][:3, 3]
+    moved = clouds[k] @ moves[k][:3, :3].T + moves[k][:3, 3]
     _, _, Vt = np.linalg.svd(moved - moved.mean(axis=0))
     R = Vt.copy()
     if np.linalg.det(R) < 0:
         R[0] *= -1.0
     level = np.eye(4)
     level[:3, :3] = R  # rows: principal directions -> x, y, z
-    return np.einsum("ij,njk->nik", level, out)
+    return level
 
 
 def _fit(src: Array, dst: Array) -> Array:

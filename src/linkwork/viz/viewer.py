@@ -196,6 +196,47 @@ def _bounds(parts: list[Part], poses: NDArray[np.float64], shift: NDArray[np.flo
 # ----------------------------------------------------------------------------------------------- trace viewer
 
 
+def _steady_rows(path: Path, per_branch: list[NDArray[np.int64]]) -> NDArray[np.float64]:
+    """``(N, 12)`` per point sent to the page, the rigid motion of the whole mechanism that keeps the drawing
+    steady (rotation rows, then translation): each branch fitted point by point
+    (:func:`linkwork.viz.snapshots.follow`), a branch leaving a bifurcation point starting from the pose its
+    parent has there, and everything levelled by the flattest configuration of the first branch."""
+    from linkwork.viz.snapshots import follow, leveling, mesh_clouds
+
+    mech = path.mechanism
+    revolute = np.array([t == "R" for t in mech.joint_types])
+    index = {br.id: bi for bi, br in enumerate(path.branches)}
+    done: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}  # branch index -> (clouds, moves)
+    for bi, idx in enumerate(per_branch):
+        clouds = mesh_clouds(mech, path.angles[idx])
+        reference = None
+        parent = path.branches[bi].parent
+        if parent is not None and index.get(parent) in done and len(idx):
+            pbi = index[parent]
+            p_angles = path.angles[per_branch[pbi]]
+            d = p_angles - path.angles[idx[0]]
+            d[:, revolute] = (d[:, revolute] + np.pi) % (2 * np.pi) - np.pi
+            k = int(np.argmin(np.linalg.norm(d, axis=1)))
+            p_clouds, p_moves = done[pbi]
+            reference = p_clouds[k] @ p_moves[k][:3, :3].T + p_moves[k][:3, 3]
+        done[bi] = (clouds, follow(clouds, reference))
+    if not done:
+        return np.zeros((0, 12))
+    level = leveling(*done[0])
+    moves = np.concatenate([np.einsum("ij,njk->nik", level, done[bi][1]) for bi in range(len(per_branch))])
+    return np.concatenate([moves[:, :3, :3].reshape(-1, 9), moves[:, :3, 3]], axis=1)
+
+
+def _compose(steady: NDArray[np.float64], poses: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Body pose rows ``(N, b, 12)`` moved by the whole-mechanism motions ``steady`` ``(N, 12)``."""
+    S, s = steady[:, :9].reshape(-1, 1, 3, 3), steady[:, None, 9:]
+    R, t = poses[:, :, :9].reshape(*poses.shape[:2], 3, 3), poses[:, :, 9:]
+    out = np.empty_like(poses)
+    out[:, :, :9] = (S @ R).reshape(*poses.shape[:2], 9)
+    out[:, :, 9:] = np.einsum("nij,nbj->nbi", S[:, 0], t) + s
+    return out
+
+
 def _kept_points(path: Path, max_points: int, must: set[int]) -> list[NDArray[np.int64]]:
     """Per branch, the indices of its points sent to the page, in path order: all of them, or thinned evenly
     when the path has more than ``max_points`` (ends and the points in ``must`` kept)."""
@@ -288,6 +329,8 @@ def trace_viewer_data(
     poses = _pose_rows(mech, angles)
     labels = joint_labels(mech, parts)
     centres = _centres(parts, poses)
+    steady = _steady_rows(path, per_branch)
+    steadied = _compose(steady, poses)
     display = _display(mech, angles)
     drive = mech.index(path.drive) if path.drive in mech.joint_names else 0
     return {
@@ -320,10 +363,11 @@ def trace_viewer_data(
         ],
         "bounds": {
             "fixed": _bounds(parts, poses, np.zeros_like(centres)),
-            "centred": _bounds(parts, poses, centres),
+            "centred": _bounds(parts, steadied, np.zeros_like(centres)),
         },
         "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
         "centres": _packed(centres, "f4"),
+        "steady": _packed(steady, "f4"),
         "points": len(keep),
         "points_traced": len(path.branch),
         "poses": _packed(poses, "f4"),

@@ -10,7 +10,8 @@
   const rank = LW.decode(data.rank);
   const step = LW.decode(data.step);
   const arclength = LW.decode(data.arclength);
-  const centres = LW.decode(data.centres);
+  const steady = LW.decode(data.steady);
+  const steadied = new Float32Array(nb * 12);
   const k = data.sigma.shape[1];
   const $ = (id) => document.getElementById(id);
   const unit = (j) => (data.joints[j].type === "R" ? "°" : "");
@@ -134,8 +135,20 @@
 
   function renderScene() {
     const r = data.branches[state.branch].start + state.point;
-    const shift = $("centred").checked ? centres.subarray(3 * r, 3 * r + 3) : null;
-    scene.render(poses.subarray(r * nb * 12, (r + 1) * nb * 12), shift);
+    const P = poses.subarray(r * nb * 12, (r + 1) * nb * 12);
+    if (!$("centred").checked) { scene.render(P, null); state.renders++; return; }
+    // Steady: the whole mechanism moved by this point's rigid motion S (rotation rows, translation).
+    const S = steady.subarray(12 * r, 12 * r + 12);
+    for (let b = 0; b < nb; b++) {
+      const o = 12 * b;
+      for (let i = 0; i < 3; i++) {
+        for (let j = 0; j < 3; j++) {
+          steadied[o + 3 * i + j] = S[3 * i] * P[o + j] + S[3 * i + 1] * P[o + 3 + j] + S[3 * i + 2] * P[o + 6 + j];
+        }
+        steadied[o + 9 + i] = S[3 * i] * P[o + 9] + S[3 * i + 1] * P[o + 10] + S[3 * i + 2] * P[o + 11] + S[9 + i];
+      }
+    }
+    scene.render(steadied, null);
     state.renders++;
   }
 
@@ -199,7 +212,7 @@
   $("view-top").addEventListener("click", () => scene.resetView("top"));
   $("view-front").addEventListener("click", () => scene.resetView("front"));
   $("centred").addEventListener("change", (ev) => scene.setMode(ev.target.checked ? "centred" : "fixed"));
-  $("centred").parentElement.title = `Follow the centre of the linkage; untick to hold ${data.fixed_body} still`;
+  $("centred").parentElement.title = `Hold the linkage steady as a whole (each point fitted onto the previous one, the flattest shape level); untick to hold ${data.fixed_body} still`;
   $("show-labels").addEventListener("change", (ev) => { scene.showLabels = ev.target.checked; renderScene(); });
 
   let last = 0, carry = 0;
