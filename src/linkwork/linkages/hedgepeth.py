@@ -1,4 +1,7 @@
-"""Hedgepeth's n-sided deployable hoops: n rods of two mirror types that fold into a bundle (Sec. 3).
+"""Hedgepeth's n-sided deployable hoops as Sec. 3 prints them: n rods of two mirror types, folded in a bundle.
+
+For n >= 6 these printed equations do not describe a hoop that opens flat (docs/linkages.md); the hoop built from
+its rods is :mod:`linkwork.linkages.hedgepeth_rods`.
 
 The rods are the paper's isosceles-triangle rods (Eqs. (7)-(9)), each described by the transform
 ``[Rz(phi) Rx(omega) Rz(psi), v]`` with ``v = [cos a3, 0, sin a3]`` (unit rod length along the apex line), and the
@@ -82,7 +85,8 @@ register(
     LinkageEntry(
         name="hedgepeth",
         build=lambda n: hedgepeth(int(n)),
-        summary="Hedgepeth's n-sided deployable hoop, folded bundle (Gan & Pellegrino 2006, Sec. 3)",
+        summary="Hedgepeth's hoop from Sec. 3's equations as printed (Gan & Pellegrino 2006); for n >= 6 it does "
+        "not open flat: see hedgepeth-rods",
         params={"n": Param(6, "int", "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry")},
     )
 )
