@@ -432,6 +432,18 @@ def test_demo_index_shows_every_result_and_its_hexagon_opens_flat(browser: Brows
     assert missing == [], f"index.html links files that are not there: {missing}"
     for section in ("hexagon", "guest-frame", "synthesis-wing", "mechanism-wing"):
         assert any(link.startswith(f"{section}/") for link in links), section
+    # The animations: the traced hexagon and the mechanized wing moving through its profiles, also as MP4s.
+    from linkwork.viz.animate import find_ffmpeg
+
+    ffmpeg = find_ffmpeg()
+    if ffmpeg is not None:
+        for movie, frames in (("hexagon/motion.mp4", None), ("mechanism-wing/mechanism.mp4", 2 * 20 - 2)):
+            run = subprocess.run(
+                [ffmpeg, "-i", str(out / movie), "-map", "0:v:0", "-f", "null", "-"],
+                capture_output=True, text=True, check=True,
+            )  # fmt: skip
+            counted = int(re.findall(r"frame=\s*(\d+)", run.stderr)[-1])
+            assert counted > 10 if frames is None else counted == frames, (movie, counted)
     # The hexagon ends on the flat hexagon (the rods' closed form).
     with (out / "hexagon" / "path.csv").open(encoding="utf-8") as f:
         last = list(csv.DictReader(f))[-1]

@@ -139,8 +139,12 @@ def animation_frames(found: Mechanization, frames: int = 20) -> Array:
     return path[idx]
 
 
-def write_animation(found: Mechanization, path: str | Path, *, frames: int = 20) -> Path:
-    """A GIF of the mechanism moving from profile 1 through every profile (there and back)."""
+def write_animation(
+    found: Mechanization, path: str | Path, *, frames: int = 20, mp4: bool = True
+) -> list[Path]:
+    """A GIF of the mechanism moving from profile 1 through every profile (there and back), and with ``mp4`` the
+    same frames as an MP4 next to it when an ffmpeg is found (:func:`linkwork.viz.animate.find_ffmpeg`).
+    Returns the files written."""
     from io import BytesIO
 
     from matplotlib.figure import Figure
@@ -154,6 +158,7 @@ def write_animation(found: Mechanization, path: str | Path, *, frames: int = 20)
     drive = mech.index(design.drive)
     marks = [s.drive_value for s in found.verification.states]
     images = []
+    rgb = []
     for q in values:
         fig = Figure(figsize=(4.2, max(1.6, 4.2 * height / width)), layout="constrained")
         ax = fig.subplots()
@@ -170,15 +175,26 @@ def write_animation(found: Mechanization, path: str | Path, *, frames: int = 20)
         buffer = BytesIO()
         fig.savefig(buffer, format="png", dpi=48)
         buffer.seek(0)
-        images.append(Image.open(buffer).convert("P", palette=Image.Palette.ADAPTIVE, colors=16))
+        frame = Image.open(buffer).convert("RGB")
+        rgb.append(np.asarray(frame, dtype=np.uint8))
+        images.append(frame.convert("P", palette=Image.Palette.ADAPTIVE, colors=16))
     images += images[-2:0:-1]
+    rgb += rgb[-2:0:-1]
     out = Path(path)
     images[0].save(out, save_all=True, append_images=images[1:], duration=120, loop=0, optimize=True)
-    return out
+    written = [out]
+    if mp4:
+        from linkwork.viz.animate import find_ffmpeg, write_mp4
+
+        ffmpeg = find_ffmpeg()
+        if ffmpeg is not None:
+            written.append(write_mp4(rgb, out.with_suffix(".mp4"), 8, ffmpeg))
+    return written
 
 
 def write_mechanism_figures(found: Mechanization, out_dir: str | Path) -> list[Path]:
-    """Write ``mechanism.png`` (and ``.svg``), the mechanism on every profile, and ``mechanism.gif``."""
+    """Write ``mechanism.png`` (and ``.svg``), the mechanism on every profile, ``mechanism.gif`` and, when an
+    ffmpeg is found, ``mechanism.mp4``."""
     import matplotlib
 
     out = Path(out_dir)
@@ -188,5 +204,5 @@ def write_mechanism_figures(found: Mechanization, out_dir: str | Path) -> list[P
     with matplotlib.rc_context({"svg.hashsalt": "linkwork", "svg.fonttype": "none"}):
         fig.savefig(paths[0], dpi=DPI, metadata={"Software": None})
         fig.savefig(paths[1], metadata={"Date": None, "Creator": None})
-    paths.append(write_animation(found, out / "mechanism.gif"))
+    paths += write_animation(found, out / "mechanism.gif")
     return paths
