@@ -213,9 +213,7 @@ def _steady_rows(path: Path, per_branch: list[NDArray[np.int64]]) -> NDArray[np.
         parent = path.branches[bi].parent
         if parent is not None and index.get(parent) in done and len(idx):
             pbi = index[parent]
-            p_angles = path.angles[per_branch[pbi]]
-            d = p_angles - path.angles[idx[0]]
-            d[:, revolute] = (d[:, revolute] + np.pi) % (2 * np.pi) - np.pi
+            d = _difference(path.angles[per_branch[pbi]], path.angles[idx[0]], revolute)
             k = int(np.argmin(np.linalg.norm(d, axis=1)))
             p_clouds, p_moves = done[pbi]
             reference = p_clouds[k] @ p_moves[k][:3, :3].T + p_moves[k][:3, 3]
@@ -252,11 +250,18 @@ def _kept_points(path: Path, max_points: int, must: set[int]) -> list[NDArray[np
     return out
 
 
-def _same(a: NDArray[np.float64], b: NDArray[np.float64], revolute: NDArray[np.bool_]) -> NDArray[np.bool_]:
-    """Rows of ``a`` that are configuration ``b`` (revolute joints compared modulo a full turn)."""
+def _difference(
+    a: NDArray[np.float64], b: NDArray[np.float64], revolute: NDArray[np.bool_]
+) -> NDArray[np.float64]:
+    """Rows of ``a`` minus configuration ``b``, revolute joints wrapped into [-pi, pi)."""
     d = a - b
     d[:, revolute] = (d[:, revolute] + np.pi) % (2 * np.pi) - np.pi
-    return np.all(np.abs(d) < SAME_POINT, axis=1)
+    return d
+
+
+def _same(a: NDArray[np.float64], b: NDArray[np.float64], revolute: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Rows of ``a`` that are configuration ``b`` (revolute joints compared modulo a full turn)."""
+    return np.all(np.abs(_difference(a, b, revolute)) < SAME_POINT, axis=1)
 
 
 def _visits(path: Path, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArray[np.int64]:
