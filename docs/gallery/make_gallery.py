@@ -20,8 +20,8 @@ import numpy as np
 
 from linkwork.kinematics.tracer import trace
 from linkwork.linkages import hedgepeth_rods
-from linkwork.linkages.hedgepeth_rods import deployed_angles
 from linkwork.linkages.guest import guest_frame
+from linkwork.linkages.hedgepeth_rods import deployed_angles
 from linkwork.viz.snapshots import deployment_sequence
 from linkwork.viz.trace_plots import plot_angles, plot_singular_values
 
@@ -108,7 +108,7 @@ def main() -> None:
             if file.suffix == ".png" and file.stem in names:
                 written.append(Path(shutil.copy(file, HERE / names[file.stem])))
     # Fig. 14: the seat chain mechanized to one degree of freedom (examples/seat/mechanize.toml).
-    from linkwork.cli.mechanize import mechanize_into
+    from linkwork.outputs.mechanization import mechanize_into
 
     seat = synthesize(load_problem(ROOT / "examples" / "seat" / "mechanize.toml"))
     with tempfile.TemporaryDirectory() as tmp:

@@ -1,4 +1,9 @@
-"""The one exception hierarchy of linkwork: every failure a user can cause or meet is one of these."""
+"""The one exception hierarchy of linkwork: every failure a user can cause or meet is one of these.
+
+The command line maps them to exit codes: :class:`RequestNotMetError` (and its subclasses) to 3, "the request
+could not be met" (a target not reached, no design or mechanism passes); every other :class:`LinkworkError` to 2,
+bad input. Exit 0 means done as asked.
+"""
 
 from __future__ import annotations
 
@@ -27,3 +32,14 @@ class AssemblyError(LinkworkError):
 
 class ConvergenceError(LinkworkError):
     """A corrector or optimiser that failed: says where and why."""
+
+
+class RequestNotMetError(LinkworkError):
+    """Valid input, but what was asked cannot be met (a target the path never reaches, no design that passes).
+
+    The command line prints its message on one line and exits with code 3, after writing what was computed.
+    """
+
+
+class MechanizationError(RequestNotMetError):
+    """No mechanism design passes: says which body or which check stopped every candidate (exit code 3)."""

@@ -15,10 +15,12 @@ import pytest
 import svgelements
 from typer.testing import CliRunner, Result
 
+from linkwork import data
 from linkwork.cli import app
 from linkwork.cli import synth as synth_module
 from linkwork.errors import SpecError
 from linkwork.io.profiles import save_profile
+from linkwork.outputs import synthesis as synthesis_outputs
 
 ROOT = Path(__file__).resolve().parents[2]
 runner = CliRunner()
@@ -240,7 +242,7 @@ def test_help_names_every_option() -> None:
 
 
 def test_run_synthesis_example_writes_inputs_and_outputs(tmp_path: Path) -> None:
-    result = synth_module.run_synthesis_example(tmp_path / "demo", "fixed-end", plots=False)
+    result = synthesis_outputs.run_synthesis_example(tmp_path / "demo", "fixed-end", plots=False)
     assert result.problem.kind == "fixed-end"
     assert (tmp_path / "demo" / "problem" / "problem.toml").is_file()
     assert (tmp_path / "demo" / "chain.json").is_file()
@@ -256,8 +258,8 @@ def test_run_synthesis_example_writes_inputs_and_outputs(tmp_path: Path) -> None
 
 
 def test_bundled_examples_match_the_committed_ones() -> None:
-    for name in synth_module.EXAMPLES:
-        bundled = synth_module.example_problem(name)
+    for name in data.EXAMPLES:
+        bundled = data.example(name)
         assert bundled.read_text(encoding="utf-8") == (ROOT / "examples" / name / "problem.toml").read_text(
             encoding="utf-8"
         )
@@ -267,11 +269,11 @@ def test_unknown_example_is_a_spec_error(tmp_path: Path) -> None:
     with pytest.raises(
         SpecError, match=r'unknown example "moon"; expected one of wing, closed, fixed-end, seat'
     ):
-        synth_module.run_synthesis_example(tmp_path, "moon")
+        synthesis_outputs.run_synthesis_example(tmp_path, "moon")
 
 
 def test_example_folder_copy_is_independent_of_the_package(tmp_path: Path) -> None:
-    source = synth_module.example_problem("closed").parent
+    source = data.example("closed").parent
     shutil.copytree(source, tmp_path / "closed")
     result = invoke(str(tmp_path / "closed" / "problem.toml"), "--out", str(tmp_path / "out"), "--no-plots")
     assert result.exit_code == 0

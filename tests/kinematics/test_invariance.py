@@ -32,7 +32,8 @@ from linkwork.kinematics import closure, kernels
 from linkwork.kinematics.chains import from_dh
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
-from linkwork.kinematics.tracer import Path, trace
+from linkwork.kinematics.trace_result import Trace
+from linkwork.kinematics.tracer import trace
 from linkwork.linkages import deployed_angle, hedgepeth
 
 #: Seeded, no deadline (the first call may load numba's cache), few examples: the file runs in seconds.
@@ -95,20 +96,20 @@ def reversed_loop(mech: Mechanism) -> Mechanism:
     )
 
 
-def paper_trace(mech: Mechanism, target: float) -> Path:
+def paper_trace(mech: Mechanism, target: float) -> Trace:
     """``STEPS`` equal steps of joint A from its start to ``target`` (radians)."""
     path = trace(mech, drive="A", until=("A", target), steps=STEPS)
     assert path.branches[-1].end_reason == "reached target"
     return path
 
 
-def by_name(path: Path, names: tuple[str, ...]) -> np.ndarray:
+def by_name(path: Trace, names: tuple[str, ...]) -> np.ndarray:
     """The path's angles ``(N, n)`` with columns in the order of ``names``."""
     order = [path.mechanism.joint_names.index(name) for name in names]
     return path.angles[:, order]
 
 
-def assert_same_path(variant: Path, reference: Path) -> None:
+def assert_same_path(variant: Trace, reference: Trace) -> None:
     """Same number of points, same angle of every named joint at each (1e-9 rad), same rank everywhere."""
     names = reference.mechanism.joint_names
     assert variant.angles.shape == reference.angles.shape

@@ -10,8 +10,8 @@ import typer
 from typer.testing import CliRunner
 
 from linkwork.cli.mechanize import mechanize
-from linkwork.cli.synth import write_synthesis_outputs
 from linkwork.io.problem import load_problem
+from linkwork.outputs.synthesis import write_synthesis_outputs
 from linkwork.synthesis import synthesize
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

@@ -7,7 +7,7 @@ import re
 import subprocess
 import sys
 import time
-from pathlib import Path as FilePath
+from pathlib import Path
 from typing import Any
 
 import matplotlib
@@ -16,7 +16,8 @@ import pytest
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError
-from linkwork.kinematics.tracer import Path, trace
+from linkwork.kinematics.trace_result import Trace
+from linkwork.kinematics.tracer import trace
 from linkwork.linkages import deployed_angle, hedgepeth
 from linkwork.linkages.guest import guest_frame
 from linkwork.viz import animate
@@ -27,28 +28,28 @@ matplotlib.use("Agg")
 
 
 @pytest.fixture(scope="module")
-def hexagon() -> Path:
+def hexagon() -> Trace:
     return trace(hedgepeth(6), until=("A", deployed_angle(6)))
 
 
 @pytest.fixture(scope="module")
-def guest() -> Path:
+def guest() -> Trace:
     return trace(guest_frame(), branches=True, max_steps=120)
 
 
-def test_branch_frames_run_from_first_to_last_point(hexagon: Path) -> None:
+def test_branch_frames_run_from_first_to_last_point(hexagon: Trace) -> None:
     idx = branch_indices(hexagon, 0, 6)
     assert len(idx) == 6
     assert idx[0] == 0 and idx[-1] == len(hexagon.angles) - 1  # exact indices
     assert np.all(np.diff(hexagon.arclength[idx]) > 0)  # strictly along the branch
 
 
-def test_unknown_branch_is_a_clear_error(hexagon: Path) -> None:
+def test_unknown_branch_is_a_clear_error(hexagon: Trace) -> None:
     with pytest.raises(LinkworkError, match="no branch 7"):
         branch_indices(hexagon, 7, 6)
 
 
-def test_hexagon_deployment_sequence_png_is_fast(hexagon: Path, tmp_path: FilePath) -> None:
+def test_hexagon_deployment_sequence_png_is_fast(hexagon: Trace, tmp_path: Path) -> None:
     started = time.perf_counter()
     out = deployment_sequence(hexagon, tmp_path / "hexagon.png")
     elapsed = time.perf_counter() - started
@@ -58,25 +59,25 @@ def test_hexagon_deployment_sequence_png_is_fast(hexagon: Path, tmp_path: FilePa
 
 
 @pytest.mark.parametrize(("suffix", "magic"), [(".svg", b"<?xml"), (".pdf", b"%PDF")])
-def test_vector_formats_by_suffix(guest: Path, tmp_path: FilePath, suffix: str, magic: bytes) -> None:
+def test_vector_formats_by_suffix(guest: Trace, tmp_path: Path, suffix: str, magic: bytes) -> None:
     out = deployment_sequence(guest, tmp_path / f"guest{suffix}", frames=3)
     assert out.read_bytes()[: len(magic)] == magic  # exact header
 
 
-def test_unknown_suffix_is_refused(guest: Path, tmp_path: FilePath) -> None:
+def test_unknown_suffix_is_refused(guest: Trace, tmp_path: Path) -> None:
     with pytest.raises(LinkworkError, match=r"\.png, \.svg or \.pdf"):
         deployment_sequence(guest, tmp_path / "guest.jpg")
     assert not (tmp_path / "guest.jpg").exists()
 
 
-def test_steadying_moves_are_proper_rigid_motions(hexagon: Path) -> None:
+def test_steadying_moves_are_proper_rigid_motions(hexagon: Trace) -> None:
     T = steady_transforms(hexagon.mechanism, hexagon.angles[::10])
     R = T[:, :3, :3]
     np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.broadcast_to(np.eye(3), R.shape), atol=1e-12)
     np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
 
 
-def test_all_branches_are_animated_in_turn(guest: Path) -> None:
+def test_all_branches_are_animated_in_turn(guest: Trace) -> None:
     idx = path_frames(guest, None, max_frames=30)
     branches = [int(b) for b in guest.branch[idx]]
     assert set(branches) == {int(b) for b in guest.branch}  # every branch appears
@@ -84,7 +85,7 @@ def test_all_branches_are_animated_in_turn(guest: Path) -> None:
     assert len(idx) <= 30 + len(set(branches))  # at most one extra frame per branch from rounding
 
 
-def decoded_mp4(path: FilePath) -> tuple[tuple[int, int], list[NDArray[np.int64]]]:
+def decoded_mp4(path: Path) -> tuple[tuple[int, int], list[NDArray[np.int64]]]:
     """The frame size ``(width, height)`` and the RGB frames of a video, decoded by ffmpeg into a stream of
     binary PPM images (``P6 width height 255`` then the pixels, one after another)."""
     ffmpeg = animate.find_ffmpeg()
@@ -106,12 +107,12 @@ def decoded_mp4(path: FilePath) -> tuple[tuple[int, int], list[NDArray[np.int64]
 
 
 def test_mp4_decodes_to_the_frames_written(
-    guest: Path, tmp_path: FilePath, monkeypatch: pytest.MonkeyPatch
+    guest: Trace, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     written: list[NDArray[np.uint8]] = []
     write_mp4 = animate.write_mp4
 
-    def keep(images: list[NDArray[np.uint8]], *args: Any) -> FilePath:
+    def keep(images: list[NDArray[np.uint8]], *args: Any) -> Path:
         written.extend(images)
         return write_mp4(images, *args)
 
@@ -149,12 +150,12 @@ def test_imageio_ffmpeg_binary_is_the_fallback(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.delenv("IMAGEIO_FFMPEG_EXE", raising=False)
     exe = animate.find_ffmpeg()
     assert exe is not None and exe == imageio_ffmpeg.get_ffmpeg_exe()
-    assert FilePath(exe).is_file()
+    assert Path(exe).is_file()
 
 
 @pytest.mark.parametrize("missing", ["package", "binary"])
 def test_gif_is_written_and_mp4_skip_is_reported(
-    guest: Path, tmp_path: FilePath, monkeypatch: pytest.MonkeyPatch, missing: str
+    guest: Trace, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, missing: str
 ) -> None:
     from PIL import Image
 
@@ -180,9 +181,7 @@ def test_gif_is_written_and_mp4_skip_is_reported(
     assert result.gif.stat().st_size < 3_000_000  # bytes
 
 
-def test_failing_ffmpeg_leaves_no_mp4(
-    guest: Path, tmp_path: FilePath, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_failing_ffmpeg_leaves_no_mp4(guest: Trace, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # A stand-in ffmpeg that reads the frames, writes half a file to its output argument and fails.
     fake = tmp_path / "ffmpeg"
     fake.write_text(

@@ -49,12 +49,12 @@ def assert_self_contained(html: str) -> None:
 
 
 @pytest.fixture(scope="module")
-def guest_path() -> lw.Path:
+def guest_path() -> lw.Trace:
     return lw.trace(lw.load("guest-frame"), branches=True, max_steps=6000)
 
 
 @pytest.fixture(scope="module")
-def guest_page(guest_path: lw.Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+def guest_page(guest_path: lw.Trace, tmp_path_factory: pytest.TempPathFactory) -> Path:
     return write_trace_viewer(guest_path, tmp_path_factory.mktemp("guest") / "viewer.html")
 
 
@@ -65,7 +65,7 @@ def test_guest_frame_viewer_is_self_contained_and_small(guest_page: Path) -> Non
     assert size < 5_000_000, f"{size / 1e6:.2f} MB"
 
 
-def test_guest_frame_viewer_embeds_every_branch(guest_path: lw.Path, guest_page: Path) -> None:
+def test_guest_frame_viewer_embeds_every_branch(guest_path: lw.Trace, guest_page: Path) -> None:
     data = page_data(guest_page.read_text(encoding="utf-8"))
     mech = guest_path.mechanism
     assert [b["id"] for b in data["branches"]] == [b.id for b in guest_path.branches]
@@ -89,7 +89,7 @@ def test_guest_frame_viewer_embeds_every_branch(guest_path: lw.Path, guest_page:
         assert any(data["branches"][bi]["id"] == located.branch for bi, _ in bif["visits"])
 
 
-def test_poses_are_the_cores_body_poses(guest_path: lw.Path, guest_page: Path) -> None:
+def test_poses_are_the_cores_body_poses(guest_path: lw.Trace, guest_page: Path) -> None:
     data = page_data(guest_page.read_text(encoding="utf-8"))
     poses = unpack(data["poses"])
     mech = guest_path.mechanism
@@ -146,7 +146,7 @@ def test_steady_view_stands_the_bundle_up_and_lays_the_hexagon_level(tmp_path: P
         assert np.linalg.norm(np.concatenate(cloud).mean(axis=0)) < 1e-5
 
 
-def test_steady_view_starts_each_branch_where_its_parent_is(guest_path: lw.Path, guest_page: Path) -> None:
+def test_steady_view_starts_each_branch_where_its_parent_is(guest_path: lw.Trace, guest_page: Path) -> None:
     data = page_data(guest_page.read_text(encoding="utf-8"))
     steadied = _steadied(data)
     angles = np.radians(unpack(data["angles"]))
@@ -163,7 +163,7 @@ def test_steady_view_starts_each_branch_where_its_parent_is(guest_path: lw.Path,
 
 
 def test_long_paths_are_thinned_keeping_ends_and_bifurcation_points(
-    guest_path: lw.Path, tmp_path: Path
+    guest_path: lw.Trace, tmp_path: Path
 ) -> None:
     page = write_trace_viewer(guest_path, tmp_path / "viewer.html", max_points=400)
     data = page_data(page.read_text(encoding="utf-8"))
@@ -203,11 +203,11 @@ def test_trace_command_writes_the_viewer(tmp_path: Path) -> None:
 
 
 def test_synthesis_viewer_carries_every_profile(tmp_path: Path) -> None:
-    from linkwork.cli.synth import example_problem
+    from linkwork.data import example
     from linkwork.io.problem import load_problem
     from linkwork.synthesis import synthesize
 
-    result = synthesize(load_problem(example_problem("wing")))
+    result = synthesize(load_problem(example("wing")))
     page = write_synthesis_viewer(result, tmp_path / "viewer.html")
     html = page.read_text(encoding="utf-8")
     assert_self_contained(html)

@@ -392,11 +392,11 @@ def test_play_button_advances_along_the_path(browser: Browser, tmp_path: Path) -
 
 
 def test_synthesis_viewer_slider_across_profiles(browser: Browser, tmp_path: Path) -> None:
-    from linkwork.cli.synth import example_problem
+    from linkwork.data import example
     from linkwork.io.problem import load_problem
     from linkwork.synthesis import synthesize
 
-    result = synthesize(load_problem(example_problem("wing")))
+    result = synthesize(load_problem(example("wing")))
     page = write_synthesis_viewer(result, tmp_path / "viewer.html")
     mark = len(browser.events)
     browser.open(page)

@@ -8,7 +8,8 @@ from typing import Annotated
 
 import typer
 
-from linkwork.cli.common import console, friendly_errors
+from linkwork.cli.common import friendly_errors
+from linkwork.outputs.staging import console
 
 
 @friendly_errors
@@ -22,8 +23,8 @@ def demo(
     import numpy as np
 
     import linkwork as lw
-    from linkwork.cli.trace import summary, write_trace_outputs
     from linkwork.linkages.hedgepeth_rods import deployed_angles
+    from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
     from linkwork.viz.viewer import write_synthesis_viewer
 
     sections: list[tuple[str, str, Path, list[str]]] = []
@@ -33,7 +34,7 @@ def demo(
     inner, outer = deployed_angles(6)
     path = lw.trace(hexagon, until=("A", inner), steps=200)
     figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots, html=True, animate=not no_plots)
-    summary(path)
+    print_trace_summary(path)
     a = np.degrees(path.angles[-1])
     sections.append(
         (
@@ -59,7 +60,7 @@ def demo(
         figs = write_trace_outputs(
             path, out / "guest-frame", plots=not no_plots, html=True, animate=not no_plots
         )
-        summary(path)
+        print_trace_summary(path)
         sections.append(
             (
                 "Guest's frame, every branch",
@@ -73,15 +74,15 @@ def demo(
 
     console.rule("[bold]3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)")
     try:
-        from linkwork.cli.synth import run_synthesis_example
+        from linkwork.outputs.synthesis import run_synthesis_example
     except ImportError:  # pragma: no cover - synthesis not installed
         run_synthesis_example = None  # type: ignore[assignment]
     if run_synthesis_example is not None:
-        from linkwork.cli.synth import print_summary
+        from linkwork.outputs.synthesis import print_synthesis_summary
 
         result = run_synthesis_example(out / "synthesis-wing", "wing", plots=not no_plots)
         write_synthesis_viewer(result, out / "synthesis-wing" / "viewer.html")
-        print_summary(result)
+        print_synthesis_summary(result)
         figs_s = sorted(p.name for p in (out / "synthesis-wing").glob("*.png"))
         sections.append(
             (

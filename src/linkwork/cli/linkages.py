@@ -6,7 +6,8 @@ from typing import Annotated
 
 import typer
 
-from linkwork.cli.common import console, friendly_errors, parse_assignments
+from linkwork.cli.common import friendly_errors, parse_assignments
+from linkwork.outputs.staging import console
 
 
 @friendly_errors

@@ -9,45 +9,15 @@ with ``mechanize = true``.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 
-from linkwork.cli.common import console, friendly_errors, have_matplotlib, staged_output
+from linkwork.cli.common import friendly_errors
 from linkwork.errors import SpecError
-
-if TYPE_CHECKING:
-    from linkwork.mechanization import Mechanization, MechanizeOptions
-    from linkwork.synthesis.result import SynthesisResult
-
-
-def mechanize_into(
-    result: SynthesisResult,
-    out_dir: Path,
-    *,
-    options: MechanizeOptions | None = None,
-    plots: bool = True,
-) -> tuple[Mechanization, list[Path]]:
-    """Mechanize ``result`` and write ``mechanism.toml``, ``mechanization.json`` and the figures into ``out_dir``.
-
-    Raises
-    ------
-    MechanizationError
-        When no design passes (one line: why).
-    """
-    from linkwork.mechanization import mechanize, write_mechanization
-
-    found = mechanize(result, options)
-    out_dir = Path(out_dir)
-    written = write_mechanization(found, out_dir)
-    if plots and have_matplotlib():
-        from linkwork.viz.mechanism_plots import write_mechanism_figures
-
-        written += write_mechanism_figures(found, out_dir)
-    return found, written
+from linkwork.outputs.staging import console, staged_output
 
 
 def _region(text: str | None) -> tuple[float, float, float, float] | None:
@@ -62,41 +32,6 @@ def _region(text: str | None) -> tuple[float, float, float, float] | None:
             f"--ground-region {text!r}: expected XMIN,YMIN,XMAX,YMAX with XMIN < XMAX and YMIN < YMAX"
         )
     return values
-
-
-def load_synthesis(folder: Path, problem: Path | None = None) -> SynthesisResult:
-    """The synthesis result of a ``linkwork synth`` output folder, checked against its ``chain.json``.
-
-    Raises
-    ------
-    SpecError
-        When ``chain.json`` or the problem file is missing, or the problem no longer gives the same chain.
-    """
-    from linkwork.io.problem import load_problem
-    from linkwork.synthesis import synthesize
-
-    chain_file = folder / "chain.json"
-    if not chain_file.is_file():
-        raise SpecError(f"{folder}: no chain.json; expected a `linkwork synth` output folder")
-    problem = problem or folder / "problem" / "problem.toml"
-    if not problem.is_file():
-        raise SpecError(
-            f"{folder}: no problem file at {problem}; pass the problem the chain came from with --problem"
-        )
-    saved = json.loads(chain_file.read_text(encoding="utf-8"))
-    result = synthesize(load_problem(problem))
-    same = saved.get("design") == result.design and math.isclose(
-        float(saved.get("joined", {}).get("e_max", math.nan)),
-        result.joined_e_max,
-        rel_tol=1e-9,
-        abs_tol=1e-12,
-    )
-    if not same:
-        raise SpecError(
-            f"{chain_file}: the chain (design {saved.get('design')}) is not what {problem} gives now "
-            f"(design {result.design}); run `linkwork synth` again"
-        )
-    return result
 
 
 @friendly_errors
@@ -143,57 +78,12 @@ def mechanize(
         ground_region=_region(ground_region),
         min_transmission=math.radians(min_transmission),
     )
+    from linkwork.outputs.mechanization import mechanize_into, print_mechanization
+    from linkwork.outputs.synthesis import load_synthesis
+
     result = load_synthesis(folder, problem)
     target = out or folder
     with staged_output(target) as stage:
         found, written = mechanize_into(result, stage, options=options, plots=not no_plots)
     print_mechanization(found)
     console.print(f"wrote {len(written)} files to {target}/: " + ", ".join(p.name for p in written))
-
-
-def print_mechanization(found: Mechanization) -> None:
-    """Print the links, DOF, drive and the state on every profile."""
-    from rich.table import Table
-
-    design, check = found.design, found.verification
-    links = Table(title="Binary links", title_justify="left", title_style="bold")
-    for column in (
-        "link",
-        "type",
-        "anchor",
-        "body",
-        "fixed pivot",
-        "moving pivot",
-        "length",
-        "transmission (deg)",
-    ):
-        links.add_column(column)
-    for link in design.links:
-        links.add_row(
-            link.name,
-            link.kind,
-            link.anchor,
-            link.body,
-            f"({link.centre[0]:.4g}, {link.centre[1]:.4g})",
-            f"({link.circle[0]:.4g}, {link.circle[1]:.4g})",
-            f"{link.length:.4g}",
-            f"{math.degrees(link.transmission):.1f}",
-        )
-    console.print(links)
-    mech = design.mechanism()
-    revolute = mech.joint_types[mech.index(design.drive)] == "R"
-    states = Table(title=f"DOF {check.dof}, drive {design.drive}", title_justify="left", title_style="bold")
-    for column in ("profile", "drive value" + (" (deg)" if revolute else ""), "E_max", "E_max joined"):
-        states.add_column(column, justify="right")
-    for j, state in enumerate(check.states):
-        value = math.degrees(state.drive_value) if revolute else state.drive_value
-        states.add_row(
-            str(j + 1), f"{value:.6f}", f"{state.e_max:.4f}", f"{design.chain.joined_errors[j]:.4f}"
-        )
-    console.print(states)
-    if not check.traced:
-        console.print(f"{check.reason} ({found.seconds:.1f} s)")
-        return
-    console.print(
-        f"verified: no circuit, branch or order defect ({found.attempts} designs traced, {found.seconds:.1f} s)"
-    )

@@ -9,13 +9,11 @@ from typing import Annotated
 import typer
 
 from linkwork.cli.common import (
-    console,
     fail,
     friendly_errors,
-    have_matplotlib,
     parse_assignments,
-    staged_output,
 )
+from linkwork.outputs.staging import console
 
 
 def _parse_until(text: str | None) -> tuple[str, float] | None:
@@ -147,99 +145,9 @@ def trace(
             branches=branches,
             progress=report,
         )
+    from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
+
     figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
-    _summary(path)
+    print_trace_summary(path)
     written = ["path.csv", "report.json", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
-
-
-def summary(path) -> None:
-    """Print the summary tables of a traced path (used by ``linkwork demo`` too)."""
-    _summary(path)
-
-
-def write_trace_outputs(
-    path, out: Path, assembly=None, plots: bool = True, html: bool = False, animate: bool = False
-) -> list[Path]:
-    """Write path.csv, report.json, (if matplotlib is there) the figures and the deployment sequence of the
-    first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
-    (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
-    ``viewer.html`` into ``out``, all or nothing. Returns the figures, animation and viewer written."""
-    from linkwork.io.results import write_path_csv, write_report_json
-
-    figures: list[Path] = []
-    with staged_output(out) as stage:
-        write_path_csv(path, stage / "path.csv")
-        write_report_json(path, stage / "report.json", assembly)
-        if plots:
-            if have_matplotlib():
-                from linkwork.viz.snapshots import deployment_sequence
-                from linkwork.viz.trace_plots import write_trace_figures
-
-                figures = write_trace_figures(path, stage)
-                figures.append(deployment_sequence(path, stage / "sequence.png"))
-                if animate:
-                    from linkwork.viz.animate import animate_path
-
-                    motion = animate_path(path, stage / "motion.gif")
-                    figures += [f for f in (motion.gif, motion.mp4) if f is not None]
-            else:
-                console.print("figures skipped: install the plotting extra, pip install 'linkwork\\[viz]'")
-        if html:
-            from linkwork.viz.viewer import write_trace_viewer
-
-            figures.append(write_trace_viewer(path, stage / "viewer.html"))
-    return [Path(out) / f.name for f in figures]
-
-
-def _summary(path) -> None:
-    """Print the rich summary tables of a traced path."""
-    import numpy as np
-    from rich.table import Table
-
-    from linkwork.io.results import report_dict
-
-    rep = report_dict(path)
-    mech = path.mechanism
-    revolute = [t == "R" for t in mech.joint_types]
-
-    def show(values: np.ndarray) -> list[str]:
-        return [f"{np.degrees(v):.4f}" if r else f"{v:.6f}" for v, r in zip(values, revolute, strict=True)]
-
-    def angles_text(values: np.ndarray) -> str:
-        return "  ".join(f"{n}={v}" for n, v in zip(mech.joint_names, show(values), strict=True))
-
-    table = Table(title="branches", title_justify="left")
-    table.add_column("branch", justify="right")
-    table.add_column("from")
-    table.add_column("steps", justify="right")
-    table.add_column("end")
-    table.add_column("joints at the end (deg)", overflow="fold")
-    for br in path.branches:
-        mask = path.of_branch(br.id)
-        origin = "start" if br.parent is None else f"bif {br.bifurcation} on {br.parent}"
-        table.add_row(str(br.id), origin, str(br.steps), br.end_reason, angles_text(path.angles[mask][-1]))
-    console.print(table)
-    mob = rep["mobility_along_path"]
-    console.print(
-        f"rank {rep['rank']} / mobility {rep['mobility']} at the start; mobility along the path "
-        f"{mob['min']}..{mob['max']} (away from bifurcation points); max closure residual "
-        f"{rep['max_residual']:.2e}; max condition (sigma_1 / smallest non-zero) {rep['max_condition']:.4g}; "
-        f"{rep['points']} points in {rep['seconds']:.3f} s"
-    )
-    if path.bifurcations:
-        bt = Table(title="bifurcation points", title_justify="left")
-        bt.add_column("id", justify="right")
-        bt.add_column("branch", justify="right")
-        bt.add_column("step", justify="right")
-        bt.add_column("rank", justify="right")
-        bt.add_column("σ_r/σ_1", justify="right")
-        bt.add_column("branches")
-        bt.add_column("joints (deg)", overflow="fold")
-        for b in path.bifurcations:
-            zero = b.sigma[b.rank] / b.sigma[0] if b.rank < len(b.sigma) else 0.0
-            bt.add_row(
-                str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}",
-                f"{len(b.tangents)} ({b.method})", angles_text(b.angles),
-            )  # fmt: skip
-        console.print(bt)

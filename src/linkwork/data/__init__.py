@@ -1,3 +1,29 @@
-"""Data bundled with linkwork: the example synthesis problems under ``examples/`` (written by
-``examples/make_examples.py``), found with :mod:`importlib.resources` so they work from an installed
-package."""
+"""Data bundled with linkwork: the example synthesis problems (written by ``examples/make_examples.py``), reached
+with :func:`example` through :mod:`importlib.resources`, so they work from an installed package."""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from linkwork.errors import SpecError
+
+EXAMPLES = ("wing", "closed", "fixed-end", "seat")
+"""The example problems bundled with linkwork (``linkwork/data/examples/<name>/problem.toml``)."""
+
+
+def example(name: str = "wing", file: str = "problem.toml") -> Path:
+    """The problem file (``problem.toml``, or ``mechanize.toml`` for wing and seat) of a bundled example (one of
+    :data:`EXAMPLES`).
+
+    Raises
+    ------
+    SpecError
+        For an unknown name.
+    """
+    if name not in EXAMPLES:
+        raise SpecError(f'unknown example "{name}"; expected one of {", ".join(EXAMPLES)}', key="example")
+    path = Path(str(resources.files(__name__) / "examples" / name / file))
+    if not path.is_file():
+        raise SpecError(f"the bundled example is missing ({path}); reinstall linkwork", key="example")
+    return path

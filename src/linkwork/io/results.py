@@ -8,15 +8,15 @@ from __future__ import annotations
 
 import csv
 import json
-from pathlib import Path as FilePath
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from linkwork.kinematics.tracer import Path
+from linkwork.kinematics.trace_result import Trace
 
 
-def _display(path: Path, values: np.ndarray) -> np.ndarray:
+def _display(path: Trace, values: np.ndarray) -> np.ndarray:
     """Joint values in file units: degrees for revolute joints, lengths as they are for prismatic ones."""
     revolute = np.array([t == "R" for t in path.mechanism.joint_types])
     out = np.array(values, dtype=float, copy=True)
@@ -24,7 +24,7 @@ def _display(path: Path, values: np.ndarray) -> np.ndarray:
     return out
 
 
-def path_rows(path: Path) -> tuple[list[str], list[list[Any]]]:
+def path_rows(path: Trace) -> tuple[list[str], list[list[Any]]]:
     """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual``."""
     names = list(path.mechanism.joint_names)
     k = path.sigma.shape[1]
@@ -46,7 +46,7 @@ def path_rows(path: Path) -> tuple[list[str], list[list[Any]]]:
     return header, rows
 
 
-def write_path_csv(path: Path, file: FilePath) -> None:
+def write_path_csv(path: Trace, file: Path) -> None:
     """Write ``path.csv`` (floats with 17 significant digits, so nothing is lost)."""
     header, rows = path_rows(path)
     with open(file, "w", newline="") as fh:
@@ -56,7 +56,7 @@ def write_path_csv(path: Path, file: FilePath) -> None:
             writer.writerow([f"{v:.17g}" if isinstance(v, float) else v for v in row])
 
 
-def report_dict(path: Path, assembly: Any | None = None) -> dict[str, Any]:
+def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
     """The content of ``report.json``."""
     mech = path.mechanism
     names = list(mech.joint_names)
@@ -131,7 +131,7 @@ def report_dict(path: Path, assembly: Any | None = None) -> dict[str, Any]:
     return out
 
 
-def write_report_json(path: Path, file: FilePath, assembly: Any | None = None) -> None:
+def write_report_json(path: Trace, file: Path, assembly: Any | None = None) -> None:
     """Write ``report.json``."""
     with open(file, "w") as fh:
         json.dump(report_dict(path, assembly), fh, indent=2)

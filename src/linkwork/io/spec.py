@@ -50,6 +50,7 @@ import numpy as np
 
 from linkwork.errors import AssemblyError, SpecError
 from linkwork.geometry import line_twist
+from linkwork.geometry.names import default_joint_name
 from linkwork.kinematics.chains import Assembly, from_dh, from_rods
 from linkwork.kinematics.mechanism import Array, Mechanism
 
@@ -480,12 +481,6 @@ class _Reader:
             )
         fixed = [joint(item, _key(fixed_key, i)) for i, item in enumerate(raw_fixed)]
         return couple, fixed
-
-
-def default_joint_name(index: int) -> str:
-    """``A, B, ..., Z``, then ``A1, B1, ...``: the name of joint ``index`` when the file gives none."""
-    letter = chr(ord("A") + index % 26)
-    return letter if index < 26 else f"{letter}{index // 26}"
 
 
 Couplings = tuple[list[list[str]], list[str]]

@@ -17,6 +17,7 @@ import numpy as np
 
 from linkwork.errors import AssemblyError
 from linkwork.geometry import exp_se3, log_se3, rot_x, rot_z, translation
+from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.mechanism import Array, Mechanism
 
 
@@ -133,7 +134,7 @@ def from_dh(
 
     ``params``: one mapping per joint with ``theta`` (start value), ``d``, ``a``, ``alpha`` (radians; missing = 0).
     """
-    names = list(joint_names or [chr(ord("A") + i) for i in range(len(params))])
+    names = list(joint_names or default_joint_names(len(params)))
     constants = [
         translation([0.0, 0.0, p.get("d", 0.0)])
         @ translation([p.get("a", 0.0), 0.0, 0.0])
@@ -157,7 +158,7 @@ def from_rods(
 
     ``rods``: one mapping per joint with ``phi``, ``omega``, ``psi`` (radians) and ``v`` (3-vector).
     """
-    names = list(joint_names or [chr(ord("A") + i) for i in range(len(rods))])
+    names = list(joint_names or default_joint_names(len(rods)))
     constants = [rod_transform(r["phi"], r["omega"], r["psi"], r["v"]) for r in rods]
     info = {"convention": "rods", "rods": [dict(r) for r in rods], **dict(meta or {})}
     return assemble_chain(name, names, constants, thetas, rotation_first=False, meta=info)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.errors import SpecError
+from linkwork.geometry.angles import wrap
 from linkwork.kinematics.chains import from_dh
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.linkages.registry import LinkageEntry, Param, register
@@ -21,8 +22,8 @@ JOINTS = ("A", "B", "C", "D")
 
 
 def wrap_angle(angle: float) -> float:
-    """An angle brought into ``(-pi, pi]``."""
-    return float(np.pi - np.mod(np.pi - angle, 2.0 * np.pi))
+    """An angle brought into ``[-pi, pi)`` (:func:`linkwork.geometry.angles.wrap`)."""
+    return float(wrap(angle))
 
 
 def bennett_constant(alpha1: float, alpha2: float) -> float:

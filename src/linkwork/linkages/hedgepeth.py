@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.errors import SpecError
+from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.chains import from_rods
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.linkages.registry import LinkageEntry, Param, register
@@ -67,18 +68,12 @@ def hedgepeth(n: int = 6, couple: bool | None = None) -> Mechanism:
     for k in range(n):
         sign = 1.0 if k % 2 == 0 else -1.0
         rods.append({"phi": sign * g["phi"], "omega": sign * g["omega"], "psi": sign * g["psi"], "v": v})
-    names = [joint_name(k) for k in range(n)]
+    names = default_joint_names(n)
     meta = {"linkage": "hedgepeth", "n": n, "deployed_A": deployed_angle(n)}
     mech, _ = from_rods(f"Hedgepeth hoop n={n}", rods, [0.0] * n, joint_names=names, meta=meta)
     if couple if couple is not None else n >= 8:
         mech = mech.with_couplings([names[0::2], names[1::2]])
     return mech
-
-
-def joint_name(k: int) -> str:
-    """A, B, ..., Z, then A1, B1, ...: short names for large hoops."""
-    letter = chr(ord("A") + k % 26)
-    return letter if k < 26 else f"{letter}{k // 26}"
 
 
 register(

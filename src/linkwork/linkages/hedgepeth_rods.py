@@ -33,8 +33,8 @@ from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
 from linkwork.geometry import line_twist
+from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.linkages.hedgepeth import joint_name
 from linkwork.linkages.registry import LinkageEntry, Param, register
 
 Array = NDArray[np.float64]
@@ -102,7 +102,7 @@ def hedgepeth_rods(n: int = 6, couple: bool | None = None, width: float = 0.2) -
         direction = frame[:3, :3] @ hinge_edge(n, sign)
         # Orient every axis so that deployment is a positive rotation (rod i turns away from rod i-1).
         twists.append(line_twist(frame[:3, 3], -sign * direction))
-    names = [joint_name(k) for k in range(n)]
+    names = default_joint_names(n)
     inner, outer = deployed_angles(n)
     meta = {
         "linkage": "hedgepeth-rods",

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import LinkworkError
+from linkwork.geometry.angles import wrap
 from linkwork.synthesis.result import JoinedProfile, SynthesisResult
 from linkwork.synthesis.segment_fit import segment_starts
 
@@ -65,12 +66,6 @@ def relative(before: ArrayLike, after: ArrayLike) -> Array:
     return np.array(
         [pose_of(np.linalg.inv(pose_matrix(u)) @ pose_matrix(v)) for u, v in zip(b, a, strict=True)]
     )
-
-
-def wrap(angle: ArrayLike) -> Array:
-    """Angles wrapped to ``(-pi, pi]``."""
-    a = np.asarray(angle, dtype=float)
-    return np.pi - (np.pi - a) % (2.0 * np.pi)
 
 
 @dataclass(frozen=True)

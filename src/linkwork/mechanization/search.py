@@ -24,16 +24,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.errors import LinkworkError
+from linkwork.errors import LinkworkError, MechanizationError
 from linkwork.mechanization import guidance
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, apply, relative
 
 Array = NDArray[np.float64]
-
-
-class MechanizationError(LinkworkError):
-    """No design passes: says which body or which check stopped every candidate."""
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
-from linkwork.kinematics.tracer import Path as TracedPath
+from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.tracer import trace
 from linkwork.mechanization.assemble import Design, spec_text
 from linkwork.mechanization.chain import pose_of, wrap
@@ -79,7 +79,7 @@ class Verification:
     states: tuple[ProfileState, ...] = ()
     max_condition: float = float("nan")
     culprit: str | None = None
-    paths: tuple[TracedPath, ...] = field(default=())
+    paths: tuple[Trace, ...] = field(default=())
     traced: bool = True
 
 
@@ -198,7 +198,7 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
             culprit="drive",
         )
     states: list[ProfileState] = [state(np.zeros(mech.n_joints), 0)]
-    paths: list[TracedPath] = []
+    paths: list[Trace] = []
     max_cond = 1.0
 
     def reject(defect: str, reason: str, culprit: str | None) -> Verification:
@@ -315,7 +315,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     return out
 
 
-def _culprit(design: Design, mech: Mechanism, path: TracedPath) -> str | None:
+def _culprit(design: Design, mech: Mechanism, path: Trace) -> str | None:
     """The RR link nearest a dead centre on the path (at the drive's turning point when there is one)."""
     d = mech.index(design.drive)
     drive = path.angles[:, d]

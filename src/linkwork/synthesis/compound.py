@@ -8,15 +8,12 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.geometry.angles import wrap
 from linkwork.synthesis.joining import join_chain
 from linkwork.synthesis.result import Compound, JoinedProfile, Segment, TargetProfile
 from linkwork.synthesis.segment_fit import segment_starts
 
 Array = NDArray[np.float64]
-
-
-def _wrap(a: Array) -> Array:
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def joint_angles(joined: Sequence[JoinedProfile], segment_matrix: NDArray[np.int64]) -> Array:
@@ -36,7 +33,7 @@ def joint_angles(joined: Sequence[JoinedProfile], segment_matrix: NDArray[np.int
         cross = p_in[:, 0] * p_out[:, 1] - p_in[:, 1] * p_out[:, 0]
         sigma[:, j] = np.arctan2(cross, np.sum(p_in * p_out, axis=1))
     if q1:
-        sigma = sigma[:, :1] + _wrap(sigma - sigma[:, :1])
+        sigma = sigma[:, :1] + wrap(sigma - sigma[:, :1])
     return sigma
 
 

@@ -13,14 +13,14 @@ import shutil
 import subprocess
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path as FilePath
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import LinkworkError
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.tracer import Path
+from linkwork.kinematics.trace_result import Trace
 from linkwork.viz.snapshots import (
     bounds,
     branch_indices,
@@ -37,13 +37,13 @@ from linkwork.viz.solids import body_meshes, hinge_pins, place
 class Animation:
     """What :func:`animate_path` wrote: the GIF, the MP4 (or None and why not), the number of frames."""
 
-    gif: FilePath | None
-    mp4: FilePath | None
+    gif: Path | None
+    mp4: Path | None
     frames: int
     mp4_skipped: str = ""
 
 
-def path_frames(path: Path, branch: int | None = None, max_frames: int = 120) -> NDArray[np.int64]:
+def path_frames(path: Trace, branch: int | None = None, max_frames: int = 120) -> NDArray[np.int64]:
     """Indices of the path points to animate: one branch, or every branch in turn (id order), at most
     ``max_frames`` in all, spread over the branches in proportion to their number of points."""
     branches = sorted({int(b) for b in path.branch}) if branch is None else [branch]
@@ -60,8 +60,8 @@ def path_frames(path: Path, branch: int | None = None, max_frames: int = 120) ->
 
 
 def animate_path(
-    path: Path,
-    out_file: str | FilePath,
+    path: Trace,
+    out_file: str | Path,
     branch: int | None = None,
     fps: int = 20,
     max_frames: int = 120,
@@ -115,7 +115,7 @@ def animate_path(
 def animate_configurations(
     mech: Mechanism,
     angles: ArrayLike,
-    out_file: str | FilePath,
+    out_file: str | Path,
     *,
     fps: int = 20,
     labels: Sequence[str] | None = None,
@@ -126,7 +126,7 @@ def animate_configurations(
     """Animate ``mech`` through the configurations ``angles`` ``(N, n)`` (radians): e.g. a synthesised
     mechanism through its profiles. ``moves`` ``(N, 4, 4)``: rigid motions applied per frame (default: a steady
     fit, :func:`linkwork.viz.snapshots.steady_transforms`)."""
-    out = FilePath(out_file)
+    out = Path(out_file)
     suffix = out.suffix.lower()
     if suffix not in {".gif", ".mp4"}:
         raise LinkworkError(f"animations are written as .gif or .mp4, got {out.name!r}")
@@ -203,7 +203,7 @@ def render_frames(
     return images
 
 
-def write_gif(images: Sequence[NDArray[np.uint8]], out: FilePath, fps: int) -> FilePath:
+def write_gif(images: Sequence[NDArray[np.uint8]], out: Path, fps: int) -> Path:
     """A looping GIF, one shared 64-colour palette (small files), ``fps`` frames per second."""
     from PIL import Image
 
@@ -227,7 +227,7 @@ def write_gif(images: Sequence[NDArray[np.uint8]], out: FilePath, fps: int) -> F
     return out
 
 
-def write_mp4(images: Sequence[NDArray[np.uint8]], out: FilePath, fps: int, ffmpeg: str) -> FilePath:
+def write_mp4(images: Sequence[NDArray[np.uint8]], out: Path, fps: int, ffmpeg: str) -> Path:
     """An H.264 MP4 through ffmpeg's stdin (raw RGB frames); the file is removed if ffmpeg fails."""
     h, w, _ = images[0].shape
     w2, h2 = w - w % 2, h - h % 2  # yuv420p needs even sides

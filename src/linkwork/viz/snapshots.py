@@ -8,7 +8,7 @@ snapshots and the animations (:mod:`linkwork.viz.animate`) share. matplotlib is 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path as FilePath
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import LinkworkError
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.tracer import Path
+from linkwork.kinematics.trace_result import Trace
 from linkwork.viz.solids import Mesh, body_meshes, hinge_pins, place
 
 Array = NDArray[np.float64]
@@ -33,7 +33,7 @@ def default_view(mech: Mechanism) -> tuple[float, float]:
     return VIEWS.get(str(mech.meta.get("linkage", "")), DEFAULT_VIEW)
 
 
-def branch_indices(path: Path, branch: int, frames: int) -> NDArray[np.int64]:
+def branch_indices(path: Trace, branch: int, frames: int) -> NDArray[np.int64]:
     """Indices of ``frames`` points of ``branch`` equally spaced in arclength, first and last included (all if 0)."""
     idx = np.flatnonzero(path.of_branch(branch))
     if idx.size == 0:
@@ -182,7 +182,7 @@ def bounds(frames: Sequence[Sequence[Mesh]]) -> tuple[Array, Array]:
     return pts.min(axis=0), pts.max(axis=0)
 
 
-def label_joint(path: Path, branch: int) -> int:
+def label_joint(path: Trace, branch: int) -> int:
     """The joint to label a branch's frames with: the drive, or, where the drive stays put along the branch
     (Guest's frame leaves its bifurcation at a fixed theta_A), the joint that moves the most."""
     mech = path.mechanism
@@ -192,7 +192,7 @@ def label_joint(path: Path, branch: int) -> int:
     return d if spans[d] > 1e-6 * max(float(spans.max()), 1e-300) else int(np.argmax(spans))
 
 
-def drive_label(path: Path, i: int, joint: int | None = None) -> str:
+def drive_label(path: Trace, i: int, joint: int | None = None) -> str:
     """``"theta_A = 12.3°"``: a joint's value at point ``i`` (degrees, or length for a slider); default the
     joint :func:`label_joint` picks for the point's branch."""
     mech = path.mechanism
@@ -205,8 +205,8 @@ def drive_label(path: Path, i: int, joint: int | None = None) -> str:
 
 
 def deployment_sequence(
-    path: Path,
-    out_file: str | FilePath,
+    path: Trace,
+    out_file: str | Path,
     frames: int = 6,
     branch: int = 0,
     view: tuple[float, float] | None = None,
@@ -215,7 +215,7 @@ def deployment_sequence(
     panel_size: float = 2.4,
     dpi: int = 110,
     title: str | None = None,
-) -> FilePath:
+) -> Path:
     """Draw ``frames`` configurations of one branch, first to last point, one panel each (Figs. 11, 13, 16).
 
     Parameters
@@ -237,7 +237,7 @@ def deployment_sequence(
     """
     from matplotlib.figure import Figure
 
-    out = FilePath(out_file)
+    out = Path(out_file)
     if out.suffix.lower() not in {".png", ".svg", ".pdf"}:
         raise LinkworkError(f"deployment_sequence writes .png, .svg or .pdf, got {out.name!r}")
     mech = path.mechanism

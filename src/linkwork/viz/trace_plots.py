@@ -3,18 +3,18 @@ Jacobian's singular values along the path (like Fig. 15). matplotlib is imported
 
 from __future__ import annotations
 
-from pathlib import Path as FilePath
+from pathlib import Path
 
 import numpy as np
 
-from linkwork.kinematics.tracer import Path
+from linkwork.kinematics.trace_result import Trace
 
 
-def _unwrap_branch(path: Path, mask: np.ndarray) -> np.ndarray:
+def _unwrap_branch(path: Trace, mask: np.ndarray) -> np.ndarray:
     return np.degrees(path.angles[mask])
 
 
-def plot_angles(path: Path, file: FilePath) -> FilePath:
+def plot_angles(path: Trace, file: Path) -> Path:
     """Every hinge angle against the drive angle, one colour per joint, one line style per branch."""
     import matplotlib
 
@@ -54,12 +54,12 @@ def plot_angles(path: Path, file: FilePath) -> FilePath:
     ax.grid(alpha=0.3)
     ax.legend(ncol=2, fontsize=8)
     fig.savefig(file, dpi=120)
-    fig.savefig(FilePath(file).with_suffix(".svg"))
+    fig.savefig(Path(file).with_suffix(".svg"))
     plt.close(fig)
-    return FilePath(file)
+    return Path(file)
 
 
-def plot_singular_values(path: Path, file: FilePath, branch: int = 0) -> FilePath:
+def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
     """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
     import matplotlib
 
@@ -94,12 +94,12 @@ def plot_singular_values(path: Path, file: FilePath, branch: int = 0) -> FilePat
     axes[1].legend(fontsize=8, ncol=2)
     fig.suptitle(f"{mech.name}: singular values of the Jacobian along branch {branch}", fontsize=10)
     fig.savefig(file, dpi=120)
-    fig.savefig(FilePath(file).with_suffix(".svg"))
+    fig.savefig(Path(file).with_suffix(".svg"))
     plt.close(fig)
-    return FilePath(file)
+    return Path(file)
 
 
-def write_trace_figures(path: Path, out: FilePath) -> list[FilePath]:
+def write_trace_figures(path: Trace, out: Path) -> list[Path]:
     """All trace figures into folder ``out``; returns the PNG paths."""
-    out = FilePath(out)
+    out = Path(out)
     return [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]

@@ -18,7 +18,7 @@ import math
 import re
 from dataclasses import dataclass
 from importlib import resources
-from pathlib import Path as FilePath
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -28,7 +28,7 @@ from linkwork.kinematics.closure import body_poses
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
-    from linkwork.kinematics.tracer import Bifurcation, Path
+    from linkwork.kinematics.trace_result import Bifurcation, Trace
     from linkwork.synthesis.result import SynthesisResult
 
 #: Joint colours of the plots and labels (matplotlib's tab10, so the viewer matches the PNG figures).
@@ -99,8 +99,8 @@ def _escape(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
 
 
-def _write(file: str | FilePath, text: str) -> FilePath:
-    file = FilePath(file)
+def _write(file: str | Path, text: str) -> Path:
+    file = Path(file)
     file.parent.mkdir(parents=True, exist_ok=True)
     file.write_text(text, encoding="utf-8")
     return file
@@ -196,7 +196,7 @@ def _bounds(parts: list[Part], poses: NDArray[np.float64], shift: NDArray[np.flo
 # ----------------------------------------------------------------------------------------------- trace viewer
 
 
-def _steady_rows(path: Path, per_branch: list[NDArray[np.int64]]) -> NDArray[np.float64]:
+def _steady_rows(path: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[np.float64]:
     """``(N, 12)`` per point sent to the page, the rigid motion of the whole mechanism that keeps the drawing
     steady (rotation rows, then translation): each branch fitted point by point
     (:func:`linkwork.viz.snapshots.follow`), a branch leaving a bifurcation point starting from the pose its
@@ -235,7 +235,7 @@ def _compose(steady: NDArray[np.float64], poses: NDArray[np.float64]) -> NDArray
     return out
 
 
-def _kept_points(path: Path, max_points: int, must: set[int]) -> list[NDArray[np.int64]]:
+def _kept_points(path: Trace, max_points: int, must: set[int]) -> list[NDArray[np.int64]]:
     """Per branch, the indices of its points sent to the page, in path order: all of them, or thinned evenly
     when the path has more than ``max_points`` (ends and the points in ``must`` kept)."""
     n = len(path.branch)
@@ -264,7 +264,7 @@ def _same(a: NDArray[np.float64], b: NDArray[np.float64], revolute: NDArray[np.b
     return np.all(np.abs(_difference(a, b, revolute)) < SAME_POINT, axis=1)
 
 
-def _visits(path: Path, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArray[np.int64]:
+def _visits(path: Trace, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArray[np.int64]:
     """Indices of the points at a bifurcation point: where branches leave or reach it, and the point of the
     branch it was found on at its step (the point is located between two steps, not inserted into it)."""
     same = set(np.flatnonzero(_same(path.angles, bif.angles, revolute)).tolist())
@@ -277,7 +277,7 @@ def _visits(path: Path, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArra
 
 
 def trace_viewer_data(
-    path: Path, *, title: str | None = None, max_points: int = MAX_POINTS
+    path: Trace, *, title: str | None = None, max_points: int = MAX_POINTS
 ) -> dict[str, Any]:
     """Everything the trace viewer page shows, as JSON-ready data (angles in degrees).
 
@@ -397,8 +397,8 @@ def _display(mech: Mechanism, values: NDArray[np.float64]) -> NDArray[np.float64
 
 
 def write_trace_viewer(
-    path: Path, file: str | FilePath, *, title: str | None = None, max_points: int = MAX_POINTS
-) -> FilePath:
+    path: Trace, file: str | Path, *, title: str | None = None, max_points: int = MAX_POINTS
+) -> Path:
     """Write the interactive viewer of a traced path: one self-contained HTML file that works offline.
 
     The page shows the linkage in 3-D at a point of the path (drag to orbit, wheel to zoom), a slider along the
@@ -504,9 +504,7 @@ def synthesis_viewer_data(result: SynthesisResult, *, title: str | None = None) 
     }
 
 
-def write_synthesis_viewer(
-    result: SynthesisResult, file: str | FilePath, *, title: str | None = None
-) -> FilePath:
+def write_synthesis_viewer(result: SynthesisResult, file: str | Path, *, title: str | None = None) -> Path:
     """Write the interactive viewer of a synthesis result: one self-contained HTML file that works offline.
 
     The page draws the target profiles and the joined chain posed on one of them, with a slider (and a play

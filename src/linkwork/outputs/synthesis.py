@@ -1,0 +1,190 @@
+"""The files of a synthesised chain (chain.json, target_profiles.csv, outline.svg/.dxf, figures), its printed
+summary, a bundled example run end to end, and a ``linkwork synth`` output folder read back."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from linkwork.data import example
+from linkwork.errors import SpecError
+from linkwork.outputs.staging import console, have_matplotlib
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from linkwork.synthesis.result import SynthesisResult
+
+
+def write_synthesis_outputs(result: SynthesisResult, folder: Path, *, plots: bool = True) -> list[Path]:
+    """Write every output file of a synthesis result into ``folder`` and return their paths.
+
+    ``chain.json`` (the contract of ``result.to_dict()``), ``target_profiles.csv``, ``outline.svg``,
+    ``outline.dxf`` and, when ``plots``, the figures of
+    :func:`linkwork.viz.synthesis_plots.write_synthesis_figures`.
+    """
+    from linkwork.io.profiles import write_outline_dxf, write_outline_svg
+    from linkwork.synthesis import write_target_profiles_csv
+
+    folder.mkdir(parents=True, exist_ok=True)
+    chain = folder / "chain.json"
+    chain.write_text(json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    targets = folder / "target_profiles.csv"
+    write_target_profiles_csv(result.targets, targets)
+    write_outline_svg(folder / "outline.svg", result)
+    write_outline_dxf(folder / "outline.dxf", result)
+    written = [chain, targets, folder / "outline.svg", folder / "outline.dxf"]
+    if plots:
+        from linkwork.viz.synthesis_plots import write_synthesis_figures
+
+        written += write_synthesis_figures(result, folder)
+    return written
+
+
+def run_synthesis_example(
+    out_dir: Path, name: str = "wing", *, plots: bool = True, file: str = "problem.toml"
+) -> SynthesisResult:
+    """Run a bundled synthesis example and write its inputs and outputs into ``out_dir``.
+
+    ``out_dir/problem/`` receives a copy of the example's problem file and profiles (so ``linkwork synth
+    out_dir/problem/problem.toml`` runs it again); ``out_dir`` receives the files of
+    :func:`write_synthesis_outputs`. Nothing is printed.
+
+    Parameters
+    ----------
+    out_dir
+        Folder to write into (created if needed).
+    name
+        One of :data:`linkwork.data.EXAMPLES`.
+    plots
+        Draw the figures (skipped anyway when matplotlib is not installed).
+    file
+        The example's problem file; ``mechanize.toml`` also mechanizes the chain (mechanism.toml,
+        mechanization.json, figures).
+    """
+    from linkwork.io.problem import load_problem
+    from linkwork.synthesis import synthesize
+
+    problem_file = example(name, file)
+    problem = load_problem(problem_file)
+    result = synthesize(problem)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    shutil.copytree(problem_file.parent, out_dir / "problem", dirs_exist_ok=True)
+    write_synthesis_outputs(result, out_dir, plots=plots and have_matplotlib())
+    if problem.mechanize:
+        from linkwork.outputs.mechanization import mechanize_into
+
+        mechanize_into(result, out_dir, plots=plots and have_matplotlib())
+    return result
+
+
+def load_synthesis(folder: Path, problem: Path | None = None) -> SynthesisResult:
+    """The synthesis result of a ``linkwork synth`` output folder, checked against its ``chain.json``.
+
+    Raises
+    ------
+    SpecError
+        When ``chain.json`` or the problem file is missing, or the problem no longer gives the same chain.
+    """
+    from linkwork.io.problem import load_problem
+    from linkwork.synthesis import synthesize
+
+    chain_file = folder / "chain.json"
+    if not chain_file.is_file():
+        raise SpecError(f"{folder}: no chain.json; expected a `linkwork synth` output folder")
+    problem = problem or folder / "problem" / "problem.toml"
+    if not problem.is_file():
+        raise SpecError(
+            f"{folder}: no problem file at {problem}; pass the problem the chain came from with --problem"
+        )
+    saved = json.loads(chain_file.read_text(encoding="utf-8"))
+    result = synthesize(load_problem(problem))
+    same = saved.get("design") == result.design and math.isclose(
+        float(saved.get("joined", {}).get("e_max", math.nan)),
+        result.joined_e_max,
+        rel_tol=1e-9,
+        abs_tol=1e-12,
+    )
+    if not same:
+        raise SpecError(
+            f"{chain_file}: the chain (design {saved.get('design')}) is not what {problem} gives now "
+            f"(design {result.design}); run `linkwork synth` again"
+        )
+    return result
+
+
+def _table(title: str) -> Table:
+    from rich.table import Table
+
+    return Table(title=title, title_justify="left", title_style="bold")
+
+
+def _matrix_table(title: str, result: SynthesisResult, cells: np.ndarray, fmt: str) -> Table:
+    """A ``(q, p)`` matrix printed as the paper prints it: one row per profile, one column per segment."""
+    table = _table(title)
+    table.add_column("profile")
+    for e, kind in enumerate(result.design):
+        table.add_column(f"{e + 1} {kind}", justify="right")
+    for j, target in enumerate(result.targets):
+        table.add_row(
+            target.name or str(j + 1), *(format(cells[e, j], fmt) for e in range(len(result.design)))
+        )
+    return table
+
+
+def print_synthesis_summary(result: SynthesisResult) -> None:
+    """Print the profiles, the design, the segment and error matrices and the compound merges."""
+    profiles = _table("Profiles")
+    for column in ("profile", "arc length C", "pieces m", "target length s", "S / C"):
+        profiles.add_column(column, justify="left" if column == "profile" else "right")
+    for j, target in enumerate(result.targets):
+        profiles.add_row(
+            target.name or str(j + 1),
+            f"{target.arc_length:.4f}",
+            str(target.pieces),
+            f"{target.target_length:.4f}",
+            f"{target.length / target.arc_length:.4f}",
+        )
+    console.print(profiles)
+    problem = result.problem
+    searched = "given" if problem.design else f"best of every design vector of {problem.segments} segments"
+    console.print(
+        f"[bold]design[/] {result.design} ({searched}); {problem.kind} profiles, piece length "
+        f"{problem.piece_length:g}, at least {problem.min_pieces} pieces per segment; "
+        f"{result.stats.starts} starts, {result.stats.seconds:.2f} s",
+        highlight=False,
+    )
+    console.print(_matrix_table("Segment matrix (pieces)", result, result.segment_matrix, "d"))
+    console.print(_matrix_table("Error matrix after segmentation", result, result.error_matrix, ".4f"))
+    console.print(_matrix_table("Error matrix after joining", result, result.joined_error_matrix, ".4f"))
+    errors = _table("Errors")
+    for column in ("stage", "E_max", "E_mean"):
+        errors.add_column(column, justify="left" if column == "stage" else "right")
+    errors.add_row("segmentation", f"{result.e_max:.4f}", f"{result.e_mean:.4f}")
+    errors.add_row(
+        "joined", f"{result.joined_e_max:.4f}", f"{float(np.mean(result.joined_error_matrix)):.4f}"
+    )
+    compound = result.compound
+    if compound is not None and compound.merged:
+        errors.add_row("compound", f"{compound.e_max:.4f}", f"{float(np.mean(compound.error_matrix)):.4f}")
+    console.print(errors)
+    if compound is None:
+        console.print("compound segments: off (merge_below = 0)")
+        return
+    joints = _table(f"Joint ranges (merge below {math.degrees(compound.threshold):.3g} deg)")
+    for column in ("joint", "between", "range (deg)", "merged"):
+        joints.add_column(column, justify="right" if column == "range (deg)" else "left")
+    for i, motion in enumerate(compound.joint_ranges):
+        between = f"{i + 1} {result.design[i]} - {i + 2} {result.design[i + 1]}"
+        joints.add_row(
+            str(i + 1), between, f"{math.degrees(motion):.2f}", "yes" if i in compound.merged else ""
+        )
+    console.print(joints)
+    for note in compound.notes:
+        console.print(f"note: {note}", highlight=False)
