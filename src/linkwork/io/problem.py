@@ -19,7 +19,9 @@ Example
     merge_below = 5.0                   # degrees; 0 disables compound segments
     seed = 1
     names = ["cruise", "climb", "landing"]   # optional; file stems by default
-    mechanize = false                   # optional
+    mechanize = false                   # optional; the mechanization options (dof, drive, actuator,
+                                        # ground_region, link_offset, max_link, min_transmission, anchors,
+                                        # attempts, time_limit, root) are keys too: docs/mechanization.md
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ import numpy as np
 
 from linkwork.errors import SpecError
 from linkwork.io.profiles import COINCIDENT, load_profile
+from linkwork.mechanization.options import OPTION_KEYS, options_from_values
 from linkwork.synthesis.problem import Problem, ProfileKind
 
 KINDS = ("open", "closed", "fixed-end")
@@ -52,6 +55,7 @@ KEYS = (
     "names",
     "mechanize",
     "description",
+    *OPTION_KEYS,
 )
 """Every key a problem file may hold (``description`` is free text for the reader and is ignored)."""
 
@@ -221,6 +225,8 @@ def load_problem(path: str | Path) -> Problem:
     )
     seed = keys.get("seed", 0, _integer(0), "a whole number >= 0")
     mechanize = keys.get("mechanize", False, _boolean, "true or false")
+    mechanize_options = {key: table[key] for key in OPTION_KEYS if key in table}
+    options_from_values(mechanize_options, source=source)  # checked here: a mistake is found before synthesis
     keys.get("description", "", lambda v: v if isinstance(v, str) else None, "a string")
     stems = [Path(name).stem for name in files]
     names = keys.get("names", stems, _string_list, f"a list of {len(files)} non-empty names")
@@ -261,4 +267,5 @@ def load_problem(path: str | Path) -> Problem:
         names=tuple(names),
         source=path,
         mechanize=mechanize,
+        mechanize_options=mechanize_options,
     )

@@ -15,9 +15,9 @@ import numpy as np
 
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
+from linkwork.mechanization.options import MechanizeOptions
 from linkwork.mechanization.search import (
     MechanizationError,
-    MechanizeOptions,
     Plan,
     plan,
     prismatic_actuator,

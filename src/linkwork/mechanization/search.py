@@ -28,69 +28,12 @@ from linkwork.errors import LinkworkError, MechanizationError
 from linkwork.mechanization import guidance
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, apply, relative
+from linkwork.mechanization.options import GroundRegion, MechanizeOptions
 
 Array = NDArray[np.float64]
 
-
-@dataclass(frozen=True)
-class MechanizeOptions:
-    """What the designer may choose (all optional).
-
-    Attributes
-    ----------
-    dof
-        Degrees of freedom (number of actuators) of the mechanism; 1 by default.
-    ground_region
-        ``(xmin, ymin, xmax, ymax)``: fixed pivots on the ground must lie in it. Default: the box of the
-        profiles grown by ``margin`` of their size on every side.
-    margin
-        See ``ground_region``.
-    link_offset
-        Moving pivots may sit off the chain, along its normal, up to this multiple of the body's length.
-    anchors
-        ``"ground"``: every dyad to the ground; ``"any"``: also between links (to a body already placed);
-        ``"auto"``: try ``"ground"`` first, then ``"any"``.
-    min_transmission
-        Radians: dyads whose transmission angle drops below this on a profile are dropped.
-    max_link
-        Longest link, as a multiple of the profiles' size.
-    root
-        The body guided first (default: the body with the longest outline).
-    drive
-        The driven joint (default: the crank of the root, else a chain joint that moves monotonically).
-    actuator
-        ``"revolute"``: the drive is a revolute joint; ``"prismatic"``: add a linear actuator (RPR) between the
-        ground (``ground_region``) and the root and drive its slider.
-    candidates
-        Moving-pivot candidates along each body (times 7 offsets).
-    attempts
-        Designs traced at most per root and anchor choice.
-    time_limit
-        Seconds after which the search stops with the best reason it has.
-    """
-
-    dof: int = 1
-    ground_region: tuple[float, float, float, float] | None = None
-    margin: float = 0.25
-    link_offset: float = 1.5
-    anchors: str = "auto"
-    min_transmission: float = math.radians(15.0)
-    max_link: float = 1.5
-    root: str | None = None
-    drive: str | None = None
-    actuator: str = "revolute"
-    candidates: int = 9
-    attempts: int = 6
-    time_limit: float = 60.0
-
-    def region(self, chain: ShapeChain) -> tuple[float, float, float, float]:
-        """The ground region in use."""
-        if self.ground_region is not None:
-            return tuple(float(v) for v in self.ground_region)  # type: ignore[return-value]
-        pts = np.vstack(chain.targets)
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        pad = self.margin * chain.size
-        return (float(lo[0] - pad), float(lo[1] - pad), float(hi[0] + pad), float(hi[1] + pad))
+#: Fixed pivots sampled in the ground region per body (candidates by kinematic inversion).
+REGION_SAMPLES = 81
 
 
 @dataclass(frozen=True)
@@ -185,7 +128,7 @@ def body_candidates(
 ) -> list[Candidate]:
     """Ranked RR dyads guiding ``body`` relative to each anchor (best first)."""
     p = chain.count
-    xmin, ymin, xmax, ymax = options.region(chain)
+    region = options.region_of(chain.targets, chain.size)
     out: list[Candidate] = []
     g_body = chain.body(body).displacements
     limit = math.sin(options.min_transmission)
@@ -193,12 +136,14 @@ def body_candidates(
         g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
         rel = relative(g_anchor, g_body)
         pivots = _pivot_candidates(chain, body, rel, options)
+        if anchor == "ground":
+            pivots += _pivots_from_region(chain, rel, region)
         for m, dyad in pivots:
             c = dyad.centre_point
             r = dyad.radius
             if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
                 continue
-            if anchor == "ground" and not (xmin <= c[0] <= xmax and ymin <= c[1] <= ymax):
+            if anchor == "ground" and not bool(region.contains(c)[0]):
                 continue
             world_m = np.array([apply(x, m) for x in g_body])
             world_c = np.array([apply(x, c) for x in g_anchor])
@@ -243,6 +188,26 @@ def _pivot_candidates(
         for m in grid:
             d = guidance.fit_circle_point(rel, m)
             out.append((d.circle_point, d))
+    return out
+
+
+def _pivots_from_region(chain: ShapeChain, rel: Array, region: GroundRegion) -> list[tuple[Array, guidance.Dyad]]:
+    """Dyads whose fixed pivot is sampled in the ground region: the moving pivot by kinematic inversion.
+
+    Seen from the body, a fixed pivot ``c`` takes the positions of the inverted motion; the moving pivot is the
+    centre of the circle through them (exact for three positions, least squares beyond), McCarthy ch. 4.
+    """
+    inverse = guidance.inverse_poses(rel)
+    out: list[tuple[Array, guidance.Dyad]] = []
+    for c in region.samples(REGION_SAMPLES):
+        try:
+            inv = guidance.centre_point(inverse, c)
+        except LinkworkError:
+            continue
+        m = inv.centre_point
+        if not np.all(np.isfinite(m)):
+            continue
+        out.append((m, guidance.Dyad(m, np.asarray(c, dtype=float), inv.radius, inv.structural_error)))
     return out
 
 
@@ -406,8 +371,7 @@ def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) 
     MechanizationError
         When no pivot pair on the ground and the body has a monotonic length.
     """
-    xmin, ymin, xmax, ymax = options.region(chain)
-    grid = np.array([(x, y) for x in np.linspace(xmin, xmax, 9) for y in np.linspace(ymin, ymax, 9)])
+    grid = options.region_of(chain.targets, chain.size).samples(REGION_SAMPLES)
     g = chain.body(body).displacements
     best, best_score = None, -math.inf
     for m in _moving_pivots(chain, body, options.candidates, options.link_offset):

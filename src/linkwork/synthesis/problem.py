@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,6 +43,11 @@ class Problem:
         A name per profile (file stem by default).
     source
         The problem file this came from, if any (for messages and relative paths).
+    mechanize
+        Whether ``linkwork synth`` also mechanizes the chain.
+    mechanize_options
+        The mechanization keys of the problem file, in file units (degrees), already checked; read them with
+        :func:`linkwork.mechanization.options_from_values`.
     """
 
     profiles: tuple[NDArray[np.float64], ...]
@@ -56,6 +62,7 @@ class Problem:
     names: tuple[str, ...] = field(default=())
     source: Path | None = None
     mechanize: bool = False
+    mechanize_options: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def count(self) -> int:
