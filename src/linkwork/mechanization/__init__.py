@@ -12,8 +12,8 @@ from linkwork.mechanization.guidance import (
     fit_circle_point,
 )
 from linkwork.mechanization.mechanize import Mechanization, mechanize
-from linkwork.mechanization.report import mechanization_dict, write_mechanization
 from linkwork.mechanization.options import GroundRegion, MechanizeOptions, options_from_values
+from linkwork.mechanization.report import mechanization_dict, write_mechanization
 from linkwork.mechanization.search import MechanizationError
 from linkwork.mechanization.verify import ProfileState, Verification, verify
 

@@ -62,12 +62,14 @@ class BinaryLink:
         return float(np.linalg.norm(self.circle - self.centre))
 
     def to_dict(self) -> dict[str, object]:
-        """JSON-ready: lengths as given, angles in degrees."""
+        """JSON-ready: lengths as given, angles in degrees; ``ground_pivot`` is ``None`` when the anchor is a
+        moving body (``fixed_pivot`` is then the anchor pivot on profile 1)."""
         return {
             "name": self.name,
             "type": self.kind,
             "anchor": self.anchor,
             "body": self.body,
+            "ground_pivot": [float(v) for v in self.centre] if self.anchor == "ground" else None,
             "fixed_pivot": [float(v) for v in self.centre],
             "moving_pivot": [float(v) for v in self.circle],
             "length": self.length,

@@ -9,13 +9,14 @@ attempts run out.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
-from linkwork.mechanization.options import MechanizeOptions
+from linkwork.mechanization.options import MechanizeOptions, ProgressCallback
+from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
     Plan,
@@ -28,13 +29,22 @@ from linkwork.synthesis.result import SynthesisResult
 
 
 @dataclass(frozen=True)
+class RankedDesign:
+    """A design that passed verification, and its quality factor (:mod:`linkwork.mechanization.quality`)."""
+
+    design: Design
+    verification: Verification
+    quality: Quality
+
+
+@dataclass(frozen=True)
 class Mechanization:
     """A verified mechanized design and how it was found.
 
     Attributes
     ----------
     design
-        The chain, its binary links and drive.
+        The chain, its binary links and drive: the passing design of highest quality factor.
     verification
         DOF, the state on every profile, the traced paths.
     attempts
@@ -43,6 +53,8 @@ class Mechanization:
         One line per rejected design: why.
     seconds
         Wall time.
+    ranked
+        Up to :data:`KEEP` passing designs, best quality factor first (``ranked[0]`` is ``design``).
     """
 
     design: Design
@@ -50,6 +62,47 @@ class Mechanization:
     attempts: int
     rejected: tuple[str, ...]
     seconds: float
+    ranked: tuple[RankedDesign, ...] = ()
+
+
+#: Passing designs kept and ranked by their quality factor.
+KEEP = 5
+
+
+@dataclass
+class _Search:
+    """The state of one mechanization search: what passed, what came closest, how much was traced."""
+
+    options: MechanizeOptions
+    started: float
+    progress: ProgressCallback | None
+    total: int
+    attempts: int = 0
+    passed: list[RankedDesign] = field(default_factory=list)
+    rejected: list[str] = field(default_factory=list)
+    closest: tuple[int, str] | None = None
+
+    def out_of_time(self) -> bool:
+        return time.perf_counter() - self.started > self.options.time_limit
+
+    def traced(self, label: str, design: Design, check: Verification) -> None:
+        """Record a verified design (passed or rejected) and report progress."""
+        self.attempts += 1
+        if check.passed:
+            final = _with_transmissions(design, check)
+            self.passed.append(RankedDesign(final, check, quality(final, check)))
+        else:
+            self.rejected.append(f"{label}: {check.reason}")
+            reached = len(check.states)
+            if self.closest is None or reached > self.closest[0]:
+                links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
+                self.closest = (
+                    reached,
+                    f"{label} (links {links}; drive {design.drive}) reached {reached} of {design.chain.count} "
+                    f"profiles, then: {check.reason}",
+                )
+        if self.progress is not None:
+            self.progress(self.attempts, self.total, f"{len(self.passed)} passed, {self.attempts} traced")
 
 
 def _design(
@@ -101,7 +154,11 @@ def _design(
 
 
 def mechanize(
-    result: SynthesisResult | ShapeChain, options: MechanizeOptions | None = None, *, name: str | None = None
+    result: SynthesisResult | ShapeChain,
+    options: MechanizeOptions | None = None,
+    *,
+    name: str | None = None,
+    progress: ProgressCallback | None = None,
 ) -> Mechanization:
     """Mechanize a synthesised chain to ``options.dof`` degrees of freedom (1 by default), verified.
 
@@ -113,14 +170,63 @@ def mechanize(
         Designer choices: DOF, ground region, link offsets, anchors, drive, actuator type.
     name
         The mechanism's name (default: from the problem file).
+    progress
+        Called as ``progress(done, total, message)`` after every design traced (``total``: the most the search
+        will trace).
 
     Raises
     ------
     MechanizationError
-        When no design passes: the last reason, and how many designs were tried.
+        When no design passes: the design that came closest (the most profiles reached) and what it violated,
+        and how many designs were tried.
     """
-    started = time.perf_counter()
     options = options or MechanizeOptions()
+    _check(options)
+    if isinstance(result, ShapeChain):
+        chain = result
+        label = name or "mechanized chain"
+    else:
+        chain = build_chain(result)
+        source = result.problem.source
+        label = name or (f"{source.parent.name} mechanized" if source is not None else "mechanized chain")
+    if chain.count < 2:
+        raise MechanizationError("mechanize: needs at least two profiles to move between")
+    modes = ("ground", "any") if options.anchors == "auto" else (options.anchors,)
+    order = roots(chain, options)
+    state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
+    for root in order:
+        for mode in modes:
+            if state.out_of_time() or len(state.passed) >= KEEP:
+                break
+            opts = replace(options, anchors=mode)
+            try:
+                pl = plan(chain, root, opts)
+            except MechanizationError as exc:
+                state.rejected.append(f"root {root}, anchors {mode}: {exc}")
+                if state.closest is None:
+                    state.closest = (-1, f"root {root}, anchors {mode}: {exc}")
+                continue
+            _search(chain, pl, opts, label, state)
+        if state.passed:  # the designs of one root are compared; other roots only when none passed
+            break
+    seconds = time.perf_counter() - state.started
+    if state.passed:
+        ranked = tuple(sorted(state.passed, key=lambda r: -r.quality.factor)[:KEEP])
+        best = ranked[0]
+        return Mechanization(
+            best.design, best.verification, state.attempts, tuple(state.rejected), seconds, ranked
+        )
+    closest = state.closest[1].removeprefix("mechanize: ") if state.closest else "no design"
+    timed_out = " (time limit reached)" if state.out_of_time() else ""
+    raise MechanizationError(
+        f"mechanize: no design passes after {state.attempts} traced{timed_out}"
+        + (f" (DOF {options.dof} asked for)" if options.dof != 1 else "")
+        + f"; closest: {closest}"
+    )
+
+
+def _check(options: MechanizeOptions) -> None:
+    """Reject options no search can use (the problem reader and the flags check them too)."""
     if options.dof < 1:
         raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
     if options.actuator not in ("revolute", "prismatic"):
@@ -131,40 +237,6 @@ def mechanize(
         raise MechanizationError(
             f"mechanize: anchors {options.anchors!r}: expected 'ground', 'any' or 'auto'"
         )
-    if isinstance(result, ShapeChain):
-        chain = result
-        label = name or "mechanized chain"
-    else:
-        chain = build_chain(result)
-        source = result.problem.source
-        label = name or (f"{source.parent.name} mechanized" if source is not None else "mechanized chain")
-    if chain.count < 2:
-        raise MechanizationError("mechanize: needs at least two profiles to move between")
-    rejected: list[str] = []
-    attempts = 0
-    modes = ("ground", "any") if options.anchors == "auto" else (options.anchors,)
-    for root in roots(chain, options):
-        for mode in modes:
-            if time.perf_counter() - started > options.time_limit:
-                break
-            opts = replace(options, anchors=mode)
-            try:
-                pl = plan(chain, root, opts)
-            except MechanizationError as exc:
-                rejected.append(f"root {root}, anchors {mode}: {exc}")
-                continue
-            found, tried = _search(chain, pl, opts, label, rejected)
-            attempts += tried
-            if found is not None:
-                design = _with_transmissions(*found)
-                return Mechanization(
-                    design, found[1], attempts, tuple(rejected), time.perf_counter() - started
-                )
-    last = rejected[-1].split(": ", 1)[1] if rejected else "no design"
-    raise MechanizationError(
-        f"mechanize: no design passes after {attempts} traced ({len(rejected)} rejected); the last: {last}"
-        + (f" (DOF {options.dof} asked for)" if options.dof != 1 else "")
-    )
 
 
 def _with_transmissions(design: Design, check: Verification) -> Design:
@@ -185,10 +257,9 @@ def _with_transmissions(design: Design, check: Verification) -> Design:
     return replace(design, links=links)
 
 
-def _search(
-    chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, rejected: list[str]
-) -> tuple[tuple[Design, Verification] | None, int]:
-    """Trace designs of one plan, replacing the link blamed for each defect, until one passes."""
+def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, state: _Search) -> None:
+    """Trace designs of one plan, replacing the link blamed for each defect; after a pass, vary the links to
+    find further passing designs to rank, until :data:`KEEP` passed or the attempts or the time run out."""
     choice = [0] * len(pl.steps)
     root_pair = 0
     index: dict[str, int] = {}
@@ -198,18 +269,19 @@ def _search(
             count += 1
             index[f"D{count}"] = i
     for attempt in range(1, options.attempts + 1):
+        if state.out_of_time() or len(state.passed) >= KEEP:
+            return
         design = _design(chain, pl, root_pair, choice, options, label)
         if options.drive is not None and options.drive not in design.joint_names():
             raise MechanizationError(
                 f"mechanize: unknown drive joint {options.drive!r}; joints are {', '.join(design.joint_names())}"
             )
         check = verify(design)
-        if check.passed:
-            return (design, check), attempt
-        rejected.append(f"root {pl.root}, anchors {options.anchors}, design {attempt}: {check.reason}")
+        state.traced(f"root {pl.root}, anchors {options.anchors}, design {attempt}", design, check)
         if check.defect == "dof":
-            break
-        culprit = check.culprit
+            return
+        # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
+        culprit = _weakest(state.passed[-1].design) if check.passed else check.culprit
         if culprit in index and choice[index[culprit]] + 1 < len(pl.steps[index[culprit]].candidates) - 1:
             choice[index[culprit]] += 1
             continue
@@ -218,9 +290,14 @@ def _search(
             continue
         movable = [i for i, s in enumerate(pl.steps) if choice[i] + 1 < len(s.candidates) - 1]
         if not movable:
-            break
+            return
         choice[movable[attempt % len(movable)]] += 1
-    return None, options.attempts
 
 
-__all__ = ["Mechanization", "MechanizationError", "MechanizeOptions", "mechanize"]
+def _weakest(design: Design) -> str | None:
+    """The binary link with the smallest transmission angle."""
+    links = [link for link in design.links if link.kind == "RR"]
+    return min(links, key=lambda link: link.transmission).name if links else None
+
+
+__all__ = ["Mechanization", "MechanizationError", "MechanizeOptions", "RankedDesign", "mechanize"]

@@ -172,7 +172,9 @@ class MechanizeOptions:
             return g
         if isinstance(g, str):
             if g != "inside":
-                raise SpecError(f'ground_region "{g}": expected a box, a polygon or "inside"', key="ground_region")
+                raise SpecError(
+                    f'ground_region "{g}": expected a box, a polygon or "inside"', key="ground_region"
+                )
             return GroundRegion.inside(targets)
         if g is None:
             pts = np.vstack(targets)
@@ -186,9 +188,13 @@ class MechanizeOptions:
 
 
 # ------------------------------------------------------------------------------------- file units -> options
-def _error(key: str, expected: str, value: Any, source: str | None) -> SpecError:
+class _Bad(ValueError):
+    """A bad option value (the caller names the key or the flag)."""
+
+
+def _error(expected: str, value: Any) -> _Bad:
     shown = f'"{value}"' if isinstance(value, str) else repr(value)
-    return SpecError(f"expected {expected}, got {shown}", source=source, key=key)
+    return _Bad(f"expected {expected}, got {shown}")
 
 
 def _number(value: Any) -> float | None:
@@ -197,28 +203,31 @@ def _number(value: Any) -> float | None:
     return float(value)
 
 
-def _region(value: Any, source: str | None) -> Any:
+def _region(value: Any) -> Any:
     expected = '"inside", a box [xmin, ymin, xmax, ymax] or a polygon [[x, y], ...] of at least 3 vertices'
     if isinstance(value, str):
         if value.strip().lower() == "inside":
             return "inside"
-        raise _error("ground_region", expected, value, source)
+        raise _error(expected, value)
     if isinstance(value, list) and len(value) == 4 and all(_number(v) is not None for v in value):
         x0, y0, x1, y1 = (float(v) for v in value)
         if x0 < x1 and y0 < y1:
             return (x0, y0, x1, y1)
-        raise SpecError("a box needs xmin < xmax and ymin < ymax", source=source, key="ground_region")
+        raise _Bad("a box needs xmin < xmax and ymin < ymax")
     if (
         isinstance(value, list)
         and len(value) >= 3
         and all(isinstance(v, list) and len(v) == 2 and all(_number(c) is not None for c in v) for v in value)
     ):
         return np.array(value, dtype=float)
-    raise _error("ground_region", expected, value, source)
+    raise _error(expected, value)
 
 
 _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
-    "dof": (lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None, "a whole number >= 1"),
+    "dof": (
+        lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None,
+        "a whole number >= 1",
+    ),
     "drive": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a joint name"),
     "root": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a body name"),
     "actuator": (lambda v: v if v in ("revolute", "prismatic") else None, '"revolute" or "prismatic"'),
@@ -229,18 +238,28 @@ _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
         lambda v: math.radians(n) if (n := _number(v)) is not None and 0 <= n < 90 else None,
         "an angle in degrees, 0 <= min_transmission < 90",
     ),
-    "attempts": (lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None, "a whole number >= 1"),
-    "time_limit": (lambda v: n if (n := _number(v)) is not None and n > 0 else None, "a positive number of seconds"),
+    "attempts": (
+        lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None,
+        "a whole number >= 1",
+    ),
+    "time_limit": (
+        lambda v: n if (n := _number(v)) is not None and n > 0 else None,
+        "a positive number of seconds",
+    ),
 }
 
 
 def options_from_values(
-    values: Mapping[str, Any], *, source: str | None = None, base: MechanizeOptions | None = None
+    values: Mapping[str, Any],
+    *,
+    source: str | None = None,
+    base: MechanizeOptions | None = None,
+    flags: bool = False,
 ) -> MechanizeOptions:
     """Options from file units (``min_transmission`` in degrees), checked; ``base`` gives the rest.
 
-    ``values`` holds problem-file keys or command-line flags (``None`` values are left at ``base``'s). Unknown
-    keys are not allowed.
+    ``values`` holds problem-file keys or command-line flags (``None`` values are left at ``base``'s; with
+    ``flags`` a mistake names the flag, ``--max-link``, instead of the key). Unknown keys are not allowed.
 
     Raises
     ------
@@ -251,20 +270,28 @@ def options_from_values(
     for key, value in values.items():
         if value is None:
             continue
-        if key == "ground_region":
-            out[key] = _region(value, source)
-            continue
-        if key not in _CHECKS:
-            raise SpecError(f"unknown mechanization option; expected one of {', '.join(OPTION_KEYS)}", source=source, key=key)
-        check, expected = _CHECKS[key]
-        checked = check(value)
-        if checked is None:
-            raise _error(key, expected, value, source)
-        out[key] = checked
+        try:
+            out[key] = _checked(key, value)
+        except _Bad as bad:
+            shown = "--" + key.replace("_", "-") if flags else key
+            raise SpecError(str(bad), source=source, key=shown) from None
     names = {f.name for f in fields(MechanizeOptions)}
     assert set(out) <= names
     base = base or MechanizeOptions()
     return MechanizeOptions(**{**{f.name: getattr(base, f.name) for f in fields(base)}, **out})
+
+
+def _checked(key: str, value: Any) -> Any:
+    """One option's value in API units, or :class:`_Bad`."""
+    if key == "ground_region":
+        return _region(value)
+    if key not in _CHECKS:
+        raise _Bad(f"unknown mechanization option; expected one of {', '.join(OPTION_KEYS)}")
+    check, expected = _CHECKS[key]
+    checked = check(value)
+    if checked is None:
+        raise _error(expected, value)
+    return checked
 
 
 def parse_region_flag(text: str | None) -> Any:

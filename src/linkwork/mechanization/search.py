@@ -191,7 +191,9 @@ def _pivot_candidates(
     return out
 
 
-def _pivots_from_region(chain: ShapeChain, rel: Array, region: GroundRegion) -> list[tuple[Array, guidance.Dyad]]:
+def _pivots_from_region(
+    chain: ShapeChain, rel: Array, region: GroundRegion
+) -> list[tuple[Array, guidance.Dyad]]:
     """Dyads whose fixed pivot is sampled in the ground region: the moving pivot by kinematic inversion.
 
     Seen from the body, a fixed pivot ``c`` takes the positions of the inverted motion; the moving pivot is the
