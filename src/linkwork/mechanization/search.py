@@ -35,6 +35,9 @@ Array = NDArray[np.float64]
 #: Fixed pivots sampled in the ground region per body (candidates by kinematic inversion).
 REGION_SAMPLES = 81
 
+#: With more than five profiles, this many moving pivots per body are moved to fit a circle best.
+POLISHED = 12
+
 
 @dataclass(frozen=True)
 class Candidate:
@@ -185,7 +188,12 @@ def _pivot_candidates(
     elif p == 5:
         out = [(d.circle_point, d) for d in guidance.burmester_points(rel)]
     else:
-        for m in grid:
+        # least squares: every grid point's best circle (fast), then the circle point itself moved to fit best
+        # (a small optimisation each) for the few that fit best already
+        rough = [(m, d) for m in grid if (d := _guide(rel, m)) is not None]
+        rough.sort(key=lambda md: md[1].structural_error)
+        out = rough[POLISHED:]
+        for m, _ in rough[:POLISHED]:
             d = guidance.fit_circle_point(rel, m)
             out.append((d.circle_point, d))
     return out
