@@ -8,6 +8,7 @@ attempts run out.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 
@@ -15,7 +16,7 @@ import numpy as np
 
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
-from linkwork.mechanization.options import MechanizeOptions, ProgressCallback
+from linkwork.mechanization.options import MechanizeOptions, ProgressCallback, options_from_values
 from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
@@ -124,14 +125,8 @@ def _design(
         first = step.candidates[k].link
         add(first)
         if step.links == 2:
-            size = chain.size
             second = next(
-                (
-                    c.link
-                    for c in step.candidates[k + 1 :]
-                    if c.link.anchor != first.anchor
-                    or np.linalg.norm(c.link.circle - first.circle) > 0.1 * size
-                ),
+                (c.link for c in step.candidates[k + 1 :] if _independent(first, c.link, chain.size, options)),
                 step.candidates[(k + 1) % len(step.candidates)].link,
             )
             add(second)
@@ -141,16 +136,28 @@ def _design(
         drive = options.drive
     elif options.actuator == "prismatic":
         drive = "A1s"
+    elif any(link.kind == "PR" for link in links):
+        drive = next(f"{link.name}s" for link in links if link.kind == "PR")  # a slider drives (paper, Fig. 14)
     elif pl.pinned_root is not None:
         drive = pl.pinned_root
     else:
-        drive = "D1a"
+        drive = links[0].joint_names()[0]  # the root's crank
     notes = (
         f"root body {pl.root}",
         f"bodies closed by two chain joints: {', '.join(pl.paired) or 'none'}",
         f"bodies left free (extra inputs): {', '.join(pl.free) or 'none'}",
     )
     return Design(chain, tuple(links), drive, options.dof, name, notes)
+
+
+def _independent(first: BinaryLink, second: BinaryLink, size: float, options: MechanizeOptions) -> bool:
+    """Two links that together can hold a body: apart, and two sliders not on parallel guides."""
+    if first.kind == "PR" and second.kind == "PR" and first.anchor == second.anchor:
+        assert first.direction is not None and second.direction is not None
+        sine = abs(float(first.direction[0] * second.direction[1] - first.direction[1] * second.direction[0]))
+        if sine < math.sin(options.min_transmission):
+            return False
+    return first.anchor != second.anchor or float(np.linalg.norm(second.circle - first.circle)) > 0.1 * size
 
 
 def mechanize(
@@ -167,7 +174,8 @@ def mechanize(
     result
         A synthesis result (its compound chain is used when joints were merged), or a chain already built.
     options
-        Designer choices: DOF, ground region, link offsets, anchors, drive, actuator type.
+        Designer choices: DOF, ground region, link offsets, anchors, drive, actuator type (default: the
+        problem file's mechanization keys).
     name
         The mechanism's name (default: from the problem file).
     progress
@@ -180,7 +188,9 @@ def mechanize(
         When no design passes: the design that came closest (the most profiles reached) and what it violated,
         and how many designs were tried.
     """
-    options = options or MechanizeOptions()
+    if options is None:
+        problem = getattr(result, "problem", None)
+        options = options_from_values(problem.mechanize_options) if problem is not None else MechanizeOptions()
     _check(options)
     if isinstance(result, ShapeChain):
         chain = result
@@ -232,6 +242,10 @@ def _check(options: MechanizeOptions) -> None:
     if options.actuator not in ("revolute", "prismatic"):
         raise MechanizationError(
             f"mechanize: actuator {options.actuator!r}: expected 'revolute' or 'prismatic'"
+        )
+    if options.binary_links not in ("revolute", "prismatic", "both"):
+        raise MechanizationError(
+            f"mechanize: binary_links {options.binary_links!r}: expected 'revolute', 'prismatic' or 'both'"
         )
     if options.anchors not in ("ground", "any", "auto"):
         raise MechanizationError(
@@ -296,7 +310,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
 
 def _weakest(design: Design) -> str | None:
     """The binary link with the smallest transmission angle."""
-    links = [link for link in design.links if link.kind == "RR"]
+    links = [link for link in design.links if link.kind in ("RR", "PR")]
     return min(links, key=lambda link: link.transmission).name if links else None
 
 

@@ -35,6 +35,7 @@ OPTION_KEYS = (
     "attempts",
     "time_limit",
     "root",
+    "binary_links",
 )
 
 ProgressCallback = Callable[[int, int, str], None]
@@ -145,6 +146,9 @@ class MechanizeOptions:
         ground (``ground_region``) and the root and drive its slider.
     candidates
         Moving-pivot candidates along each body (times 7 offsets).
+    binary_links
+        ``"revolute"``: RR dyads; ``"prismatic"``: PR sliders (a slider on a straight guide of the frame or of a
+        body, pivoted to the moving body; its prismatic joint can drive); ``"both"``.
     attempts
         Designs traced at most per root and anchor choice.
     time_limit
@@ -161,6 +165,7 @@ class MechanizeOptions:
     root: str | None = None
     drive: str | None = None
     actuator: str = "revolute"
+    binary_links: str = "revolute"
     candidates: int = 9
     attempts: int = 6
     time_limit: float = 60.0
@@ -232,6 +237,10 @@ _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
     "root": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a body name"),
     "actuator": (lambda v: v if v in ("revolute", "prismatic") else None, '"revolute" or "prismatic"'),
     "anchors": (lambda v: v if v in ("ground", "any", "auto") else None, '"ground", "any" or "auto"'),
+    "binary_links": (
+        lambda v: v if v in ("revolute", "prismatic", "both") else None,
+        '"revolute", "prismatic" or "both"',
+    ),
     "link_offset": (lambda v: n if (n := _number(v)) is not None and n >= 0 else None, "a number >= 0"),
     "max_link": (lambda v: n if (n := _number(v)) is not None and n > 0 else None, "a positive number"),
     "min_transmission": (

@@ -8,10 +8,11 @@ The quality factor of a design is the product of three numbers between 0 and 1 (
   angle between a link and the direction its moving pivot is free to move in; 90 degrees is best, 0 a dead
   centre), and for a linear actuator the angle between it and its pivot's path;
 * ``L_min / L_max``: the link-length ratio, shortest over longest binary link (a linear actuator counts with its
-  shortest and longest length);
+  shortest and longest length; a slider has no length and does not count);
 * ``f_stroke``: the actuator stroke. For a linear actuator ``min(1, L_retracted / stroke)`` (a single-stage
   actuator cannot extend by more than its retracted length); for a revolute drive ``min(1, 180 deg / sweep)``
-  (a crank that turns more than half a revolution between the first and last profile needs a gear).
+  (a crank that turns more than half a revolution between the first and last profile needs a gear); 1 for a
+  slider's drive.
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def quality(design: Design, check: Verification) -> Quality:
         mu = min(mu, link.transmission)
         if link.kind == "RR":
             lengths.append(link.length)
-        else:
+        elif link.kind == "RPR":
             slide = names.index(f"{link.name}s")
             extent = link.length + np.array([s.values[slide] for s in check.states])
             lengths += [float(extent.min()), float(extent.max())]
@@ -82,7 +83,9 @@ def quality(design: Design, check: Verification) -> Quality:
         slide = names.index(design.drive)
         retracted = actuator.length + min(s.values[slide] for s in check.states)
         f_stroke = min(1.0, retracted / stroke) if stroke > 0 else 1.0
-    else:
+    elif design.drive.endswith("a") or design.drive.startswith("J"):
         f_stroke = min(1.0, math.pi / stroke) if stroke > 0 else 1.0
+    else:  # a slider or the chain's own prismatic joint: its guide is as long as it must be
+        f_stroke = 1.0
     factor = math.sin(max(0.0, mu)) / ratio * f_stroke
     return Quality(factor, mu, ratio, stroke, f_stroke)

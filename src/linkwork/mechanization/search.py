@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, MechanizationError
-from linkwork.mechanization import guidance
+from linkwork.mechanization import guidance, sliders
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, apply, relative
 from linkwork.mechanization.options import GroundRegion, MechanizeOptions
@@ -129,43 +129,110 @@ def body_candidates(
     options: MechanizeOptions,
     name: str = "D",
 ) -> list[Candidate]:
-    """Ranked RR dyads guiding ``body`` relative to each anchor (best first)."""
+    """Ranked binary links guiding ``body`` relative to each anchor (best first): RR dyads and, as
+    ``options.binary_links`` allows, PR sliders."""
     p = chain.count
     region = options.region_of(chain.targets, chain.size)
     out: list[Candidate] = []
     g_body = chain.body(body).displacements
-    limit = math.sin(options.min_transmission)
     for anchor in anchors:
         g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
         rel = relative(g_anchor, g_body)
-        pivots = _pivot_candidates(chain, body, rel, options)
-        if anchor == "ground":
-            pivots += _pivots_from_region(chain, rel, region)
-        for m, dyad in pivots:
-            c = dyad.centre_point
-            r = dyad.radius
-            if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
-                continue
-            if anchor == "ground" and not bool(region.contains(c)[0]):
-                continue
-            world_m = np.array([apply(x, m) for x in g_body])
-            world_c = np.array([apply(x, c) for x in g_anchor])
-            u = world_m - world_c
-            u /= np.linalg.norm(u, axis=1, keepdims=True)
-            free = _free_directions(chain, body, via, m)
-            if free is not None and np.any(~np.isfinite(free)):
-                continue
-            s = _quality(u, free)
-            if free is not None and (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0))):
-                continue
-            mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
-            ratio = abs(math.log(r / (0.5 * chain.size)))
-            score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
-            link = BinaryLink(
-                name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via
-            )
-            out.append(Candidate(link, score, s))
+        if options.binary_links in ("revolute", "both"):
+            pivots = _pivot_candidates(chain, body, rel, options)
+            if anchor == "ground":
+                pivots += _pivots_from_region(chain, rel, region)
+            out += _rr_candidates(chain, body, via, anchor, pivots, options, region, name)
+        if options.binary_links in ("prismatic", "both"):
+            out += _slider_candidates(chain, body, via, anchor, rel, options, region, name)
     out.sort(key=lambda cand: -cand.score)
+    return out
+
+
+def _accepts(s: Array | None, options: MechanizeOptions) -> bool:
+    """Transmission above the limit on every profile, one assembly mode throughout (one sign)."""
+    if s is None:
+        return True
+    limit = math.sin(options.min_transmission)
+    return not (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0)))
+
+
+def _rr_candidates(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    anchor: str,
+    pivots: list[tuple[Array, guidance.Dyad]],
+    options: MechanizeOptions,
+    region: GroundRegion,
+    name: str,
+) -> list[Candidate]:
+    """RR dyads from their pivots: long, short, outside the region or badly transmitting ones dropped."""
+    p = chain.count
+    g_body = chain.body(body).displacements
+    g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+    out = []
+    for m, dyad in pivots:
+        c = dyad.centre_point
+        r = dyad.radius
+        if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
+            continue
+        if anchor == "ground" and not bool(region.contains(c)[0]):
+            continue
+        world_m = np.array([apply(x, m) for x in g_body])
+        world_c = np.array([apply(x, c) for x in g_anchor])
+        u = world_m - world_c
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        free = _free_directions(chain, body, via, m)
+        if free is not None and np.any(~np.isfinite(free)):
+            continue
+        s = _quality(u, free)
+        if not _accepts(None if free is None else s, options):
+            continue
+        mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+        ratio = abs(math.log(r / (0.5 * chain.size)))
+        score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
+        link = BinaryLink(name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via)
+        out.append(Candidate(link, score, s))
+    return out
+
+
+def _slider_candidates(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    anchor: str,
+    rel: Array,
+    options: MechanizeOptions,
+    region: GroundRegion,
+    name: str,
+) -> list[Candidate]:
+    """PR sliders: slider points of the body (exact for three profiles), guides fitted through their positions,
+    kept when the slider moves one way, its guide lies in the region (on the ground) and it transmits well."""
+    p = chain.count
+    g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+    grid = _moving_pivots(chain, body, max(3, options.candidates // 2), options.link_offset)
+    out = []
+    for g in grid:
+        for v in (np.array([1.0, 0.0]), np.array([0.0, 1.0])):
+            for m in sliders.slider_points(rel, g, v * chain.size, reach=options.link_offset):
+                start, u, travel, error = sliders.fit_guide(rel, m)
+                if not sliders.monotonic(travel, chain.size) or error > 0.05 * chain.size:
+                    continue
+                ends = start + np.outer([travel[0], travel[-1]], u)
+                if anchor == "ground" and not np.all(region.contains(ends)):
+                    continue
+                free = _free_directions(chain, body, via, m)
+                if free is not None and np.any(~np.isfinite(free)):
+                    continue
+                world_u = np.array([apply(np.array([0.0, 0.0, x[2]]), u) for x in g_anchor])
+                s = sliders.transmission(world_u, free) if free is not None else np.ones(p)
+                if not _accepts(None if free is None else s, options):
+                    continue
+                mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+                score = math.degrees(mu) - 1e3 * error / chain.size
+                link = BinaryLink(name, "PR", anchor, body, start, np.asarray(m, float), error, mu, via, u)
+                out.append(Candidate(link, score, s))
     return out
 
 
@@ -342,11 +409,12 @@ def _root_pairs(
     out = []
     for i, a in enumerate(singles):
         wa = np.array([apply(x, a.link.circle) for x in g])
-        ca = a.link.centre
-        phi = np.unwrap(np.arctan2(wa[:, 1] - ca[1], wa[:, 0] - ca[0]))
-        dphi = np.diff(phi)
-        if not (np.all(dphi > 1e-6) or np.all(dphi < -1e-6)):
-            continue  # the crank must turn one way through the profiles (order)
+        if a.link.kind == "RR":
+            ca = a.link.centre
+            phi = np.unwrap(np.arctan2(wa[:, 1] - ca[1], wa[:, 0] - ca[0]))
+            dphi = np.diff(phi)
+            if not (np.all(dphi > 1e-6) or np.all(dphi < -1e-6)):
+                continue  # the crank must turn one way through the profiles (order); a slider does by choice
         for b in singles[i + 1 :]:
             wb = np.array([apply(x, b.link.circle) for x in g])
             coupler = wb - wa
@@ -354,19 +422,26 @@ def _root_pairs(
             if np.any(n < 0.05 * chain.size):
                 continue
             perp = np.column_stack([-coupler[:, 1], coupler[:, 0]]) / n[:, None]
-            ub = (wb - b.link.centre) / b.link.length
-            ua = (wa - ca) / a.link.length
-            s_b = np.sum(ub * perp, axis=1)  # transmission at the rocker
-            s_a = np.sum(ua * perp, axis=1)  # crank against coupler: away from the crank's dead centre
+            s_b = np.sum(_pull(b.link, wb) * perp, axis=1)  # transmission at the rocker
+            s_a = np.sum(_pull(a.link, wa) * perp, axis=1)  # crank against coupler: away from its dead centre
             ok = all(np.all(np.abs(s) >= limit) and (np.all(s > 0) or np.all(s < 0)) for s in (s_a, s_b))
             if not ok:
                 continue
             mu = math.degrees(float(np.arcsin(min(1.0, float(min(np.abs(s_a).min(), np.abs(s_b).min()))))))
-            lengths = [a.link.length, b.link.length, float(n[0])]
+            lengths = [link.length for link in (a.link, b.link) if link.kind == "RR"] + [float(n[0])]
             ratio = max(lengths) / min(lengths)
             out.append((a, b, mu - 10.0 * math.log(ratio)))
     out.sort(key=lambda t: -t[2])
     return out[:40]
+
+
+def _pull(link: BinaryLink, w: Array) -> Array:
+    """``(p, 2)`` the unit direction a ground link acts on its moving pivot at positions ``w``: along an RR
+    link, along the normal of a slider's guide."""
+    if link.kind == "PR":
+        assert link.direction is not None
+        return np.tile([-link.direction[1], link.direction[0]], (len(w), 1))
+    return (w - link.centre) / link.length
 
 
 def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) -> BinaryLink:

@@ -281,7 +281,8 @@ def _circuit_culprit(design: Design, mech: Mechanism, values: Array, j: int) -> 
 
 
 def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
-    """Sine of every RR link's transmission angle at joint displacements ``values`` (0: a dead centre).
+    """Sine of every RR link's (and PR slider's) transmission angle at joint displacements ``values`` (0: a dead
+    centre).
 
     The angle at the moving pivot between the link and the line to the point that, with the link, places the
     body: the body's chain joint ``via``, or the other root link's moving pivot.
@@ -293,11 +294,16 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     links = {link.name: link for link in design.links}
     out: dict[str, float] = {}
     for link in design.links:
-        if link.kind != "RR" or link.via is None:
+        if link.kind not in ("RR", "PR") or link.via is None:
             continue
         m = apply(disp[link.body], link.circle)
-        c = apply(disp[link.name], link.centre)
-        u = (m - c) / max(float(np.linalg.norm(m - c)), 1e-300)
+        if link.kind == "PR":  # the guide reacts along its normal
+            assert link.direction is not None
+            d = apply(np.array([0.0, 0.0, disp[link.anchor][2]]), link.direction)
+            u = np.array([-d[1], d[0]])
+        else:
+            c = apply(disp[link.name], link.centre)
+            u = (m - c) / max(float(np.linalg.norm(m - c)), 1e-300)
         if link.via in joints:
             jt = joints[link.via]
             if jt.kind == "P":
