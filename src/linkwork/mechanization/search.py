@@ -353,37 +353,37 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
     order = order[: len(order) - extra] if extra else order
     steps = []
     done = ["ground", root]
-    deferred: str | None = None
+    deferred: list[str] = []  # bodies no single dyad can guide: a body placed from each takes two
+    joints = {j.name: j for j in chain.joints}
     for body, via in order:
         anchors = ["ground"]
         if options.anchors == "any":
             adjacent = {o for _, o in _adjacent(chain, body)}
             anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
-        if deferred is not None:
-            # the body before had no dyad: this one takes two, and the pair is placed together
+        parent = next(b for b in joints[via].bodies if b != body)
+        if parent in deferred:
+            # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)
             if len(cands) >= 2:
                 steps.append(Step(body, None, tuple(cands), 2))
-                done += [deferred, body]
-                deferred = None
+                done += [parent, body]
+                deferred.remove(parent)
                 continue
+            raise MechanizationError(
+                f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it: "
+                f"every candidate pivot leaves the ground region, is too long, has a transmission angle below "
+                f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
+                "(try a larger ground region or link offset)"
+            )
+        cands = body_candidates(chain, body, via, anchors, options)
+        if cands:
+            steps.append(Step(body, via, tuple(cands)))
+            done.append(body)
         else:
-            cands = body_candidates(chain, body, via, anchors, options)
-            if cands:
-                steps.append(Step(body, via, tuple(cands)))
-                done.append(body)
-                continue
-            deferred = body
-            continue
+            deferred.append(body)
+    if deferred:
         raise MechanizationError(
-            f"mechanize: no dyad can guide body {deferred or body} (root {root}): every candidate pivot leaves "
-            f"the ground region, is too long, has a transmission angle below "
-            f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
-            "(try a larger ground region or link offset)"
-        )
-    if deferred is not None:
-        raise MechanizationError(
-            f"mechanize: no dyad can guide body {deferred} (root {root}), the last body placed from it "
+            f"mechanize: no dyad can guide body {deferred[0]} (root {root}), the last body placed from it "
             f"(transmission angle below {math.degrees(options.min_transmission):.0f} deg or a change of "
             "assembly mode between profiles; try a larger ground region or link offset)"
         )

@@ -1,0 +1,68 @@
+"""The bundled wing mechanized with ``ground_region = "inside"``: every fixed pivot inside every airfoil outline
+(checked with matplotlib's point-in-polygon on the Selig files as written), every binary link no longer than the
+cruise chord (1.0), and the written mechanism, traced, passes through every profile."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from linkwork.io.problem import load_problem
+from linkwork.io.spec import load_spec
+from linkwork.kinematics.tracer import trace
+from linkwork.mechanization import MechanizeOptions, build_chain, mechanize, write_mechanization
+from linkwork.synthesis import synthesize
+
+WING = Path(__file__).resolve().parents[2] / "examples" / "wing"
+CHORD = 1.0  # the cruise profile's chord, the shortest of the three
+
+
+@pytest.fixture(scope="module")
+def inside(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object]:
+    result = synthesize(load_problem(WING / "mechanize.toml"))
+    size = build_chain(result).size
+    options = MechanizeOptions(ground_region="inside", max_link=CHORD / size, attempts=3, time_limit=60.0)
+    found = mechanize(result, options)
+    folder = tmp_path_factory.mktemp("wing-inside")
+    write_mechanization(found, folder)
+    return folder, result
+
+
+def _outline(name: str) -> np.ndarray:
+    return np.loadtxt(WING / name, skiprows=1)
+
+
+def test_every_ground_pivot_is_inside_every_airfoil(inside: tuple) -> None:
+    mpath = pytest.importorskip("matplotlib.path")
+    folder, _ = inside
+    report = json.loads((folder / "mechanization.json").read_text())
+    pivots = [d["ground_pivot"] for d in report["dyads"] if d["ground_pivot"] is not None]
+    assert pivots, "at least the root's links are pivoted on the ground"
+    for name in ("cruise.dat", "climb.dat", "landing.dat"):
+        assert np.all(mpath.Path(_outline(name)).contains_points(pivots)), name
+    for dyad in report["dyads"]:
+        assert (dyad["ground_pivot"] is None) == (dyad["anchor"] != "ground")
+        if dyad["type"] == "RR":
+            assert dyad["length"] <= CHORD + 1e-12
+            # the length is the distance between the pivots as written
+            assert abs(math.dist(dyad["fixed_pivot"], dyad["moving_pivot"]) - dyad["length"]) <= 1e-12
+
+
+def test_the_written_mechanism_traces_through_every_profile(inside: tuple) -> None:
+    folder, result = inside
+    report = json.loads((folder / "mechanization.json").read_text())
+    mech = load_spec(folder / "mechanism.toml").mechanism
+    drive = report["drive"]
+    for j, profile in enumerate(report["profiles"]):
+        # exact three-position guidance: the shape error on every profile is the joined chain's
+        assert abs(profile["e_max"] - float(np.max(result.joined[j].errors))) <= 1e-9
+        if j == 0:
+            continue
+        value = math.radians(profile["drive_value"]) if report["drive_type"] == "R" else profile["drive_value"]
+        path = trace(mech, drive=drive, until=(drive, value))
+        assert path.branches[0].end_reason == "reached target"
+        assert not path.bifurcations
