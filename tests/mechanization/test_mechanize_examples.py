@@ -13,22 +13,16 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
-from linkwork.io.problem import load_problem
 from linkwork.io.spec import load_spec
 from linkwork.kinematics.tracer import trace
-from linkwork.mechanization import MechanizationError, MechanizeOptions, mechanize, write_mechanization
-from linkwork.synthesis import synthesize
+from linkwork.mechanization import MechanizationError, MechanizeOptions, mechanize
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 @pytest.fixture(scope="module")
-def seat(tmp_path_factory: pytest.TempPathFactory) -> tuple[object, object, Path]:
-    result = synthesize(load_problem(EXAMPLES / "seat" / "mechanize.toml"))
-    found = mechanize(result)
-    folder = tmp_path_factory.mktemp("seat")
-    write_mechanization(found, folder)
-    return result, found, folder
+def seat(seat_mechanized: tuple) -> tuple[object, object, Path]:
+    return seat_mechanized
 
 
 def test_seat_is_mechanized_to_one_dof_with_the_joined_error(seat: tuple) -> None:

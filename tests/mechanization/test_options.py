@@ -28,9 +28,9 @@ def _problem(tmp_path: Path, extra: str) -> Path:
 def test_every_option_is_a_problem_key_in_file_units(tmp_path: Path) -> None:
     file = _problem(
         tmp_path,
-        "dof = 2\ndrive = \"J1\"\nactuator = \"prismatic\"\nground_region = \"inside\"\nlink_offset = 0.5\n"
-        "max_link = 0.8\nmin_transmission = 20.0\nanchors = \"any\"\nattempts = 3\ntime_limit = 12.5\n"
-        "root = \"s1\"\nbinary_links = \"both\"\n",
+        'dof = 2\ndrive = "J1"\nactuator = "prismatic"\nground_region = "inside"\nlink_offset = 0.5\n'
+        'max_link = 0.8\nmin_transmission = 20.0\nanchors = "any"\nattempts = 3\ntime_limit = 12.5\n'
+        'root = "s1"\nbinary_links = "both"\n',
     )
     problem = load_problem(file)
     assert set(problem.mechanize_options) == set(OPTION_KEYS)
@@ -77,7 +77,7 @@ def test_a_bad_flag_names_the_flag() -> None:
 
 def test_ground_regions_box_polygon_and_inside() -> None:
     square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0], [0.0, 0.0]])
-    shifted = square + [1.0, 0.0]
+    shifted = square + np.array([1.0, 0.0])
     inside = MechanizeOptions(ground_region="inside").region_of((square, shifted), 3.0)
     assert inside.contains([[1.5, 1.0], [0.5, 1.0], [2.5, 1.0]]).tolist() == [True, False, False]
     box = MechanizeOptions(ground_region=(0.0, 0.0, 1.0, 1.0)).region_of((square,), 2.0)

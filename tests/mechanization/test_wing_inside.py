@@ -62,7 +62,9 @@ def test_the_written_mechanism_traces_through_every_profile(inside: tuple) -> No
         assert abs(profile["e_max"] - float(np.max(result.joined[j].errors))) <= 1e-9
         if j == 0:
             continue
-        value = math.radians(profile["drive_value"]) if report["drive_type"] == "R" else profile["drive_value"]
+        value = (
+            math.radians(profile["drive_value"]) if report["drive_type"] == "R" else profile["drive_value"]
+        )
         path = trace(mech, drive=drive, until=(drive, value))
         assert path.branches[0].end_reason == "reached target"
         assert not path.bifurcations

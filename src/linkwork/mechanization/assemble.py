@@ -79,6 +79,7 @@ class BinaryLink:
             "structural_error": float(self.structural_error),
             "transmission_deg": math.degrees(self.transmission),
             "guide_direction": [float(v) for v in self.direction] if self.direction is not None else None,
+            "via": self.via,
             "joints": self.joint_names(),
         }
 

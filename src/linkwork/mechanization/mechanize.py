@@ -287,9 +287,14 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
             return
         design = _design(chain, pl, root_pair, choice, options, label)
         if options.drive is not None and options.drive not in design.joint_names():
-            raise MechanizationError(
-                f"mechanize: unknown drive joint {options.drive!r}; joints are {', '.join(design.joint_names())}"
+            # a link's joint names depend on the design: this one has no such joint, another may
+            state.rejected.append(
+                f"root {pl.root}, anchors {options.anchors}, design {attempt}: no joint {options.drive!r} "
+                f"(joints are {', '.join(design.joint_names())})"
             )
+            if state.closest is None:
+                state.closest = (-1, state.rejected[-1])
+            return
         check = verify(design)
         state.traced(f"root {pl.root}, anchors {options.anchors}, design {attempt}", design, check)
         if check.defect == "dof":
