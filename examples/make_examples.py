@@ -359,7 +359,10 @@ MECHANIZE_KEYS = {
     "seat": [
         'binary_links = "both"     # RR dyads and prismatic sliders on the frame; a slider drives (paper, Fig. 14)'
     ],
-    "wing-six": ['anchors = "any"          # dyads between bodies too (the trailing edge moves 0.3 chords)'],
+    "wing-six": [
+        'anchors = "any"          # dyads between bodies too (the trailing edge moves 0.3 chords)',
+        "attempts = 3             # designs traced per root: the first passing ones are ranked",
+    ],
 }
 
 
