@@ -16,6 +16,12 @@ Anchors = Annotated[
 Actuator = Annotated[
     str | None, typer.Option(help="'revolute' (a crank) or 'prismatic' (a linear actuator); key actuator.")
 ]
+BinaryLinks = Annotated[
+    str | None,
+    typer.Option(
+        help="'revolute' (RR dyads), 'prismatic' (PR sliders on guides) or 'both'; key binary_links."
+    ),
+]
 GroundRegion = Annotated[
     str | None,
     typer.Option(

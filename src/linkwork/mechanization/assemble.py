@@ -62,6 +62,8 @@ class BinaryLink:
     @property
     def length(self) -> float:
         """Link length (RR), the actuator's length on profile 1 (RPR), 0 for a slider (PR)."""
+        if self.kind == "PR":
+            return 0.0
         return float(np.linalg.norm(self.circle - self.centre))
 
     def to_dict(self) -> dict[str, object]:

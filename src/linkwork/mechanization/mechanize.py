@@ -126,7 +126,11 @@ def _design(
         add(first)
         if step.links == 2:
             second = next(
-                (c.link for c in step.candidates[k + 1 :] if _independent(first, c.link, chain.size, options)),
+                (
+                    c.link
+                    for c in step.candidates[k + 1 :]
+                    if _independent(first, c.link, chain.size, options)
+                ),
                 step.candidates[(k + 1) % len(step.candidates)].link,
             )
             add(second)
@@ -137,7 +141,9 @@ def _design(
     elif options.actuator == "prismatic":
         drive = "A1s"
     elif any(link.kind == "PR" for link in links):
-        drive = next(f"{link.name}s" for link in links if link.kind == "PR")  # a slider drives (paper, Fig. 14)
+        drive = next(
+            f"{link.name}s" for link in links if link.kind == "PR"
+        )  # a slider drives (paper, Fig. 14)
     elif pl.pinned_root is not None:
         drive = pl.pinned_root
     else:
@@ -190,7 +196,9 @@ def mechanize(
     """
     if options is None:
         problem = getattr(result, "problem", None)
-        options = options_from_values(problem.mechanize_options) if problem is not None else MechanizeOptions()
+        options = (
+            options_from_values(problem.mechanize_options) if problem is not None else MechanizeOptions()
+        )
     _check(options)
     if isinstance(result, ShapeChain):
         chain = result
