@@ -30,7 +30,7 @@ def test_every_option_is_a_problem_key_in_file_units(tmp_path: Path) -> None:
         tmp_path,
         'dof = 2\ndrive = "J1"\nactuator = "prismatic"\nground_region = "inside"\nlink_offset = 0.5\n'
         'max_link = 0.8\nmin_transmission = 20.0\nanchors = "any"\nattempts = 3\ntime_limit = 12.5\n'
-        'root = "s1"\nbinary_links = "both"\n',
+        'root = "s1"\nbinary_links = "both"\ndesigns = 2\n',
     )
     problem = load_problem(file)
     assert set(problem.mechanize_options) == set(OPTION_KEYS)
@@ -38,7 +38,7 @@ def test_every_option_is_a_problem_key_in_file_units(tmp_path: Path) -> None:
     assert options.dof == 2 and options.drive == "J1" and options.actuator == "prismatic"
     assert options.ground_region == "inside" and options.anchors == "any" and options.root == "s1"
     assert options.link_offset == 0.5 and options.max_link == 0.8 and options.attempts == 3
-    assert options.time_limit == 12.5 and options.binary_links == "both"
+    assert options.time_limit == 12.5 and options.binary_links == "both" and options.designs == 2
     assert abs(options.min_transmission - math.radians(20.0)) <= 1e-15  # degrees in the file, radians here
 
 

@@ -57,7 +57,7 @@ def test_mechanize_runs_on_the_folder_of_a_plain_synth(tmp_path: Path) -> None:
     run = CliRunner().invoke(_app(synth), [str(plain), "-o", str(out), "--no-plots"])
     assert run.exit_code == 0, run.output
     assert not (out / "mechanism.toml").exists()
-    run = CliRunner().invoke(_app(mechanize), [str(out), "--no-plots", "--html", "--attempts", "2"])
+    run = CliRunner().invoke(_app(mechanize), [str(out), "--no-plots", "--html", "--designs", "2"])
     assert run.exit_code == 0, run.output
     report = json.loads((out / "mechanization.json").read_text())
     assert report["dof"] == 1 and report["verification"]["passed"]

@@ -25,7 +25,7 @@ CHORD = 1.0  # the cruise profile's chord, the shortest of the three
 def inside(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object]:
     result = synthesize(load_problem(WING / "mechanize.toml"))
     size = build_chain(result).size
-    options = MechanizeOptions(ground_region="inside", max_link=CHORD / size, attempts=3, time_limit=60.0)
+    options = MechanizeOptions(ground_region="inside", max_link=CHORD / size, designs=1, time_limit=60.0)
     found = mechanize(result, options)
     folder = tmp_path_factory.mktemp("wing-inside")
     write_mechanization(found, folder)

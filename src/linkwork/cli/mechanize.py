@@ -41,6 +41,7 @@ def mechanize(
     max_link: mf.MaxLink = None,
     min_transmission: mf.MinTransmission = None,
     attempts: mf.Attempts = None,
+    designs: mf.Designs = None,
     time_limit: mf.TimeLimit = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Do not draw the figures and animation.")
@@ -73,6 +74,7 @@ def mechanize(
         max_link=max_link,
         min_transmission=min_transmission,
         attempts=attempts,
+        designs=designs,
         time_limit=time_limit,
     )
     result = load_synthesis(folder, problem)

@@ -40,6 +40,10 @@ MinTransmission = Annotated[
     float | None, typer.Option(help="Smallest transmission angle (degrees); key min_transmission.")
 ]
 Attempts = Annotated[int | None, typer.Option(help="Designs traced at most per root and anchor choice.")]
+Designs = Annotated[
+    int | None,
+    typer.Option(help="Passing designs to find and rank by quality factor (1: the first); key designs."),
+]
 TimeLimit = Annotated[
     float | None, typer.Option(help="Seconds after which the search stops; key time_limit.")
 ]

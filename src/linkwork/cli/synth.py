@@ -57,6 +57,7 @@ def synth(
     max_link: mf.MaxLink = None,
     min_transmission: mf.MinTransmission = None,
     attempts: mf.Attempts = None,
+    designs: mf.Designs = None,
     time_limit: mf.TimeLimit = None,
 ) -> None:
     """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
@@ -92,6 +93,7 @@ def synth(
         max_link=max_link,
         min_transmission=min_transmission,
         attempts=attempts,
+        designs=designs,
         time_limit=time_limit,
     )
     options = resolve_options(spec, flags)  # a bad flag or key stops here, before the synthesis

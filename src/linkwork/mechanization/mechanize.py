@@ -55,7 +55,7 @@ class Mechanization:
     seconds
         Wall time.
     ranked
-        Up to :data:`KEEP` passing designs, best quality factor first (``ranked[0]`` is ``design``).
+        Up to ``options.designs`` (5) passing designs, best quality factor first (``ranked[0]`` is ``design``).
     """
 
     design: Design
@@ -64,10 +64,6 @@ class Mechanization:
     rejected: tuple[str, ...]
     seconds: float
     ranked: tuple[RankedDesign, ...] = ()
-
-
-#: Passing designs kept and ranked by their quality factor.
-KEEP = 5
 
 
 @dataclass
@@ -214,7 +210,7 @@ def mechanize(
     state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
     for root in order:
         for mode in modes:
-            if state.out_of_time() or len(state.passed) >= KEEP:
+            if state.out_of_time() or len(state.passed) >= state.options.designs:
                 break
             opts = replace(options, anchors=mode)
             try:
@@ -229,7 +225,7 @@ def mechanize(
             break
     seconds = time.perf_counter() - state.started
     if state.passed:
-        ranked = tuple(sorted(state.passed, key=lambda r: -r.quality.factor)[:KEEP])
+        ranked = tuple(sorted(state.passed, key=lambda r: -r.quality.factor))
         best = ranked[0]
         return Mechanization(
             best.design, best.verification, state.attempts, tuple(state.rejected), seconds, ranked
@@ -281,7 +277,7 @@ def _with_transmissions(design: Design, check: Verification) -> Design:
 
 def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, state: _Search) -> None:
     """Trace designs of one plan, replacing the link blamed for each defect; after a pass, vary the links to
-    find further passing designs to rank, until :data:`KEEP` passed or the attempts or the time run out."""
+    find further passing designs to rank, until ``options.designs`` passed or the attempts or the time run out."""
     choice = [0] * len(pl.steps)
     root_pair = 0
     index: dict[str, int] = {}
@@ -291,7 +287,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
             count += 1
             index[f"D{count}"] = i
     for attempt in range(1, options.attempts + 1):
-        if state.out_of_time() or len(state.passed) >= KEEP:
+        if state.out_of_time() or len(state.passed) >= state.options.designs:
             return
         design = _design(chain, pl, root_pair, choice, options, label)
         if options.drive is not None and options.drive not in design.joint_names():

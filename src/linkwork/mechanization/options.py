@@ -36,6 +36,7 @@ OPTION_KEYS = (
     "time_limit",
     "root",
     "binary_links",
+    "designs",
 )
 
 ProgressCallback = Callable[[int, int, str], None]
@@ -151,6 +152,9 @@ class MechanizeOptions:
         body, pivoted to the moving body; its prismatic joint can drive); ``"both"``.
     attempts
         Designs traced at most per root and anchor choice.
+    designs
+        Passing designs to find and rank by quality factor before stopping (the best is kept); 1 stops at the
+        first design that passes.
     time_limit
         Seconds after which the search stops with the best reason it has.
     """
@@ -168,6 +172,7 @@ class MechanizeOptions:
     binary_links: str = "revolute"
     candidates: int = 9
     attempts: int = 6
+    designs: int = 5
     time_limit: float = 60.0
 
     def region_of(self, targets: tuple[Array, ...], size: float) -> GroundRegion:
@@ -250,6 +255,10 @@ _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
     "attempts": (
         lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None,
         "a whole number >= 1",
+    ),
+    "designs": (
+        lambda v: v if isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 20 else None,
+        "a whole number of designs, 1 to 20",
     ),
     "time_limit": (
         lambda v: n if (n := _number(v)) is not None and n > 0 else None,

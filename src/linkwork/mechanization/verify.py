@@ -229,6 +229,17 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
                 f"{_show(mech, d, path.angles[k, d])}",
                 _culprit(design, mech, path),
             )
+        dv = np.diff(path.angles[:, d])
+        if np.any(dv * np.sign(v[j]) < -1e-12):
+            # a dead centre on the way: the drive turns back (the trace may then wander until its budget)
+            k = int(np.flatnonzero(dv * np.sign(v[j]) < -1e-12)[0])
+            return reject(
+                "order",
+                f"order defect: the drive {drive} turns back {where} at "
+                f"{_show(mech, d, path.angles[k, d])} (a dead centre)"
+                + (f"; the trace then {end}" if end != "reached target" else ""),
+                _culprit(design, mech, path),
+            )
         if end != "reached target":
             defect = "order" if "turning" in end else "branch"
             return reject(
@@ -236,13 +247,6 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
                 f"{defect} defect: the trace {where} stopped ({end}) before the drive "
                 f"{drive} reached {_show(mech, d, v[j])}",
                 _culprit(design, mech, path),
-            )
-        dv = np.diff(path.angles[:, d])
-        if np.any(dv * np.sign(v[j]) < -1e-12):
-            return reject(
-                "order",
-                f"order defect: the drive {drive} turns back {where}",
-                "drive",
             )
         st = state(path.angles[-1], j)
         structural = max((link.structural_error for link in design.links), default=0.0)
