@@ -1,0 +1,218 @@
+"""The closure misfit along a path: the least weighted closure residual over the other joints, drive held.
+
+For an imperfect mechanism (perturbed twists) and the nominal path ``u_k`` (unknowns at drive value ``k``), the
+misfit at ``k`` is ``min |T r(u)|`` over the unknowns other than the drive, with the drive unknown held at its
+nominal value; ``r`` is the stacked loop logarithm (closure residual, Eq. (23) in twist form) and ``T`` the weight
+of :mod:`linkwork.studies.scale`, so the misfit is a length in the linkage's units. It is solved by Gauss-Newton
+(normal equations, Cholesky, with backtracking), warm-started along the path from the previous drive value's
+solution shifted by the nominal step. The compiled batch kernel runs many samples and all drive values in one call.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from linkwork.kinematics.kernels import exp_unit_twist, expand, log_rigid
+
+
+@njit(cache=True)
+def weighted_closure(
+    twists: np.ndarray,
+    q: np.ndarray,
+    loop_joint: np.ndarray,
+    loop_sign: np.ndarray,
+    loop_ptr: np.ndarray,
+    rows: np.ndarray,
+    groups: np.ndarray,
+    T: np.ndarray,
+    residual: np.ndarray,
+    jac: np.ndarray,
+) -> None:
+    """Weighted closure residual ``T log(P)`` (kept rows, per loop) and its Jacobian in the unknowns, in place.
+
+    As :func:`linkwork.kinematics.kernels.closure_jacobian` (columns ``s Ad(g) xi``, Eq. (21)), with every
+    6-vector mapped by ``T`` before the rows are kept.
+    """
+    nrows = rows.shape[0]
+    jac[:, :] = 0.0
+    Rg = np.empty((3, 3))
+    pg = np.empty(3)
+    Re = np.empty((3, 3))
+    pe = np.empty(3)
+    Rn = np.empty((3, 3))
+    w = np.empty(3)
+    v = np.empty(3)
+    col = np.empty(6)
+    lg = np.empty(6)
+    for k in range(loop_ptr.shape[0] - 1):
+        for i in range(3):
+            for c in range(3):
+                Rg[i, c] = 1.0 if i == c else 0.0
+            pg[i] = 0.0
+        for idx in range(loop_ptr[k], loop_ptr[k + 1]):
+            j = loop_joint[idx]
+            s = float(loop_sign[idx])
+            for i in range(3):
+                w[i] = s * twists[j, i]
+                v[i] = s * twists[j, 3 + i]
+            g = groups[j]
+            if g >= 0:
+                for i in range(3):
+                    col[i] = Rg[i, 0] * w[0] + Rg[i, 1] * w[1] + Rg[i, 2] * w[2]
+                    col[3 + i] = Rg[i, 0] * v[0] + Rg[i, 1] * v[1] + Rg[i, 2] * v[2]
+                col[3] += pg[1] * col[2] - pg[2] * col[1]
+                col[4] += pg[2] * col[0] - pg[0] * col[2]
+                col[5] += pg[0] * col[1] - pg[1] * col[0]
+                for r in range(nrows):
+                    acc = 0.0
+                    for c in range(6):
+                        acc += T[rows[r], c] * col[c]
+                    jac[k * nrows + r, g] += acc
+            exp_unit_twist(w, v, q[j], Re, pe)
+            for i in range(3):
+                for c in range(3):
+                    Rn[i, c] = Rg[i, 0] * Re[0, c] + Rg[i, 1] * Re[1, c] + Rg[i, 2] * Re[2, c]
+            for i in range(3):
+                pg[i] += Rg[i, 0] * pe[0] + Rg[i, 1] * pe[1] + Rg[i, 2] * pe[2]
+            for i in range(3):
+                for c in range(3):
+                    Rg[i, c] = Rn[i, c]
+        log_rigid(Rg, pg, lg)
+        for r in range(nrows):
+            acc = 0.0
+            for c in range(6):
+                acc += T[rows[r], c] * lg[c]
+            residual[k * nrows + r] = acc
+
+
+@njit(cache=True)
+def _solve_normal(J: np.ndarray, r: np.ndarray, drive: int, dx: np.ndarray) -> None:
+    """Gauss-Newton step ``dx`` over the unknowns except ``drive``: ``(A + mu I) dx = -J^T r`` with
+    ``A = J^T J`` by Cholesky; ``mu`` a tiny regularisation that keeps singular points finite."""
+    m = J.shape[1]
+    A = np.zeros((m, m))
+    b = np.zeros(m)
+    for a in range(m):
+        for c in range(a, m):
+            acc = 0.0
+            for e in range(J.shape[0]):
+                acc += J[e, a] * J[e, c]
+            A[a, c] = acc
+            A[c, a] = acc
+        acc = 0.0
+        for e in range(J.shape[0]):
+            acc += J[e, a] * r[e]
+        b[a] = -acc
+    top = 0.0
+    for a in range(m):
+        top = max(top, A[a, a])
+    mu = 1e-14 * top + 1e-300
+    for a in range(m):
+        A[a, drive] = 0.0
+        A[drive, a] = 0.0
+        A[a, a] += mu
+    A[drive, drive] = 1.0
+    b[drive] = 0.0
+    # Cholesky A = L L^T in place (lower triangle), then two triangular solves.
+    for a in range(m):
+        for c in range(a + 1):
+            acc = A[a, c]
+            for k in range(c):
+                acc -= A[a, k] * A[c, k]
+            if a == c:
+                A[a, a] = np.sqrt(acc) if acc > 0.0 else 1e-150
+            else:
+                A[a, c] = acc / A[c, c]
+    for a in range(m):
+        acc = b[a]
+        for k in range(a):
+            acc -= A[a, k] * dx[k]
+        dx[a] = acc / A[a, a]
+    for a in range(m - 1, -1, -1):
+        acc = dx[a]
+        for k in range(a + 1, m):
+            acc -= A[k, a] * dx[k]
+        dx[a] = acc / A[a, a]
+
+
+@njit(cache=True)
+def misfit_along_path(
+    twists: np.ndarray,
+    u_path: np.ndarray,
+    drive: int,
+    loop_joint: np.ndarray,
+    loop_sign: np.ndarray,
+    loop_ptr: np.ndarray,
+    rows: np.ndarray,
+    groups: np.ndarray,
+    T: np.ndarray,
+    max_iter: int,
+    out: np.ndarray,
+) -> None:
+    """Misfit ``out (K,)`` of one imperfect mechanism at every nominal path point ``u_path (K, m)``."""
+    K, m = u_path.shape
+    E = (loop_ptr.shape[0] - 1) * rows.shape[0]
+    q = np.empty(groups.shape[0])
+    r = np.empty(E)
+    J = np.empty((E, m))
+    dx = np.empty(m)
+    u = u_path[0].copy()
+    u_old = u.copy()
+    for k in range(K):
+        if k > 0:
+            for a in range(m):
+                u[a] += u_path[k, a] - u_path[k - 1, a]
+        u[drive] = u_path[k, drive]
+        best = np.inf
+        halvings = 0
+        for _ in range(max_iter):
+            expand(u, groups, q)
+            weighted_closure(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J)
+            norm = np.sqrt(np.sum(r * r))
+            if norm > best * (1.0 + 1e-10) and halvings < 30:
+                # The step made things worse: go back half way (Gauss-Newton with backtracking).
+                for a in range(m):
+                    u[a] = 0.5 * (u[a] + u_old[a])
+                halvings += 1
+                continue
+            converged = best - norm <= 1e-10 * norm
+            best = norm
+            halvings = 0
+            for a in range(m):
+                u_old[a] = u[a]
+            if converged or norm == 0.0:
+                break
+            _solve_normal(J, r, drive, dx)
+            step = 0.0
+            for a in range(m):
+                u[a] += dx[a]
+                step = max(step, abs(dx[a]))
+            if step < 1e-15:
+                break
+        for a in range(m):
+            u[a] = u_old[a]
+        out[k] = best
+
+
+@njit(cache=True)
+def misfit_batch(
+    twists: np.ndarray,
+    u_path: np.ndarray,
+    drive: int,
+    loop_joint: np.ndarray,
+    loop_sign: np.ndarray,
+    loop_ptr: np.ndarray,
+    rows: np.ndarray,
+    groups: np.ndarray,
+    T: np.ndarray,
+    max_iter: int,
+) -> np.ndarray:
+    """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path."""
+    S = twists.shape[0]
+    out = np.empty((S, u_path.shape[0]))
+    for s in range(S):
+        misfit_along_path(
+            twists[s], u_path, drive, loop_joint, loop_sign, loop_ptr, rows, groups, T, max_iter, out[s]
+        )
+    return out
