@@ -26,6 +26,7 @@ def histogram(values: Array, length: float) -> NDArray[np.int64]:
     with np.errstate(divide="ignore"):
         x = np.log10(np.maximum(values, 0.0) / length)
     pos = np.where(np.isfinite(x), (x - LOW) * PER_DECADE + 1.0, 0.0)
+    pos = np.where(np.isnan(x) | (x == np.inf), N_BINS - 1.0, pos)  # failed solves count as the largest
     idx = np.clip(np.floor(pos), 0, N_BINS - 1).astype(np.int64)
     flat = (np.arange(K)[None, :] * N_BINS + idx).ravel()
     return np.bincount(flat, minlength=K * N_BINS).astype(np.int64).reshape(K, N_BINS)

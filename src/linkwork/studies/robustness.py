@@ -203,13 +203,11 @@ def merge_chunks(
     )
 
 
-def robustness(
-    mech: Mechanism,
-    path: Trace,
-    model: ImperfectionModel,
+def run_study(
+    setup: RobustnessSetup,
     samples: int,
+    ratio_paper: Array,
     *,
-    seed: int = 0,
     scheduler: str | None = None,
     workers: int | None = None,
     client: Any = None,
@@ -217,11 +215,9 @@ def robustness(
     progress: Callable[[int, int], None] | None = None,
     sink: Callable[[ChunkResult], None] | None = None,
 ) -> RobustnessResult:
-    """Monte Carlo of ``samples`` imperfect copies of ``mech`` along the nominal ``path`` (from
-    :func:`linkwork.trace`), on the Dask engine (:func:`linkwork.studies.engine.map_chunks`)."""
+    """Run ``samples`` samples of a prepared study on the Dask engine and merge them."""
     if samples < 1:
         raise SpecError(f"samples must be at least 1, got {samples}")
-    setup = prepare(mech, path, model, seed)
     results = map_chunks(
         run_chunk,
         setup,
@@ -231,4 +227,28 @@ def robustness(
         client=client,
         progress=progress,
     )
-    return merge_chunks(setup, results, path.condition()[path.branch == path.branch[0]], sink)
+    return merge_chunks(setup, results, ratio_paper, sink)
+
+
+def nominal_ratio(path: Trace) -> Array:
+    """``(K,)`` the paper's Sec. 5 ratio at the points of the path's first branch."""
+    first = path.branch == (path.branches[0].id if path.branches else 0)
+    return path.condition()[first]
+
+
+def robustness(
+    mech: Mechanism,
+    path: Trace,
+    model: ImperfectionModel,
+    samples: int,
+    *,
+    seed: int = 0,
+    **engine: Any,
+) -> RobustnessResult:
+    """Monte Carlo of ``samples`` imperfect copies of ``mech`` along the nominal ``path`` (from
+    :func:`linkwork.trace`), on the Dask engine; ``engine`` are the keywords of :func:`run_study`
+    (``scheduler``, ``workers``, ``client``, ``chunk``, ``progress``, ``sink``)."""
+    if samples < 1:
+        raise SpecError(f"samples must be at least 1, got {samples}")
+    setup = prepare(mech, path, model, seed)
+    return run_study(setup, samples, nominal_ratio(path), **engine)
