@@ -67,16 +67,27 @@ class HingeLines:
 
     @classmethod
     def of(cls, mech: Mechanism, centre: Array) -> HingeLines:
-        """The hinge lines of ``mech`` at its reference, each with the point nearest ``centre``."""
+        """The hinge lines of ``mech`` at its reference, each with the point nearest ``centre``.
+
+        ``e1`` points from the line towards ``centre`` (along their common normal) and ``e2 = direction x e1``,
+        so that errors drawn in this basis do not depend on where the linkage stands or how it is turned; a line
+        through the centre (or a prismatic joint) takes ``e1`` normal to it along the coordinate axis it is most
+        nearly normal to.
+        """
         w = mech.twists[:, :3]
         revolute = np.einsum("ij,ij->i", w, w) > 0.5
         directions = np.where(revolute[:, None], w, mech.twists[:, 3:])
+        points = line_points(mech, centre)
+        radial = np.asarray(centre, dtype=float)[None, :] - points
+        radial -= np.einsum("ij,ij->i", radial, directions)[:, None] * directions
+        size = np.linalg.norm(radial, axis=1)
         least = np.argmin(np.abs(directions), axis=1)
-        axis = np.eye(3)[least]
-        e1 = np.cross(directions, axis)
+        fallback = np.cross(np.cross(directions, np.eye(3)[least]), directions)
+        ok = revolute & (size > 1e-9 * max(1.0, float(size.max(initial=0.0))))
+        e1 = np.where(ok[:, None], radial, fallback)
         e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
         e2 = np.cross(directions, e1)
-        return cls(line_points(mech, centre), directions, e1, e2, revolute)
+        return cls(points, directions, e1, e2, revolute)
 
 
 def sample_seeds(seed: int, start: int, stop: int) -> NDArray[np.uint64]:
