@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import typer
 
-from linkwork.cli import demo, linkages, mechanize, robustness, synth, trace
+from linkwork.cli import demo, linkages, mechanize, robustness, sweep, synth, trace
 
 app = typer.Typer(
     name="linkwork",
@@ -24,6 +24,7 @@ app.command("synth")(synth.synth)
 app.command("mechanize")(mechanize.mechanize)
 app.command("demo")(demo.demo)
 app.command("robustness")(robustness.robustness)
+app.command("sweep")(sweep.sweep)
 
 
 def main() -> None:
