@@ -14,12 +14,20 @@ from linkwork.studies.study_file import Study
 
 def columns_of(rows: list[dict[str, Any]], study: Study) -> list[str]:
     """Column order: the grid parameters, then every other key in first-seen order, ``error`` last."""
-    cols = list(study.grid)
+    seen: list[str] = []
     for row in rows:
         for key in row:
-            if key not in cols and key != "error":
-                cols.append(key)
-    return [*cols, "error"]
+            if key not in seen and key not in study.grid and key != "error":
+                seen.append(key)
+
+    def group(key: str) -> int:
+        if key in ("mobility", "points"):
+            return 0
+        if key.endswith(("_min", "_max")) and key not in ("ratio_max", "first_order_max"):
+            return 1
+        return 2
+
+    return [*study.grid, *sorted(seen, key=lambda k: (group(k), seen.index(k))), "error"]
 
 
 def write_table(rows: list[dict[str, Any]], cols: list[str], parquet: Path, csv_file: Path) -> None:

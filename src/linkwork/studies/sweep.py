@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from linkwork.errors import LinkworkError
+from linkwork.errors import LinkworkError, SpecError
 from linkwork.studies.engine import map_chunks
 from linkwork.studies.study_file import Study
 
@@ -136,7 +136,21 @@ def prepare_study(study: Study) -> Study:
         return replace(study, extra={"problem": load_problem(target)})
     from linkwork.io.spec import resolve_spec
 
-    resolve_spec(study.target, study.points()[0] if study.grid else None)
+    if study.grid:  # a built-in: its name and parameter names must be right (values are checked per point)
+        from linkwork.io.spec import _import_builtins
+        from linkwork.linkages.registry import get
+
+        _import_builtins()
+        entry = get(study.target)
+        unknown = [k for k in study.grid if k not in entry.params]
+        if unknown:
+            raise SpecError(
+                f"{entry.name} has no parameter {unknown[0]!r}; expected {', '.join(entry.params)}",
+                source=str(study.source),
+                key=f"grid.{unknown[0]}",
+            )
+    else:
+        resolve_spec(study.target)
     return study
 
 
