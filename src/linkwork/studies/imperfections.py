@@ -12,8 +12,8 @@ Distributions: ``normal`` draws every component with standard deviation equal to
 the tilt vector uniformly in the disc of radius ``direction_tol`` and the shift uniformly in the disc of radius
 ``position_tol``.
 
-Seeds: sample ``i`` of a study with seed ``S`` has its own 64-bit seed from ``numpy.random.SeedSequence(S,
-spawn_key=(i,))``; its numbers are a splitmix64 stream of that seed (normal variates by Box-Muller), computed in a
+Seeds: sample ``i`` of a study with seed ``S`` has its own 64-bit seed, a hash of ``i`` and the study key that
+``numpy.random.SeedSequence(S)`` gives; its numbers are a splitmix64 stream of that seed (normal variates by Box-Muller), computed in a
 compiled kernel. A sample's numbers therefore depend only on ``(S, i)``: never on chunking or on which worker ran
 it.
 """
@@ -91,14 +91,21 @@ class HingeLines:
 
 
 def sample_seeds(seed: int, start: int, stop: int) -> NDArray[np.uint64]:
-    """The 64-bit seeds of samples ``start .. stop - 1`` of a study seeded with ``seed``."""
-    return np.array(
-        [
-            np.random.SeedSequence(seed, spawn_key=(i,)).generate_state(1, dtype=np.uint64)[0]
-            for i in range(start, stop)
-        ],
-        dtype=np.uint64,
-    )
+    """The 64-bit seeds of samples ``start .. stop - 1`` of a study seeded with ``seed``.
+
+    The study's 128-bit key comes from ``numpy.random.SeedSequence(seed)``; sample ``i``'s seed is the splitmix64
+    hash of that key and ``i``, so it depends on ``(seed, i)`` alone.
+    """
+    key = np.random.SeedSequence(seed).generate_state(2, dtype=np.uint64)
+    return _sample_seeds(key, start, stop)
+
+
+@njit(cache=True)
+def _sample_seeds(key: np.ndarray, start: int, stop: int) -> np.ndarray:
+    out = np.empty(stop - start, dtype=np.uint64)
+    for i in range(start, stop):
+        out[i - start] = _splitmix64(_splitmix64(key[0] ^ np.uint64(i)) ^ key[1])
+    return out
 
 
 @njit(cache=True)

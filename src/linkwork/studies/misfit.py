@@ -34,17 +34,40 @@ def weighted_closure(
     As :func:`linkwork.kinematics.kernels.closure_jacobian` (columns ``s Ad(g) xi``, Eq. (21)), with every
     6-vector mapped by ``T`` before the rows are kept.
     """
+    scratch = np.empty((5, 3, 3))
+    vectors = np.empty((5, 6))
+    _weighted_closure(
+        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, residual, jac, scratch, vectors
+    )
+
+
+@njit(cache=True)
+def _weighted_closure(
+    twists: np.ndarray,
+    q: np.ndarray,
+    loop_joint: np.ndarray,
+    loop_sign: np.ndarray,
+    loop_ptr: np.ndarray,
+    rows: np.ndarray,
+    groups: np.ndarray,
+    T: np.ndarray,
+    residual: np.ndarray,
+    jac: np.ndarray,
+    scratch: np.ndarray,
+    vectors: np.ndarray,
+) -> None:
+    """:func:`weighted_closure` with its work arrays given (``scratch (5, 3, 3)``, ``vectors (5, 6)``)."""
     nrows = rows.shape[0]
     jac[:, :] = 0.0
-    Rg = np.empty((3, 3))
-    pg = np.empty(3)
-    Re = np.empty((3, 3))
-    pe = np.empty(3)
-    Rn = np.empty((3, 3))
-    w = np.empty(3)
-    v = np.empty(3)
-    col = np.empty(6)
-    lg = np.empty(6)
+    Rg = scratch[0]
+    Re = scratch[1]
+    Rn = scratch[2]
+    pg = vectors[0, :3]
+    pe = vectors[0, 3:]
+    w = vectors[1, :3]
+    v = vectors[1, 3:]
+    col = vectors[2]
+    lg = vectors[3]
     for k in range(loop_ptr.shape[0] - 1):
         for i in range(3):
             for c in range(3):
@@ -87,12 +110,13 @@ def weighted_closure(
 
 
 @njit(cache=True)
-def _solve_normal(J: np.ndarray, r: np.ndarray, drive: int, dx: np.ndarray) -> None:
+def _solve_normal(
+    J: np.ndarray, r: np.ndarray, drive: int, dx: np.ndarray, A: np.ndarray, b: np.ndarray
+) -> None:
     """Gauss-Newton step ``dx`` over the unknowns except ``drive``: ``(A + mu I) dx = -J^T r`` with
-    ``A = J^T J`` by Cholesky; ``mu`` a tiny regularisation that keeps singular points finite."""
+    ``A = J^T J`` by Cholesky (``A``, ``b`` are work arrays); ``mu`` a tiny regularisation that keeps singular
+    points finite."""
     m = J.shape[1]
-    A = np.zeros((m, m))
-    b = np.zeros(m)
     for a in range(m):
         for c in range(a, m):
             acc = 0.0
@@ -157,6 +181,10 @@ def misfit_along_path(
     r = np.empty(E)
     J = np.empty((E, m))
     dx = np.empty(m)
+    scratch = np.empty((5, 3, 3))
+    vectors = np.empty((5, 6))
+    A = np.empty((m, m))
+    b = np.empty(m)
     u = u_path[0].copy()
     u_old = u.copy()
     for k in range(K):
@@ -168,7 +196,9 @@ def misfit_along_path(
         halvings = 0
         for _ in range(max_iter):
             expand(u, groups, q)
-            weighted_closure(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J)
+            _weighted_closure(
+                twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, scratch, vectors
+            )
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
@@ -183,7 +213,17 @@ def misfit_along_path(
                 u_old[a] = u[a]
             if converged or norm == 0.0:
                 break
-            _solve_normal(J, r, drive, dx)
+            _solve_normal(J, r, drive, dx, A, b)
+            # The step lowers |r|^2 by |J dx|^2 to first order: when that is below 1e-8 |r|^2 the misfit is
+            # known to 1e-8 relative already, and a further evaluation would not change it.
+            gain = 0.0
+            for e in range(E):
+                acc = 0.0
+                for a in range(m):
+                    acc += J[e, a] * dx[a]
+                gain += acc * acc
+            if gain <= 1e-8 * norm * norm:
+                break
             step = 0.0
             for a in range(m):
                 u[a] += dx[a]
