@@ -20,7 +20,7 @@ from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
 from linkwork.studies import bands
-from linkwork.studies.engine import map_chunks
+from linkwork.studies.engine import default_workers, map_chunks
 from linkwork.studies.first_order import first_order_misfit, sensitivity_maps
 from linkwork.studies.imperfections import (
     HingeLines,
@@ -144,9 +144,12 @@ def first_order_only(setup: RobustnessSetup, start: int, stop: int) -> Array:
     return first_order_misfit(setup.G, errors).max(axis=1)
 
 
-def chunk_ranges(samples: int, chunk: int | None = None) -> list[tuple[int, int]]:
-    """``(start, stop)`` of every chunk of ``samples`` (``chunk`` samples each, :data:`CHUNK` by default)."""
-    size = max(1, chunk or CHUNK)
+def chunk_ranges(samples: int, chunk: int | None = None, workers: int = 1) -> list[tuple[int, int]]:
+    """``(start, stop)`` of every chunk of ``samples``: ``chunk`` samples each, by default enough chunks for four
+    per worker (so that the last ones balance) of 250 to :data:`CHUNK` samples. A sample's numbers never depend
+    on its chunk."""
+    size = chunk or min(CHUNK, max(250, -(-samples // (4 * max(1, workers)))))
+    size = max(1, size)
     return [(a, min(a + size, samples)) for a in range(0, samples, size)]
 
 
@@ -218,10 +221,14 @@ def run_study(
     """Run ``samples`` samples of a prepared study on the Dask engine and merge them."""
     if samples < 1:
         raise SpecError(f"samples must be at least 1, got {samples}")
+    if client is not None:
+        n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+    else:
+        n_workers = workers if workers is not None else default_workers()
     results = map_chunks(
         run_chunk,
         setup,
-        chunk_ranges(samples, chunk),
+        chunk_ranges(samples, chunk, n_workers),
         scheduler=scheduler,
         workers=workers,
         client=client,
