@@ -5,8 +5,8 @@ hexagon) with hinges within 1e-3 rod lengths and 0.05 deg (normal):
 
 (a) 10,000 imperfect hexagons on two local worker processes (goal: under 60 s), the cluster's start-up timed apart;
 (b) the same study on one worker: the two-worker speed-up (goal: >= 1.7x);
-(c) the first-order prediction of all 10,000 largest misfits in this process against (a) and against the
-    Monte Carlo's own CPU time in one process (goal: >= 100x faster);
+(c) the first-order prediction of all 10,000 largest misfits against the Monte Carlo, both as CPU time in one
+    process (goal: >= 100x faster), and against the wall time of (a);
 (d) memory: ``--memory-samples`` samples (10^6 by default; hexagon, 20-point path) streamed to Parquet in this
     process, peak resident memory before and after (goal: the study adds no more than about 200 MB).
 
@@ -102,9 +102,11 @@ def main() -> None:
 
     setup, ratio = hexagon_setup(200)
     run_chunk(setup, 0, 2)  # compile / load the numba cache
-    t0 = time.perf_counter()
+    first_order_only(setup, 0, 10)
+    t0, c0 = time.perf_counter(), time.process_time()
     first_order_only(setup, 0, samples)
     report["first_order_s"] = time.perf_counter() - t0
+    report["first_order_cpu_s"] = time.process_time() - c0
     n_cpu = min(samples, 1000)
     t0 = time.process_time()
     run_chunk(setup, 0, n_cpu)
@@ -113,7 +115,7 @@ def main() -> None:
     report["one_worker"] = timed_cluster_run(setup, ratio, samples, 1)
     report["speedup_two_over_one"] = report["one_worker"]["study_s"] / report["two_workers"]["study_s"]
     report["first_order_vs_mc_wall"] = report["two_workers"]["study_s"] / report["first_order_s"]
-    report["first_order_vs_mc_cpu"] = report["mc_cpu_s_per_sample"] * samples / report["first_order_s"]
+    report["first_order_vs_mc_cpu"] = report["mc_cpu_s_per_sample"] * samples / report["first_order_cpu_s"]
     report["memory"] = memory_run(memory_samples)
     report["load_after"] = loadavg()
 
@@ -123,8 +125,8 @@ def main() -> None:
         (f"(b) {samples} hexagons, 1 worker", f"{report['one_worker']['study_s']:.1f} s", ""),
         ("    speed-up 2 workers / 1", f"{report['speedup_two_over_one']:.2f}x", ">= 1.7x"),
         ("(c) first order, all samples", f"{report['first_order_s']:.3f} s", ""),
-        ("    vs Monte Carlo wall (a)", f"{report['first_order_vs_mc_wall']:.0f}x", ">= 100x"),
-        ("    vs Monte Carlo CPU, 1 process", f"{report['first_order_vs_mc_cpu']:.0f}x", ""),
+        ("    vs Monte Carlo wall time (a)", f"{report['first_order_vs_mc_wall']:.0f}x", ""),
+        ("    CPU time, both in one process", f"{report['first_order_vs_mc_cpu']:.0f}x", ">= 100x"),
         (
             f"(d) {memory_samples} samples streamed",
             f"+{report['memory']['added_mb']:.0f} MB peak RSS ({report['memory']['seconds']:.0f} s)",
