@@ -6,9 +6,10 @@ its loop factor becomes ``D exp(s xi_j q_j) D^-1`` and the loop product changes 
 Eq. (21)). A tilt ``t`` about the unit vector ``e`` normal to the line through its point ``p`` is
 ``d = t (e, p x e)``; a shift ``s`` along ``e`` is ``d = s (0, e)``. Stacked over joints this is
 ``B_k`` (equations x 4n) at path point ``k``, and the weighted residual of the imperfect loop is, to first order,
-``T (J_k dx + B_k delta)``. The least residual over the other joints ``dx`` leaves the part of ``T B_k delta``
-outside the range of ``T J_k`` (drive column removed): with ``N_k`` an orthonormal basis of the left null space of
-that matrix, the predicted misfit is ``|N_k^T T B_k delta|``. The paper's Sec. 5 ratio measures how close
+``T (J_k dx + B_k delta)``. The least residual over the joint motions ``dx`` normal to the path (or with the drive
+held: ``J_k`` annihilates the tangent, so both reach the same range) leaves the part of ``T B_k delta`` outside the
+range of ``T J_k``: with ``N_k`` an orthonormal basis of the left null space of ``T J_k``, the predicted misfit is
+``|N_k^T T B_k delta|``. The paper's Sec. 5 ratio measures how close
 ``J_k`` is to losing rank; ``N_k`` is exactly what the hinge errors project on.
 """
 
@@ -59,28 +60,27 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
     return J @ mech.coupling_matrix(), B.reshape(mech.n_equations, 4 * n)
 
 
-def sensitivity_maps(
-    mech: Mechanism, u_path: Array, drive: int, lines: HingeLines, T: Array
-) -> tuple[Array, Array]:
-    """Per path point the map ``G_k = N_k^T T B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
-    space), and ``(K,)`` the ratio of largest to smallest non-zero singular value of ``T J_k`` (the Sec. 5 ratio
-    on the weighted Jacobian)."""
+def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array) -> tuple[Array, Array, Array]:
+    """Per path point: the map ``G_k = N_k^T T B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
+    space), ``(K,)`` the ratio of largest to smallest non-zero singular value of ``T J_k`` (the Sec. 5 ratio on the
+    weighted Jacobian), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's
+    tangent (the last right singular vector), in which the misfit is minimised."""
     K = u_path.shape[0]
     E = mech.n_equations
+    m = mech.n_unknowns
     G = np.zeros((K, E, 4 * mech.n_joints))
     ratio = np.full(K, np.nan)
-    others = [a for a in range(mech.n_unknowns) if a != drive]
+    normal = np.zeros((K, m, m - 1))
     for k in range(K):
         J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T)
-        sigma = np.linalg.svd(J, compute_uv=False)
-        rank_all = numerical_rank(sigma)
-        if rank_all > 0 and sigma[rank_all - 1] > 0:
-            ratio[k] = sigma[0] / sigma[rank_all - 1]
-        U, s, _ = np.linalg.svd(J[:, others], full_matrices=True)
-        rank = numerical_rank(s) if s.size else 0
+        U, sigma, Vt = np.linalg.svd(J, full_matrices=True)
+        rank = numerical_rank(sigma)
+        if rank > 0 and sigma[rank - 1] > 0:
+            ratio[k] = sigma[0] / sigma[rank - 1]
+        normal[k] = Vt[: m - 1].T
         N = U[:, rank:]
         G[k, : N.shape[1], :] = N.T @ B
-    return G, ratio
+    return G, ratio, normal
 
 
 @njit(cache=True, fastmath=True)

@@ -1,8 +1,10 @@
 """The closure misfit along a path: the least weighted closure residual over the other joints, drive held.
 
-For an imperfect mechanism (perturbed twists) and the nominal path ``u_k`` (unknowns at drive value ``k``), the
-misfit at ``k`` is ``min |T r(u)|`` over the unknowns other than the drive, with the drive unknown held at its
-nominal value; ``r`` is the stacked loop logarithm (closure residual, Eq. (23) in twist form) and ``T`` the weight
+For an imperfect mechanism (perturbed twists) and the nominal path ``u_k`` (unknowns at point ``k``), the misfit
+at ``k`` is ``min |T r(u)|`` over the unknowns ``u`` in the plane through ``u_k`` normal to the nominal path's
+tangent: where the drive parameterises the path this is the drive held, to first order exactly (the Jacobian
+annihilates the tangent, so every plane transverse to it gives the same least residual to first order), and unlike
+holding the drive it stays well posed at a fold of the drive, where the path turns back; ``r`` is the stacked loop logarithm (closure residual, Eq. (23) in twist form) and ``T`` the weight
 of :mod:`linkwork.studies.scale`, so the misfit is a length in the linkage's units. It is solved by Gauss-Newton
 (normal equations, Cholesky, with backtracking), warm-started along the path from the previous drive value's
 solution shifted by the nominal step. The compiled batch kernel runs many samples and all drive values in one call.
@@ -110,34 +112,27 @@ def _weighted_closure(
 
 
 @njit(cache=True)
-def _solve_normal(
-    J: np.ndarray, r: np.ndarray, drive: int, dx: np.ndarray, A: np.ndarray, b: np.ndarray
-) -> None:
-    """Gauss-Newton step ``dx`` over the unknowns except ``drive``: ``(A + mu I) dx = -J^T r`` with
-    ``A = J^T J`` by Cholesky (``A``, ``b`` are work arrays); ``mu`` a tiny regularisation that keeps singular
-    points finite."""
-    m = J.shape[1]
+def _solve_normal(Jy: np.ndarray, r: np.ndarray, dy: np.ndarray, A: np.ndarray, b: np.ndarray) -> None:
+    """Gauss-Newton step ``dy``: ``(A + mu I) dy = -Jy^T r`` with ``A = Jy^T Jy`` by Cholesky (``A``, ``b`` are
+    work arrays); ``mu`` a tiny regularisation that keeps singular points finite."""
+    m = Jy.shape[1]
     for a in range(m):
         for c in range(a, m):
             acc = 0.0
-            for e in range(J.shape[0]):
-                acc += J[e, a] * J[e, c]
+            for e in range(Jy.shape[0]):
+                acc += Jy[e, a] * Jy[e, c]
             A[a, c] = acc
             A[c, a] = acc
         acc = 0.0
-        for e in range(J.shape[0]):
-            acc += J[e, a] * r[e]
+        for e in range(Jy.shape[0]):
+            acc += Jy[e, a] * r[e]
         b[a] = -acc
     top = 0.0
     for a in range(m):
         top = max(top, A[a, a])
     mu = 1e-14 * top + 1e-300
     for a in range(m):
-        A[a, drive] = 0.0
-        A[drive, a] = 0.0
         A[a, a] += mu
-    A[drive, drive] = 1.0
-    b[drive] = 0.0
     # Cholesky A = L L^T in place (lower triangle), then two triangular solves.
     for a in range(m):
         for c in range(a + 1):
@@ -151,20 +146,20 @@ def _solve_normal(
     for a in range(m):
         acc = b[a]
         for k in range(a):
-            acc -= A[a, k] * dx[k]
-        dx[a] = acc / A[a, a]
+            acc -= A[a, k] * dy[k]
+        dy[a] = acc / A[a, a]
     for a in range(m - 1, -1, -1):
-        acc = dx[a]
+        acc = dy[a]
         for k in range(a + 1, m):
-            acc -= A[k, a] * dx[k]
-        dx[a] = acc / A[a, a]
+            acc -= A[k, a] * dy[k]
+        dy[a] = acc / A[a, a]
 
 
 @njit(cache=True)
 def misfit_along_path(
     twists: np.ndarray,
     u_path: np.ndarray,
-    drive: int,
+    normal: np.ndarray,
     loop_joint: np.ndarray,
     loop_sign: np.ndarray,
     loop_ptr: np.ndarray,
@@ -174,27 +169,43 @@ def misfit_along_path(
     max_iter: int,
     out: np.ndarray,
 ) -> None:
-    """Misfit ``out (K,)`` of one imperfect mechanism at every nominal path point ``u_path (K, m)``."""
+    """Misfit ``out (K,)`` of one imperfect mechanism at every nominal path point ``u_path (K, m)``.
+
+    At point ``k`` the unknowns move in the plane normal to the nominal path, ``u = u_k + Q_k y`` with
+    ``normal[k] = Q_k (m, m - 1)`` orthonormal: the drive held wherever it parameterises the path, and still a
+    well-posed problem at a fold of the drive.
+    """
     K, m = u_path.shape
+    p = normal.shape[2]
     E = (loop_ptr.shape[0] - 1) * rows.shape[0]
     q = np.empty(groups.shape[0])
     r = np.empty(E)
     J = np.empty((E, m))
-    dx = np.empty(m)
+    Jy = np.empty((E, p))
+    dy = np.empty(p)
     scratch = np.empty((5, 3, 3))
     vectors = np.empty((5, 6))
-    A = np.empty((m, m))
-    b = np.empty(m)
-    u = u_path[0].copy()
-    u_old = u.copy()
+    A = np.empty((p, p))
+    b = np.empty(p)
+    y = np.zeros(p)
+    y_old = np.zeros(p)
+    u = np.empty(m)
     for k in range(K):
         if k > 0:
-            for a in range(m):
-                u[a] += u_path[k, a] - u_path[k - 1, a]
-        u[drive] = u_path[k, drive]
+            # Warm start: the previous point's offset from the path, carried into this point's normal plane.
+            for c in range(p):
+                acc = 0.0
+                for a in range(m):
+                    acc += normal[k, a, c] * (u[a] - u_path[k - 1, a])
+                y[c] = acc
         best = np.inf
         halvings = 0
         for _ in range(max_iter):
+            for a in range(m):
+                acc = u_path[k, a]
+                for c in range(p):
+                    acc += normal[k, a, c] * y[c]
+                u[a] = acc
             expand(u, groups, q)
             _weighted_closure(
                 twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, scratch, vectors
@@ -202,36 +213,45 @@ def misfit_along_path(
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
-                for a in range(m):
-                    u[a] = 0.5 * (u[a] + u_old[a])
+                for c in range(p):
+                    y[c] = 0.5 * (y[c] + y_old[c])
                 halvings += 1
                 continue
             converged = best - norm <= 1e-10 * norm
             best = norm
             halvings = 0
-            for a in range(m):
-                u_old[a] = u[a]
+            for c in range(p):
+                y_old[c] = y[c]
             if converged or norm == 0.0:
                 break
-            _solve_normal(J, r, drive, dx, A, b)
-            # The step lowers |r|^2 by |J dx|^2 to first order: when that is below 1e-8 |r|^2 the misfit is
+            for e in range(E):
+                for c in range(p):
+                    acc = 0.0
+                    for a in range(m):
+                        acc += J[e, a] * normal[k, a, c]
+                    Jy[e, c] = acc
+            _solve_normal(Jy, r, dy, A, b)
+            # The step lowers |r|^2 by |Jy dy|^2 to first order: when that is below 1e-8 |r|^2 the misfit is
             # known to 1e-8 relative already, and a further evaluation would not change it.
             gain = 0.0
             for e in range(E):
                 acc = 0.0
-                for a in range(m):
-                    acc += J[e, a] * dx[a]
+                for c in range(p):
+                    acc += Jy[e, c] * dy[c]
                 gain += acc * acc
             if gain <= 1e-8 * norm * norm:
                 break
             step = 0.0
-            for a in range(m):
-                u[a] += dx[a]
-                step = max(step, abs(dx[a]))
+            for c in range(p):
+                y[c] += dy[c]
+                step = max(step, abs(dy[c]))
             if step < 1e-15:
                 break
         for a in range(m):
-            u[a] = u_old[a]
+            acc = u_path[k, a]
+            for c in range(p):
+                acc += normal[k, a, c] * y_old[c]
+            u[a] = acc
         out[k] = best
 
 
@@ -239,7 +259,7 @@ def misfit_along_path(
 def misfit_batch(
     twists: np.ndarray,
     u_path: np.ndarray,
-    drive: int,
+    normal: np.ndarray,
     loop_joint: np.ndarray,
     loop_sign: np.ndarray,
     loop_ptr: np.ndarray,
@@ -253,6 +273,6 @@ def misfit_batch(
     out = np.empty((S, u_path.shape[0]))
     for s in range(S):
         misfit_along_path(
-            twists[s], u_path, drive, loop_joint, loop_sign, loop_ptr, rows, groups, T, max_iter, out[s]
+            twists[s], u_path, normal, loop_joint, loop_sign, loop_ptr, rows, groups, T, max_iter, out[s]
         )
     return out

@@ -53,6 +53,7 @@ class RobustnessSetup:
     u_path: Array
     drive_values: Array
     drive_unknown: int
+    normal: Array
     G: Array
     ratio_weighted: Array
     keep_tol: float
@@ -61,7 +62,7 @@ class RobustnessSetup:
         """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists."""
         joint, sign, ptr = self.mech.loop_arrays()
         rows = np.array(self.mech.rows, dtype=np.int64)
-        return (self.u_path, self.drive_unknown, joint, sign, ptr, rows, self.mech.groups, self.scale.weight)
+        return (self.u_path, self.normal, joint, sign, ptr, rows, self.mech.groups, self.scale.weight)
 
 
 @dataclass
@@ -97,7 +98,7 @@ def prepare(
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
-    G, ratio = sensitivity_maps(mech, u_path, drive_unknown, lines, scale.weight)
+    G, ratio, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
@@ -109,6 +110,7 @@ def prepare(
         u_path=u_path,
         drive_values=path.angles[first, drive_joint],
         drive_unknown=drive_unknown,
+        normal=normal,
         G=G,
         ratio_weighted=ratio,
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,

@@ -26,7 +26,11 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
 
     b = summary["bands"]
     key = "drive_deg" if "drive_deg" in b else "drive"
-    x = np.array(b[key], dtype=float)
+    drive = np.array(b[key], dtype=float)
+    steps = np.diff(drive)
+    monotonic = bool(np.all(steps > 0) or np.all(steps < 0))
+    # A path on which the drive turns back (a closed path, a fold) is drawn against the point number instead.
+    x = drive if monotonic else np.arange(drive.size, dtype=float)
     fig, ax = plt.subplots(figsize=(8.0, 5.0), layout="constrained")
     ax.fill_between(x, _positive(b["p5"]), _positive(b["p95"]), color="tab:blue", alpha=0.25, label="5-95 %")
     ax.plot(x, _positive(b["p50"]), color="tab:blue", label="median (Monte Carlo)")
@@ -36,7 +40,12 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     if np.any(np.isfinite(_positive(b["p95"]))):
         ax.set_yscale("log")
     unit = " (deg)" if key == "drive_deg" else ""
-    ax.set_xlabel(f"drive {summary['drive']}{unit}")
+    if monotonic:
+        ax.set_xlabel(f"drive {summary['drive']}{unit}")
+    else:
+        ax.set_xlabel(
+            f"point along the nominal path (drive {summary['drive']} from {drive.min():.4g} to {drive.max():.4g}{unit})"
+        )
     ax.set_ylabel(f"closure misfit (length units, L = {summary['scale']['length']:.3g})")
     ratio = _positive(b["ratio"])
     twin = ax.twinx()
