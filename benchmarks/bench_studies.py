@@ -54,8 +54,9 @@ def timed_cluster_run(setup: Any, ratio: np.ndarray, samples: int, workers: int)
 
     t0 = time.perf_counter()
     with (
-        LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None)
-        as cluster,
+        LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        ) as cluster,
         Client(cluster) as client,
     ):
         client.run(lambda: run_chunk(setup, 0, 2))  # numba cache load on every worker, timed with start-up
@@ -90,11 +91,15 @@ def memory_run(samples: int) -> dict[str, float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--samples", type=int, default=10_000)
     parser.add_argument("--memory-samples", type=int, default=1_000_000)
     parser.add_argument("--quick", action="store_true", help="1,000 hexagons and 100,000 for memory")
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results" / "studies.json")
+    parser.add_argument(
+        "--out", type=Path, default=Path(__file__).resolve().parent / "results" / "studies.json"
+    )
     args = parser.parse_args()
     samples = 1_000 if args.quick else args.samples
     memory_samples = 100_000 if args.quick else args.memory_samples

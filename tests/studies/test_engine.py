@@ -38,8 +38,9 @@ def test_two_worker_cluster_gives_the_local_numbers(bennett):
     local = robustness(mech, path, model, 80, seed=3, workers=0)
     seen: list[tuple[int, int]] = []
     with (
-        LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=None)
-        as cluster,
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=None
+        ) as cluster,
         Client(cluster) as client,
     ):
         remote = robustness(

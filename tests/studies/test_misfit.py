@@ -47,7 +47,9 @@ def test_bennett_binds_linearly_and_first_order_matches(bennett):
         assert (res.misfit_max > 0).all() and not res.mobility_kept.any()
         medians.append(np.median(res.misfit_max))
         predicted.append(np.median(res.first_order_max))
-    assert abs(medians[1] / medians[0] - 2.0) < 0.2  # doubling both tolerances doubles the median, within 10 %
+    assert (
+        abs(medians[1] / medians[0] - 2.0) < 0.2
+    )  # doubling both tolerances doubles the median, within 10 %
     for mc, fo in zip(medians, predicted, strict=True):
         assert abs(fo / mc - 1.0) < 0.1  # first order within 10 % of the Monte Carlo median
 
@@ -83,7 +85,9 @@ def test_misfit_is_frame_invariant_and_scales_with_the_linkage(bennett):
     D = exp_se3(np.array([0.3, -1.1, 0.7, 2.0, -3.0, 0.5]))
     moved = robustness(_moved(mech, D), path, model, 30, seed=5, workers=0)
     np.testing.assert_allclose(moved.misfit_max, base.misfit_max, rtol=1e-7)
-    big = robustness(_moved(mech, np.eye(4), 2.0), path, replace(model, position_tol=2e-4), 30, seed=5, workers=0)
+    big = robustness(
+        _moved(mech, np.eye(4), 2.0), path, replace(model, position_tol=2e-4), 30, seed=5, workers=0
+    )
     np.testing.assert_allclose(big.misfit_max, 2.0 * base.misfit_max, rtol=1e-7)
     assert abs(big.setup.scale.length / base.setup.scale.length - 2.0) < 1e-12
 

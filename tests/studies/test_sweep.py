@@ -55,7 +55,9 @@ alpha2 = { from = 70, to = 90, count = 3 }
 
 
 def test_failed_point_keeps_its_row_with_the_reason(tmp_path):
-    study = load_study(_write(tmp_path, 'linkage = "bennett"\n[trace]\nuntil = "A=100"\n[grid]\nalpha2 = [45, 75]\n'))
+    study = load_study(
+        _write(tmp_path, 'linkage = "bennett"\n[trace]\nuntil = "A=100"\n[grid]\nalpha2 = [45, 75]\n')
+    )
     rows = [row for row, _ in run_sweep(study, workers=0)]
     assert "twists must differ" in rows[0]["error"]  # alpha1 = alpha2 = 45 deg is a parallelogram
     assert rows[1]["error"] == "" and rows[1]["mobility"] == 1

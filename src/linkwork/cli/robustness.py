@@ -27,15 +27,21 @@ def _parse_until(text: str | None) -> tuple[str, float] | None:
 
 @friendly_errors
 def robustness(
-    spec: Annotated[str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")],
+    spec: Annotated[
+        str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")
+    ],
     samples: Annotated[int, typer.Option(help="Number of imperfect samples.")],
     hinge_position_tol: Annotated[
         float, typer.Option(help="Hinge position tolerance, normal to the line (length units).")
     ],
-    hinge_direction_tol: Annotated[float, typer.Option(help="Hinge direction tolerance: cone half-angle (deg).")],
+    hinge_direction_tol: Annotated[
+        float, typer.Option(help="Hinge direction tolerance: cone half-angle (deg).")
+    ],
     set_: Annotated[
         list[str] | None,
-        typer.Option("--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False),
+        typer.Option(
+            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
+        ),
     ] = None,
     until: Annotated[
         str | None, typer.Option(help="Nominal path: trace until JOINT reaches VALUE (degrees), e.g. A=120.")
@@ -48,13 +54,19 @@ def robustness(
     seed: Annotated[int, typer.Option(help="Seed of the study; sample i gets its own seed from it.")] = 0,
     scheduler: Annotated[
         str | None,
-        typer.Option(help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."),
+        typer.Option(
+            help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."
+        ),
     ] = None,
     workers: Annotated[
-        int | None, typer.Option(help="Local worker processes (default: one per core; 0 runs in this process).")
+        int | None,
+        typer.Option(help="Local worker processes (default: one per core; 0 runs in this process)."),
     ] = None,
     spatial_errors: Annotated[
-        bool, typer.Option("--spatial-errors", help="Planar mechanisms: tilt and shift hinges out of the plane too.")
+        bool,
+        typer.Option(
+            "--spatial-errors", help="Planar mechanisms: tilt and shift hinges out of the plane too."
+        ),
     ] = False,
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
@@ -100,7 +112,11 @@ def robustness(
     )
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from linkwork.outputs.robustness import print_robustness_summary, robustness_dict, run_and_write_robustness
+    from linkwork.outputs.robustness import (
+        print_robustness_summary,
+        robustness_dict,
+        run_and_write_robustness,
+    )
 
     with Progress(
         TextColumn("samples"),
@@ -112,6 +128,7 @@ def robustness(
         disable=not console.is_terminal,
     ) as bar:
         task = bar.add_task("", total=samples)
+
         def report(done: int, total: int) -> None:
             bar.update(task, completed=min(samples, round(samples * done / max(total, 1))))
 

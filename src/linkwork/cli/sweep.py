@@ -13,13 +13,18 @@ from linkwork.outputs.staging import console
 
 @friendly_errors
 def sweep(
-    study_file: Annotated[Path, typer.Argument(help="The study file (TOML): a linkage or problem and a [grid].")],
+    study_file: Annotated[
+        Path, typer.Argument(help="The study file (TOML): a linkage or problem and a [grid].")
+    ],
     scheduler: Annotated[
         str | None,
-        typer.Option(help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."),
+        typer.Option(
+            help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."
+        ),
     ] = None,
     workers: Annotated[
-        int | None, typer.Option(help="Local worker processes (default: one per core; 0 runs in this process).")
+        int | None,
+        typer.Option(help="Local worker processes (default: one per core; 0 runs in this process)."),
     ] = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,

@@ -74,7 +74,9 @@ def write_sweep_outputs(
                 folder.mkdir(parents=True)
                 summary = robustness_dict(res, study.target)
                 summary["parameters"] = {k: rows[i].get(k) for k in study.grid}
-                (folder / "robustness.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+                (folder / "robustness.json").write_text(
+                    json.dumps(summary, indent=2) + "\n", encoding="utf-8"
+                )
                 write_robustness_figures(res, summary, folder)
         elif plots:
             console.print("figures skipped: install the plotting extra, pip install 'linkwork\\[viz]'")

@@ -17,12 +17,12 @@ Array = NDArray[np.float64]
 LOW = -16.0
 HIGH = 3.0
 PER_DECADE = 100
-N_BINS = int(round((HIGH - LOW) * PER_DECADE)) + 2
+N_BINS = round((HIGH - LOW) * PER_DECADE) + 2
 
 
 def histogram(values: Array, length: float) -> NDArray[np.int64]:
     """``(K, N_BINS)`` counts of ``values (S, K)`` per column."""
-    S, K = values.shape
+    K = values.shape[1]
     with np.errstate(divide="ignore"):
         x = np.log10(np.maximum(values, 0.0) / length)
     pos = np.where(np.isfinite(x), (x - LOW) * PER_DECADE + 1.0, 0.0)

@@ -98,8 +98,13 @@ def map_chunks(
         yield from _run_on(own, func, shared, chunks, progress)
 
 
-def _run_on(client: Any, func: Callable[..., T], shared: Any, chunks: Sequence[tuple[Any, ...]],
-            progress: Progress | None) -> Iterator[T]:
+def _run_on(
+    client: Any,
+    func: Callable[..., T],
+    shared: Any,
+    chunks: Sequence[tuple[Any, ...]],
+    progress: Progress | None,
+) -> Iterator[T]:
     """Submit chunks to ``client`` with a bounded window and yield their results in order."""
     from dask.distributed import as_completed
 

@@ -60,7 +60,9 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
     return J @ mech.coupling_matrix(), B.reshape(mech.n_equations, 4 * n)
 
 
-def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array) -> tuple[Array, Array, Array]:
+def sensitivity_maps(
+    mech: Mechanism, u_path: Array, lines: HingeLines, T: Array
+) -> tuple[Array, Array, Array]:
     """Per path point: the map ``G_k = N_k^T T B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
     space), ``(K,)`` the ratio of largest to smallest non-zero singular value of ``T J_k`` (the Sec. 5 ratio on the
     weighted Jacobian), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's
@@ -111,7 +113,7 @@ def first_order_misfit(G: Array, errors: Array) -> Array:
     so that a sample's numbers never depend on how many others share its chunk.
     """
     S = errors.shape[0]
-    K, E, P = G.shape
+    K, _, P = G.shape
     rows = np.array([int(np.flatnonzero(np.any(G[k] != 0.0, axis=1)).max(initial=-1)) + 1 for k in range(K)])
     delta = np.ascontiguousarray(errors.reshape(S, P))
     return _first_order_kernel(np.ascontiguousarray(G), rows.astype(np.int64), delta)

@@ -52,7 +52,9 @@ class ImperfectionModel:
                 f"hinge direction tolerance must be >= 0 and below 90 deg, got {np.degrees(self.direction_tol)}"
             )
         if self.distribution not in DISTRIBUTIONS:
-            raise SpecError(f"distribution must be one of {', '.join(DISTRIBUTIONS)}, got {self.distribution!r}")
+            raise SpecError(
+                f"distribution must be one of {', '.join(DISTRIBUTIONS)}, got {self.distribution!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -154,7 +156,9 @@ def component_scale(mech: Mechanism, model: ImperfectionModel, lines: HingeLines
     return scale
 
 
-def hinge_errors(seeds: NDArray[np.uint64], mech: Mechanism, model: ImperfectionModel, lines: HingeLines) -> Array:
+def hinge_errors(
+    seeds: NDArray[np.uint64], mech: Mechanism, model: ImperfectionModel, lines: HingeLines
+) -> Array:
     """``(S, n, 4)`` hinge errors ``(t1, t2, s1, s2)`` of the samples with these seeds."""
     noise = unit_noise(seeds, mech.n_joints, model.distribution == "uniform")
     return noise * component_scale(mech, model, lines)[None, :, :]

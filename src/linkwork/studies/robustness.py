@@ -122,7 +122,8 @@ def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
     seeds = sample_seeds(setup.seed, start, stop)
     errors = hinge_errors(seeds, setup.mech, setup.model, setup.lines)
     twists = perturbed_twists(errors, setup.lines)
-    misfit = misfit_batch(twists, *setup.kernel_args(), MAX_ITER)
+    u_path, normal, joint, sign, ptr, rows, groups, weight = setup.kernel_args()
+    misfit = misfit_batch(twists, u_path, normal, joint, sign, ptr, rows, groups, weight, MAX_ITER)
     predicted = first_order_misfit(setup.G, errors)
     at = np.argmax(misfit, axis=1)
     worst = misfit[np.arange(len(seeds)), at]
@@ -176,7 +177,9 @@ class RobustnessResult:
 
 
 def merge_chunks(
-    setup: RobustnessSetup, results: Iterator[ChunkResult], ratio_paper: Array,
+    setup: RobustnessSetup,
+    results: Iterator[ChunkResult],
+    ratio_paper: Array,
     sink: Callable[[ChunkResult], None] | None = None,
 ) -> RobustnessResult:
     """Merge chunk results in order (``sink`` sees each one, e.g. to stream it to Parquet)."""

@@ -75,7 +75,9 @@ class Study:
 def _check_keys(table: dict[str, Any], allowed: tuple[str, ...], where: str, source: str) -> None:
     for key in table:
         if key not in allowed:
-            raise SpecError(f"unknown key; expected one of {', '.join(allowed)}", source=source, key=f"{where}{key}")
+            raise SpecError(
+                f"unknown key; expected one of {', '.join(allowed)}", source=source, key=f"{where}{key}"
+            )
 
 
 def _grid_values(value: Any, key: str, source: str) -> list[Any]:
@@ -92,7 +94,9 @@ def _grid_values(value: Any, key: str, source: str) -> list[Any]:
                 "expected { from = A, to = B, count = N } with numbers", source=source, key=f"grid.{key}"
             ) from None
         if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-            raise SpecError(f"count must be a whole number >= 1, got {count!r}", source=source, key=f"grid.{key}")
+            raise SpecError(
+                f"count must be a whole number >= 1, got {count!r}", source=source, key=f"grid.{key}"
+            )
         return [float(x) for x in np.linspace(lo, hi, count)]
     return [value]
 
@@ -104,7 +108,7 @@ def _parse_until(text: Any, source: str) -> tuple[str, float]:
     except ValueError:
         value = float("nan")
     if not isinstance(text, str) or not sep or not name.strip() or not np.isfinite(value):
-        raise SpecError(f"expected \"JOINT=VALUE\" (degrees), got {text!r}", source=source, key="trace.until")
+        raise SpecError(f'expected "JOINT=VALUE" (degrees), got {text!r}', source=source, key="trace.until")
     return name.strip(), value
 
 
@@ -161,13 +165,17 @@ def load_study(path: str | Path) -> Study:
     _check_keys(trace_table, TRACE_KEYS, "trace.", source)
     until = _parse_until(trace_table["until"], source) if "until" in trace_table else None
     steps = trace_table.get("steps")
-    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1 or until is None):
+    if steps is not None and (
+        isinstance(steps, bool) or not isinstance(steps, int) or steps < 1 or until is None
+    ):
         raise SpecError("expected a whole number >= 1, with trace.until", source=source, key="trace.steps")
     target = str(table.get("linkage") or table.get("spec"))
     if "spec" in table:
         target = str((path.parent / target).resolve())
         if grid:
-            raise SpecError("a spec file has no parameters to vary; use a built-in linkage", source=source, key="grid")
+            raise SpecError(
+                "a spec file has no parameters to vary; use a built-in linkage", source=source, key="grid"
+            )
     robustness = _robustness(table["robustness"], source) if "robustness" in table else None
     return Study(
         kind="linkage",

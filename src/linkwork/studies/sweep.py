@@ -167,5 +167,7 @@ def run_sweep(
     func = synthesis_point if study.kind == "synthesis" else linkage_point
     chunks = [(i,) for i in range(len(study.points()))]
     return list(
-        map_chunks(func, study, chunks, scheduler=scheduler, workers=workers, client=client, progress=progress)
+        map_chunks(
+            func, study, chunks, scheduler=scheduler, workers=workers, client=client, progress=progress
+        )
     )

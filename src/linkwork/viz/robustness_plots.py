@@ -87,13 +87,17 @@ def plot_histogram(result: RobustnessResult, summary: dict[str, Any], file: Path
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(NullFormatter())
     else:
-        edges = np.linspace(float(mc.min()) if mc.size else 0.0, float(mc.max()) + 1e-300 if mc.size else 1.0, 50)
-    ax.hist(mc, bins=edges, alpha=0.6, label="Monte Carlo")
-    ax.hist(fo, bins=edges, histtype="step", lw=1.5, label="first order")
+        edges = np.linspace(
+            float(mc.min()) if mc.size else 0.0, float(mc.max()) + 1e-300 if mc.size else 1.0, 50
+        )
+    ax.hist(mc, bins=list(edges), alpha=0.6, label="Monte Carlo")
+    ax.hist(fo, bins=list(edges), histtype="step", lw=1.5, label="first order")
     ax.set_xlabel("largest misfit along the path (length units)")
     ax.set_ylabel("samples")
     kept = summary["mobility_kept"]
-    ax.set_title(f"{summary['linkage']}: mobility kept by {100.0 * (kept or 0.0):.1f} % of samples", fontsize=10)
+    ax.set_title(
+        f"{summary['linkage']}: mobility kept by {100.0 * (kept or 0.0):.1f} % of samples", fontsize=10
+    )
     ax.legend(fontsize=8)
     fig.savefig(file, dpi=120)
     plt.close(fig)

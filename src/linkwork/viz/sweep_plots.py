@@ -38,7 +38,9 @@ def plot_lines(study: Study, rows: list[dict[str, Any]], metric: str, file: Path
     import matplotlib.pyplot as plt
 
     params = [p for p in study.grid if np.isfinite(_numeric(rows, p)).all()]
-    fig, axes = plt.subplots(1, len(params), figsize=(4.5 * len(params), 3.8), layout="constrained", squeeze=False)
+    fig, axes = plt.subplots(
+        1, len(params), figsize=(4.5 * len(params), 3.8), layout="constrained", squeeze=False
+    )
     y = _numeric(rows, metric)
     for ax, p in zip(axes[0], params, strict=True):
         x = _numeric(rows, p)
@@ -47,7 +49,10 @@ def plot_lines(study: Study, rows: list[dict[str, Any]], metric: str, file: Path
         for key in dict.fromkeys(keys):
             mask = np.array([k == key for k in keys])
             order = np.argsort(x[mask])
-            label = ", ".join(f"{q}={v:g}" if isinstance(v, int | float) else f"{q}={v}" for q, v in zip(others, key, strict=True))
+            label = ", ".join(
+                f"{q}={v:g}" if isinstance(v, int | float) else f"{q}={v}"
+                for q, v in zip(others, key, strict=True)
+            )
             ax.plot(x[mask][order], y[mask][order], "o-", ms=3, label=label or None)
         ax.set_xlabel(p)
         ax.set_ylabel(METRICS[metric])
