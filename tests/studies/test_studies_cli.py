@@ -139,3 +139,17 @@ def test_bundled_example_studies_parse():
 
     for f in sorted(STUDIES.glob("*.toml")):
         assert load_study(f).points()
+
+
+def test_robustness_target_not_reached_writes_then_exits_3(tmp_path):
+    out = tmp_path / "short"
+    res = invoke(
+        "robustness", "bennett", "--until", "A=170", "--max-steps", "5", "--samples", "10",
+        "--hinge-position-tol", "1e-4", "--hinge-direction-tol", "0.01", "--workers", "0", "--no-plots",
+        "-o", str(out),
+    )  # fmt: skip
+    assert res.exit_code == 3
+    text = ANSI.sub("", res.stderr).strip()
+    assert len(text.splitlines()) == 1 and "A = 170" in text
+    summary = json.loads((out / "robustness.json").read_text())
+    assert summary["samples"] == 10 and summary["bands"]["drive_deg"][-1] < 170.0

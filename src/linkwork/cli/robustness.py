@@ -145,3 +145,13 @@ def robustness(
     print_robustness_summary(robustness_dict(result, spec))
     written = ["robustness.json", "samples.parquet", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
+    end = path.branches[0].end_reason if path.branches else ""
+    if target is not None and end != "reached target":
+        from linkwork.errors import RequestNotMetError
+
+        last = float(setup.drive_values[-1])
+        reached = float(np.degrees(last)) if mech.joint_types[mech.index(target[0])] == "R" else last
+        raise RequestNotMetError(
+            f"the nominal path stopped before {target[0]} = {target[1]:g} ({end}, at {reached:.6g}); "
+            "the study covers the path up to there"
+        )
