@@ -205,7 +205,9 @@ def mechanize(
         label = name or (f"{source.parent.name} mechanized" if source is not None else "mechanized chain")
     if chain.count < 2:
         raise MechanizationError("mechanize: needs at least two profiles to move between")
-    modes = ("ground", "any") if options.anchors == "auto" else (options.anchors,)
+    # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
+    # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
+    modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
     order = roots(chain, options)
     state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
     for root in order:

@@ -133,7 +133,7 @@ class MechanizeOptions:
         Moving pivots may sit off the chain, along its normal, up to this multiple of the body's length.
     anchors
         ``"ground"``: every dyad to the ground; ``"any"``: also between links (to a body already placed);
-        ``"auto"``: try ``"ground"`` first, then ``"any"``.
+        ``"auto"``: for each root, try ``"any"`` first, then ``"ground"`` (its top candidates differ).
     min_transmission
         Radians: dyads whose transmission angle drops below this on a profile are dropped.
     max_link
