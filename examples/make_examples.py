@@ -357,7 +357,7 @@ MECHANIZE = {
 # dyads, and the trailing edge (whose arc slide lengthens the chord) is guided by a dyad to another body.
 MECHANIZE_KEYS = {
     "seat": [
-        'binary_links = "both"     # RR dyads and prismatic sliders on the frame; a slider drives (paper, Fig. 14)'
+        'binary_links = "prismatic"   # sliders on the frame and between segments; a slider drives (paper, Fig. 14)'
     ],
     "wing-six": [
         'anchors = "any"          # dyads between bodies too (the trailing edge moves 0.3 chords)',

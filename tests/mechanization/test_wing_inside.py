@@ -17,6 +17,8 @@ from linkwork.kinematics.tracer import trace
 from linkwork.mechanization import MechanizeOptions, build_chain, mechanize, write_mechanization
 from linkwork.synthesis import synthesize
 
+from .geometry_checks import joint_positions, triangle_angle
+
 WING = Path(__file__).resolve().parents[2] / "examples" / "wing"
 CHORD = 1.0  # the cruise profile's chord, the shortest of the three
 
@@ -68,3 +70,33 @@ def test_the_written_mechanism_traces_through_every_profile(inside: tuple) -> No
         path = trace(mech, drive=drive, until=(drive, value))
         assert path.branches[0].end_reason == "reached target"
         assert not path.bifurcations
+
+
+def test_transmission_angles_are_the_triangle_angles_at_the_moving_pivots(inside: tuple) -> None:
+    folder, _ = inside
+    report = json.loads((folder / "mechanization.json").read_text())
+    names = {d["name"] for d in report["dyads"]}
+    at = [joint_positions(folder, p["angles"]) for p in report["profiles"]]
+    checked = 0
+    for d in report["dyads"]:
+        if d["type"] != "RR" or d["via"] is None:
+            continue
+        other = f"{d['via']}m" if d["via"] in names else d["via"]
+        # the triangle fixed pivot - moving pivot - the joint that places the body with this link
+        angles = [triangle_angle(a[f"{d['name']}a"], a[f"{d['name']}m"], a[other]) for a in at]
+        assert abs(d["transmission_deg"] - min(angles)) <= 1e-6, d["name"]  # degrees
+        checked += 1
+    assert checked >= 5
+
+
+def test_quality_factor_is_the_documented_product(inside: tuple) -> None:
+    folder, _ = inside
+    report = json.loads((folder / "mechanization.json").read_text())
+    sweep = abs(
+        report["profiles"][-1]["drive_value"] - report["profiles"][0]["drive_value"]
+    )  # the crank, deg
+    lengths = [d["length"] for d in report["dyads"] if d["type"] == "RR"]
+    mu = min(d["transmission_deg"] for d in report["dyads"])
+    expected = math.sin(math.radians(mu)) * min(lengths) / max(lengths) * min(1.0, 180.0 / sweep)
+    assert abs(report["quality"]["quality"] - expected) <= 1e-12
+    assert report["designs"][0]["quality"] == report["quality"]["quality"]
