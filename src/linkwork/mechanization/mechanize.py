@@ -95,8 +95,8 @@ class _Search:
                 links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
                 self.closest = (
                     reached,
-                    f"{label} (links {links}; drive {design.drive}) reached {reached} of {design.chain.count} "
-                    f"profiles, then: {check.reason}",
+                    f"{label} (links {links}; drive {design.drive}) reached profile {reached} of {design.chain.count}, "
+                    f"then: {check.reason}",
                 )
         if self.progress is not None:
             self.progress(self.attempts, self.total, f"{len(self.passed)} passed, {self.attempts} traced")
