@@ -15,12 +15,13 @@ P. Kumar, S. Pellegrino, "Computation of kinematic paths and bifurcation points"
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.kinematics.closure import hessian, reduce
-from linkwork.kinematics.march import evaluate, tangent_and_test
+from linkwork.kinematics.jit import march_kernels
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank
 
@@ -40,6 +41,7 @@ class Workspace:
     q: Array
     res: Array
     jac: Array
+    kernels: Any  # the compiled march module or its plain-Python twin (linkwork.kinematics.jit)
 
     @classmethod
     def of(cls, mech: Mechanism) -> Workspace:
@@ -55,11 +57,12 @@ class Workspace:
             q=np.empty(mech.n_joints),
             res=np.empty(mech.n_equations),
             jac=np.empty((mech.n_equations, mech.n_unknowns)),
+            kernels=march_kernels(),
         )
 
     def evaluate(self, u: Array) -> tuple[float, Array, Array]:
         """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
-        r = evaluate(
+        r = self.kernels.evaluate(
             self.twists,
             self.loop_joint,
             self.loop_sign,
@@ -120,7 +123,7 @@ def locate(
     def evaluate_at(u: Array) -> tuple[float, Array]:
         _, _, jac = ws.evaluate(u)
         t = np.empty_like(t_a)
-        value = tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
+        value = ws.kernels.tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
         return float(value), t
 
     def hermite(x: float, lo: tuple[float, Array, Array], hi: tuple[float, Array, Array]) -> Array:

@@ -24,7 +24,7 @@ from linkwork.kinematics.bifurcation import (
     locate_minimum,
     polish,
 )
-from linkwork.kinematics.march import FAILED, SIGN_CHANGE, STOP_REASONS, march
+from linkwork.kinematics.march import FAILED, SIGN_CHANGE, STOP_REASONS
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Trace
@@ -96,8 +96,8 @@ def trace(
     limits
         Joint limits ``{name: (low, high)}`` (radians); the path stops when one is passed.
     """
+    ws = Workspace.of(mech)  # picks compiled or plain-Python kernels (and compiles, if asked) before the clock
     started = time.perf_counter()
-    ws = Workspace.of(mech)
     m = mech.n_unknowns
     if m == 0:
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
@@ -190,7 +190,7 @@ def trace(
             out_tau = np.empty(N + 1)
             out_s = np.empty(N + 1)
             basis_prev = basis.copy()
-            count, code, h = march(
+            count, code, h = ws.kernels.march(
                 ws.twists, ws.loop_joint, ws.loop_sign, ws.loop_ptr, ws.rows, ws.groups,
                 u, t, u_home, basis, paper, d_unknown, h0, min_step, max_step, np.cos(max_turn),
                 0.0 if target is None else target, target is not None,
@@ -351,12 +351,10 @@ def trace(
 
 def _basis_before(ws: Workspace, u: Array, t: Array, basis_prev: Array, r_path: int) -> Array:
     """The oriented range basis at point ``u`` (as the march kept it), recomputed for the locator."""
-    from linkwork.kinematics.march import tangent_and_test
-
     _, _, jac = ws.evaluate(u)
     basis = basis_prev.copy()
     tt = np.empty_like(t)
-    tangent_and_test(jac, t.copy(), basis, r_path, tt, np.empty(min(jac.shape)))
+    ws.kernels.tangent_and_test(jac, t.copy(), basis, r_path, tt, np.empty(min(jac.shape)))
     return basis
 
 

@@ -1,0 +1,213 @@
+"""Compiled or plain-Python kernels: which implementation of the tracing hot loop a trace runs, and when to compile.
+
+The tracing kernels (:mod:`linkwork.kinematics.march` and :mod:`linkwork.kinematics.kernels`) are numba functions
+cached on disk. On a fresh install that cache is empty and compiling them takes longer than most traces. So, by
+default (``LINKWORK_JIT=auto``), a process that finds the cache cold traces with the *same* functions run as plain
+Python (numba's ``py_func``, rebound so that they call each other as Python too: identical arithmetic, no
+compile) and starts one background process that compiles the kernels into the cache for the next run.
+
+``LINKWORK_JIT=compiled`` always uses the compiled kernels, compiling them first in this process when the cache is
+cold (announced, and excluded from the trace's reported time); ``LINKWORK_JIT=python`` always uses plain Python.
+Announcements go to the ``linkwork.jit`` logger (the command line prints them on stderr).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import subprocess
+import sys
+import time
+import types
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from numba.core.registry import CPUDispatcher
+
+log = logging.getLogger("linkwork.jit")
+
+MODES = ("auto", "compiled", "python")
+ENTRY_POINTS = ("march", "evaluate", "tangent_and_test")
+"""The functions of :mod:`linkwork.kinematics.march` that the tracer and the bifurcation locator call."""
+
+LOCK_NAME = "linkwork-compiling.lock"
+LOCK_STALE_SECONDS = 600.0
+
+_state: dict[str, Any] = {"compiling": False, "spawned": False, "compile_seconds": 0.0}
+
+
+def mode() -> str:
+    """The kernel mode from ``LINKWORK_JIT`` (``auto`` when unset); an unknown value is reported and ignored."""
+    value = os.environ.get("LINKWORK_JIT", "auto").strip().lower() or "auto"
+    if value not in MODES:
+        log.warning("LINKWORK_JIT=%s is not one of %s; using auto", value, ", ".join(MODES))
+        return "auto"
+    return value
+
+
+def python_twin(functions: dict[str, CPUDispatcher]) -> types.SimpleNamespace:
+    """The plain-Python versions of compiled ``functions``, calling each other (and every kernel they call) as
+    plain Python: numba's ``py_func`` of each, re-bound to globals in which every dispatcher is replaced by its
+    twin. The arithmetic is the same statements in the same order, so results agree with the compiled kernels to
+    round-off."""
+    memo: dict[int, types.FunctionType] = {}
+
+    def twin(dispatcher: CPUDispatcher) -> types.FunctionType:
+        key = id(dispatcher)
+        if key in memo:
+            return memo[key]
+        py = dispatcher.py_func
+        scope = dict(py.__globals__)
+        fn = types.FunctionType(py.__code__, scope, py.__name__, py.__defaults__, py.__closure__)
+        fn.__doc__, fn.__qualname__ = py.__doc__, py.__qualname__
+        memo[key] = fn  # before the globals, so that recursion and mutual calls resolve to the twin
+        for name, value in py.__globals__.items():
+            if isinstance(value, CPUDispatcher):
+                scope[name] = twin(value)
+        return fn
+
+    return types.SimpleNamespace(**{name: twin(d) for name, d in functions.items()})
+
+
+def is_cached(dispatcher: CPUDispatcher) -> bool:
+    """Whether ``dispatcher`` is compiled in this process or has a compiled version in numba's on-disk cache
+    (an index written by numba for this very source; a stale index reads as empty)."""
+    if dispatcher.signatures:
+        return True
+    try:
+        return bool(dispatcher._cache._cache_file._load_index())
+    except Exception:  # numba internals moved: assume warm, i.e. behave as before this module existed
+        return True
+
+
+def _march_dispatchers() -> dict[str, CPUDispatcher]:
+    from linkwork.kinematics import march
+
+    return {name: getattr(march, name) for name in ENTRY_POINTS}
+
+
+def kernels_cached() -> bool:
+    """Whether every tracing kernel is ready without compiling (in this process or in the on-disk cache)."""
+    return all(is_cached(d) for d in _march_dispatchers().values())
+
+
+_TWIN: dict[str, types.SimpleNamespace] = {}
+
+
+def march_kernels() -> Any:
+    """The implementation of :data:`ENTRY_POINTS` a trace should run now: the compiled module or its
+    plain-Python twin, by :func:`mode` and the state of the cache (see the module's docstring)."""
+    from linkwork.kinematics import march
+
+    chosen = mode()
+    if _state["compiling"]:
+        return march
+    if chosen == "python":
+        return plain_march_kernels()
+    if kernels_cached():
+        return march
+    if chosen == "compiled":
+        compile_now(announce=True)
+        return march
+    start_background_compile()
+    return plain_march_kernels()
+
+
+def plain_march_kernels() -> types.SimpleNamespace:
+    """The plain-Python twin of the tracing kernels (built once per process)."""
+    if "march" not in _TWIN:
+        _TWIN["march"] = python_twin(_march_dispatchers())
+    return _TWIN["march"]
+
+
+def compile_now(announce: bool = False) -> float:
+    """Compile the tracing kernels in this process (into numba's cache) by tracing two small linkages with them;
+    returns the seconds it took (also kept as ``last_compile_seconds()``)."""
+    if announce:
+        log.info("compiling kernels, first run only ...")
+    started = time.perf_counter()
+    _state["compiling"] = True
+    try:
+        _warm_up()
+    finally:
+        _state["compiling"] = False
+    seconds = time.perf_counter() - started
+    _state["compile_seconds"] += seconds
+    if announce:
+        log.info("compiled kernels in %.1f s (cached for next time)", seconds)
+    return seconds
+
+
+def last_compile_seconds() -> float:
+    """Seconds this process has spent compiling kernels (0 when it found them cached)."""
+    return float(_state["compile_seconds"])
+
+
+def _warm_up() -> None:
+    """Run every entry point with the argument types a trace uses: an adaptive trace with a target, a
+    paper-mode trace and an adaptive trace without a target, of a Bennett linkage."""
+    import math
+
+    from linkwork.io.spec import resolve_spec
+    from linkwork.kinematics.tracer import trace
+
+    mech = resolve_spec("bennett", {}).mechanism
+    trace(mech, until=(mech.joint_names[0], mech.offsets[0] + 0.3))
+    trace(mech, until=(mech.joint_names[0], mech.offsets[0] + 0.3), steps=4)
+    trace(mech, max_steps=8, max_step=math.radians(5.0))
+
+
+def _lock_path() -> Path | None:
+    try:
+        from linkwork.kinematics import march
+
+        return Path(march.march._cache._cache_path) / LOCK_NAME
+    except Exception:
+        return None
+
+
+def start_background_compile(runner: Callable[..., Any] = subprocess.Popen) -> bool:
+    """Start (at most once per process, and not while another process is at it) a detached
+    ``python -m linkwork.kinematics.jit`` that fills the cache; returns whether one was started."""
+    if _state["spawned"]:
+        return False
+    _state["spawned"] = True
+    lock = _lock_path()
+    if lock is not None:
+        try:
+            if time.time() - lock.stat().st_mtime < LOCK_STALE_SECONDS:
+                log.info("kernels are compiling in another process; tracing with the Python kernels meanwhile")
+                return False
+        except OSError:
+            pass
+    log.info(
+        "compiling kernels, first run only: in the background for next time; this run uses the Python kernels"
+    )
+    env = dict(os.environ, LINKWORK_JIT="compiled")
+    runner(
+        [sys.executable, "-m", "linkwork.kinematics.jit"],
+        env=env,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    return True
+
+
+def _background_main() -> None:
+    """Body of the background compile: hold the lock file while compiling."""
+    lock = _lock_path()
+    try:
+        if lock is not None:
+            lock.parent.mkdir(parents=True, exist_ok=True)
+            lock.touch()
+        compile_now()
+    finally:
+        if lock is not None:
+            lock.unlink(missing_ok=True)
+
+
+if __name__ == "__main__":
+    _background_main()
