@@ -72,7 +72,7 @@ def trace(
     branches: Annotated[
         bool, typer.Option("--branches", help="Follow every branch at every bifurcation.")
     ] = False,
-    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
     animate: Annotated[
         bool,

@@ -27,3 +27,17 @@ def example(name: str = "wing", file: str = "problem.toml") -> Path:
     if not path.is_file():
         raise SpecError(f"the bundled example is missing ({path}); reinstall linkwork", key="example")
     return path
+
+
+def problem_file(spec: str | Path) -> Path:
+    """The problem file that ``spec`` names: an existing file as it is, else a bundled example's problem file by
+    name (``"wing"``), as built-in linkages are found by name; a name that is neither is a :class:`SpecError`."""
+    path = Path(spec)
+    if path.exists() or str(spec) not in EXAMPLES:
+        if not path.exists():
+            raise SpecError(
+                f"{spec}: file not found; expected a problem file (TOML) or a bundled example "
+                f"({', '.join(EXAMPLES)})"
+            )
+        return path
+    return example(str(spec))

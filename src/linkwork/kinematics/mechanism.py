@@ -217,7 +217,7 @@ class Mechanism:
         from linkwork.kinematics.closure import body_poses, spatial_twists
 
         q = np.asarray(q, dtype=float)
-        poses = body_poses(self, q)
+        poses = body_poses(self, q=q)
         twists = spatial_twists(self, q, poses)
         return replace(self, twists=twists, offsets=self.offsets + q)
 

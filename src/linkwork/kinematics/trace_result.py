@@ -111,3 +111,76 @@ class Trace:
     def of_branch(self, branch: int) -> NDArray[np.bool_]:
         """Boolean mask of the points of one branch."""
         return self.branch == branch
+
+    # ---------------------------------------------------------------------------------------- notebook use
+    def positions(self) -> Array:
+        """``(N, n, 3)`` world coordinates of every joint at every point, in ``mechanism.joint_names`` order.
+
+        A joint's point is a fixed point on its axis (see :mod:`linkwork.kinematics.positions`), placed by the
+        pose of its body; the reference offsets are taken care of.
+        """
+        from linkwork.kinematics.positions import joint_positions
+
+        return joint_positions(self.mechanism, self.angles, self.poses())
+
+    def poses(self) -> dict[str, Array]:
+        """``{body: (N, 4, 4)}`` the world pose of every body at every point (displacement from the reference
+        configuration, the first body or the ground held still)."""
+        from linkwork.kinematics.positions import poses_along
+
+        return poses_along(self.mechanism, self.angles)
+
+    def plot(self, kind: str = "angles", *, branch: int = 0) -> Any:
+        """A matplotlib ``Figure``: ``kind="angles"`` (every hinge angle against the drive, all branches) or
+        ``"singular_values"`` (the Jacobian's singular values along ``branch``). Needs ``linkwork[viz]``."""
+        from linkwork.viz import trace_plots
+
+        if kind == "angles":
+            return trace_plots.angles_figure(self)
+        if kind == "singular_values":
+            return trace_plots.singular_values_figure(self, branch)
+        raise ValueError(f"Expected kind 'angles' or 'singular_values', got {kind!r}")
+
+    def __repr__(self) -> str:
+        """A few lines a notebook user can read: size, joints, branches, the range of the drive, accuracy."""
+        return "\n".join(_summary_lines(self))
+
+    def _repr_html_(self) -> str:
+        """The interactive viewer (the same page ``linkwork trace --html`` writes), inline in Jupyter."""
+        from linkwork.viz.inline import trace_html
+
+        return trace_html(self)
+
+
+def _names(names: tuple[str, ...], most: int = 12) -> str:
+    """Joint names, shortened in the middle when there are many."""
+    if len(names) <= most:
+        return ", ".join(names)
+    return ", ".join(names[: most - 2]) + f", ... , {names[-1]}"
+
+
+def _summary_lines(trace: Trace) -> list[str]:
+    mech = trace.mechanism
+    n_points = len(trace.angles)
+    d = mech.index(trace.drive)
+    unit, scale = ("deg", 180.0 / np.pi) if mech.joint_types[d] == "R" else ("", 1.0)
+    drive = trace.angles[:, d] * scale if n_points else np.zeros(1)
+    mobility = trace.mobility
+    lines = [
+        f"Trace of {mech.name!r}: {n_points} points, {len(trace.branches)} branch(es), "
+        f"{len(trace.bifurcations)} bifurcation point(s)",
+        f"  joints ({mech.n_joints}): {_names(mech.joint_names)}; drive {trace.drive} "
+        f"from {drive[0]:.6g} to {drive[-1]:.6g} {unit}".rstrip(),
+    ]
+    if n_points:
+        lines.append(
+            f"  mobility {int(mobility.min())}..{int(mobility.max())}; max closure residual "
+            f"{float(np.max(trace.residual)):.2e}; max condition {trace.max_condition:.4g}"
+        )
+    for br in trace.branches[:4]:
+        origin = "start" if br.parent is None else f"bifurcation {br.bifurcation} on branch {br.parent}"
+        lines.append(f"  branch {br.id}: {br.steps} steps from {origin}, ended: {br.end_reason}")
+    if len(trace.branches) > 4:
+        lines.append(f"  ... {len(trace.branches) - 4} more branches (trace.branches)")
+    lines.append("  .angles (N, n) rad, .positions() (N, n, 3), .poses(), .plot(), .sigma, .bifurcations")
+    return lines

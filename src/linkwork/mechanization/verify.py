@@ -95,7 +95,7 @@ def loaded_mechanism(design: Design) -> Mechanism:
 
 def chain_displacements(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
     """``(x, y, angle)`` displacement of every body of the mechanism at joint displacements ``values``."""
-    poses = body_poses(mech, values)
+    poses = body_poses(mech, q=values)
     return {name: pose_of(g[np.ix_([0, 1, 3], [0, 1, 3])]) for name, g in poses.items()}
 
 
