@@ -315,7 +315,7 @@ def plot_compound(result: SynthesisResult) -> Figure:
 
 def plot_errors(result: SynthesisResult) -> Figure:
     """The error of every segment on every profile (Eq. 21: the largest point-to-point distance), after
-    segmentation (outlined) and after joining (filled), with E_max of the joined chain (Eq. 22) dashed."""
+    segmentation (pale, left) and after joining (solid, right), with E_max of the joined chain (Eq. 22) dashed."""
     from matplotlib.figure import Figure
 
     q, p = result.joined_error_matrix.shape
@@ -324,16 +324,16 @@ def plot_errors(result: SynthesisResult) -> Figure:
     width = 0.8 / p
     x = np.arange(q)
     for j in range(p):
-        left = x - 0.4 + (j + 0.5) * width
-        ax.bar(left, result.error_matrix[:, j], width, fill=False, edgecolor=_colour(j), linewidth=1.0)
-        ax.bar(left, result.joined_error_matrix[:, j], width * 0.6, color=_colour(j), label=_name(result, j))
+        centre = x - 0.4 + (j + 0.5) * width
+        ax.bar(centre - width / 4, result.error_matrix[:, j], width / 2, color=_colour(j), alpha=0.35)
+        ax.bar(centre + width / 4, result.joined_error_matrix[:, j], width / 2, color=_colour(j), label=_name(result, j))
     ax.axhline(result.joined_e_max, color="black", linestyle="--", linewidth=0.9)
     ax.set_xticks(x, [f"{e + 1} {kind}" for e, kind in enumerate(result.design)])
     ax.set_xlabel("segment (M: rigid, C: constant curvature)")
     ax.set_ylabel("error E (profile length units)")
     ax.set_title(
-        f"segment errors, outlined: segmented (E_max = {result.e_max:.3g}); "
-        f"filled: joined (E_max = {result.joined_e_max:.3g}, dashed)",
+        f"segment errors, pale: segmented (E_max = {result.e_max:.3g}); "
+        f"solid: joined (E_max = {result.joined_e_max:.3g}, dashed)",
         fontsize="medium",
     )
     ax.grid(axis="y", alpha=0.3)
