@@ -82,7 +82,12 @@ def _file_units(spec: str | pathlib.Path, params: dict[str, Any]) -> dict[str, A
     out = dict(params)
     for key, value in params.items():
         param = entry.params.get(key)
-        if param is not None and param.unit == "deg" and isinstance(value, int | float) and not isinstance(value, bool):
+        if (
+            param is not None
+            and param.unit == "deg"
+            and isinstance(value, int | float)
+            and not isinstance(value, bool)
+        ):
             out[key] = math.degrees(value)
     return out
 

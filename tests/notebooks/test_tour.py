@@ -28,7 +28,8 @@ def _outputs(notebook: nbformat.NotebookNode, source_start: str, *, whole: bool 
     cells = [
         c
         for c in notebook.cells
-        if c.cell_type == "code" and (c.source.strip() == source_start if whole else c.source.startswith(source_start))
+        if c.cell_type == "code"
+        and (c.source.strip() == source_start if whole else c.source.startswith(source_start))
     ]
     assert len(cells) == 1, f"expected one cell starting with {source_start!r}"
     return list(cells[0].outputs)
@@ -49,7 +50,12 @@ def test_tour_runs_and_shows_figures_and_viewers(executed: nbformat.NotebookNode
         html = result["data"]["text/html"]
         assert html.startswith("<iframe srcdoc=") and "&lt;script" in html and "<script" not in html
         assert len(result["data"]["text/plain"].splitlines()) < 10
-    for start in ("hoop.plot()", 'frame.plot("singular_values")', 'wing.plot("chain")', 'wing.plot("errors")'):
+    for start in (
+        "hoop.plot()",
+        'frame.plot("singular_values")',
+        'wing.plot("chain")',
+        'wing.plot("errors")',
+    ):
         (figure,) = _outputs(executed, start)
         assert "image/png" in figure["data"]
 

@@ -95,7 +95,9 @@ def reduce(mech: Mechanism, matrix: Array) -> Array:
     return np.einsum("eij,ia,jb->eab", matrix, C, C)
 
 
-def body_poses(mech: Mechanism, *, q: ArrayLike | None = None, angles: ArrayLike | None = None) -> dict[str, Array]:
+def body_poses(
+    mech: Mechanism, *, q: ArrayLike | None = None, angles: ArrayLike | None = None
+) -> dict[str, Array]:
     """Displacement of every body from the reference (4x4), along a spanning tree from the first body (the
     ground, when there is one).
 
@@ -105,7 +107,7 @@ def body_poses(mech: Mechanism, *, q: ArrayLike | None = None, angles: ArrayLike
     """
     if (q is None) == (angles is None):
         raise TypeError("body_poses takes exactly one of angles= (joint values) or q= (displacements)")
-    q = mech.q_from_angles(angles) if q is None else np.asarray(q, dtype=float)
+    q = np.asarray(q, dtype=float) if angles is None else mech.q_from_angles(angles)
     if not mech.bodies:
         return {}
     root = "ground" if "ground" in mech.bodies else mech.bodies[0]

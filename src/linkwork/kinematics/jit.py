@@ -76,7 +76,7 @@ def is_cached(dispatcher: CPUDispatcher) -> bool:
     if dispatcher.signatures:
         return True
     try:
-        return bool(dispatcher._cache._cache_file._load_index())
+        return bool(dispatcher._cache._cache_file._load_index())  # type: ignore[attr-defined]
     except Exception:  # numba internals moved: assume warm, i.e. behave as before this module existed
         return True
 
@@ -111,7 +111,38 @@ def march_kernels() -> Any:
         compile_now(announce=True)
         return march
     start_background_compile()
-    return plain_march_kernels()
+    return SwitchingKernels()
+
+
+class SwitchingKernels:
+    """The plain-Python kernels until the background compile has filled the cache, then the compiled ones.
+
+    Looked up at every call of an entry point (``kernels.march(...)``); the cache is checked at most once every
+    :attr:`CHECK_SECONDS`, so that a long first trace moves to compiled code as soon as it exists. Both give the
+    same numbers (see :func:`python_twin`), so a trace may switch halfway.
+    """
+
+    CHECK_SECONDS = 1.0
+
+    def __init__(self) -> None:
+        self._compiled: Any = None
+        self._checked = time.monotonic()
+
+    def __getattr__(self, name: str) -> Any:
+        if name not in ENTRY_POINTS:
+            raise AttributeError(name)
+        if self._compiled is None and time.monotonic() - self._checked > self.CHECK_SECONDS:
+            self._checked = time.monotonic()
+            if background_compile_finished():
+                from linkwork.kinematics import march
+
+                self._compiled = march
+        return getattr(self._compiled or plain_march_kernels(), name)
+
+
+def background_compile_finished() -> bool:
+    """Whether no compile is under way (no fresh lock file) and the kernels are in the cache."""
+    return not _compile_under_way() and kernels_cached()
 
 
 def plain_march_kernels() -> types.SimpleNamespace:
@@ -158,34 +189,49 @@ def _warm_up() -> None:
     trace(mech, max_steps=8, max_step=math.radians(5.0))
 
 
+def _compile_under_way() -> bool:
+    """Whether a fresh lock file says that a process is compiling the kernels into the cache."""
+    lock = _lock_path()
+    try:
+        return lock is not None and time.time() - lock.stat().st_mtime < LOCK_STALE_SECONDS
+    except OSError:
+        return False
+
+
+def _touch_lock() -> None:
+    lock = _lock_path()
+    if lock is not None:
+        try:
+            lock.parent.mkdir(parents=True, exist_ok=True)
+            lock.touch()
+        except OSError:
+            pass
+
+
 def _lock_path() -> Path | None:
     try:
         from linkwork.kinematics import march
 
-        return Path(march.march._cache._cache_path) / LOCK_NAME
+        return Path(march.march._cache._cache_path) / LOCK_NAME  # type: ignore[attr-defined]
     except Exception:
         return None
 
 
-def start_background_compile(runner: Callable[..., Any] = subprocess.Popen) -> bool:
+def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
     """Start (at most once per process, and not while another process is at it) a detached
     ``python -m linkwork.kinematics.jit`` that fills the cache; returns whether one was started."""
     if _state["spawned"]:
         return False
     _state["spawned"] = True
-    lock = _lock_path()
-    if lock is not None:
-        try:
-            if time.time() - lock.stat().st_mtime < LOCK_STALE_SECONDS:
-                log.info("kernels are compiling in another process; tracing with the Python kernels meanwhile")
-                return False
-        except OSError:
-            pass
+    if _compile_under_way():
+        log.info("kernels are compiling in another process; tracing with the Python kernels meanwhile")
+        return False
+    _touch_lock()  # at once, so that a process started meanwhile does not compile too
     log.info(
         "compiling kernels, first run only: in the background for next time; this run uses the Python kernels"
     )
     env = dict(os.environ, LINKWORK_JIT="compiled")
-    runner(
+    (runner or subprocess.Popen)(
         [sys.executable, "-m", "linkwork.kinematics.jit"],
         env=env,
         stdin=subprocess.DEVNULL,
@@ -198,13 +244,11 @@ def start_background_compile(runner: Callable[..., Any] = subprocess.Popen) -> b
 
 def _background_main() -> None:
     """Body of the background compile: hold the lock file while compiling."""
-    lock = _lock_path()
+    _touch_lock()
     try:
-        if lock is not None:
-            lock.parent.mkdir(parents=True, exist_ok=True)
-            lock.touch()
         compile_now()
     finally:
+        lock = _lock_path()
         if lock is not None:
             lock.unlink(missing_ok=True)
 

@@ -96,7 +96,8 @@ def trace(
     limits
         Joint limits ``{name: (low, high)}`` (radians); the path stops when one is passed.
     """
-    ws = Workspace.of(mech)  # picks compiled or plain-Python kernels (and compiles, if asked) before the clock
+    # Workspace.of picks compiled or plain-Python kernels (and compiles them, if asked) before the clock starts.
+    ws = Workspace.of(mech)
     started = time.perf_counter()
     m = mech.n_unknowns
     if m == 0:

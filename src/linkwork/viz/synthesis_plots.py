@@ -326,7 +326,13 @@ def plot_errors(result: SynthesisResult) -> Figure:
     for j in range(p):
         centre = x - 0.4 + (j + 0.5) * width
         ax.bar(centre - width / 4, result.error_matrix[:, j], width / 2, color=_colour(j), alpha=0.35)
-        ax.bar(centre + width / 4, result.joined_error_matrix[:, j], width / 2, color=_colour(j), label=_name(result, j))
+        ax.bar(
+            centre + width / 4,
+            result.joined_error_matrix[:, j],
+            width / 2,
+            color=_colour(j),
+            label=_name(result, j),
+        )
     ax.axhline(result.joined_e_max, color="black", linestyle="--", linewidth=0.9)
     ax.set_xticks(x, [f"{e + 1} {kind}" for e, kind in enumerate(result.design)])
     ax.set_xlabel("segment (M: rigid, C: constant curvature)")
