@@ -47,7 +47,9 @@ def test_every_out_option_has_the_short_form(command: str) -> None:
 
 
 def test_short_out_writes_where_asked(tmp_path: Path) -> None:
-    result = runner.invoke(app, ["trace", "bennett", "--until", "A=80", "--no-plots", "-o", str(tmp_path / "t")])
+    result = runner.invoke(
+        app, ["trace", "bennett", "--until", "A=80", "--no-plots", "-o", str(tmp_path / "t")]
+    )
     assert result.exit_code == 0, result.stderr
     report = json.loads((tmp_path / "t" / "report.json").read_text())
     assert report["branches"][0]["end_reason"] == "reached target"
@@ -83,7 +85,9 @@ def test_a_cold_kernel_cache_is_announced_on_stderr(tmp_path: Path, monkeypatch:
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
     monkeypatch.setattr(jit, "kernels_cached", lambda: False)
     monkeypatch.setattr(jit, "_warm_up", lambda: None)  # the kernels are compiled in this process already
-    result = runner.invoke(app, ["trace", "bennett", "--until", "A=70", "--no-plots", "-o", str(tmp_path / "t")])
+    result = runner.invoke(
+        app, ["trace", "bennett", "--until", "A=70", "--no-plots", "-o", str(tmp_path / "t")]
+    )
     assert result.exit_code == 0, result.stderr
     assert "note: compiling kernels, first run only" in result.stderr
     assert "compiling" not in result.stdout

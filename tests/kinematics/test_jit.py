@@ -94,7 +94,7 @@ def test_a_cold_cache_traces_in_python_and_compiles_in_the_background(
     assert kernels.march is jit.plain_march_kernels().march
     assert len(started) == 1
     cmd, env = started[0]
-    assert cmd == [sys.executable, "-m", "linkwork.kinematics.jit"] and env["LINKWORK_JIT"] == "compiled"
+    assert cmd == [sys.executable, "-c", jit.BACKGROUND_COMMAND] and env["LINKWORK_JIT"] == "compiled"
     assert "compiling kernels, first run only" in caplog.text
     # Once the compile has finished, the next call of an entry point runs compiled code.
     monkeypatch.setattr(jit, "kernels_cached", lambda: True)

@@ -4,7 +4,12 @@ The tracing kernels (:mod:`linkwork.kinematics.march` and :mod:`linkwork.kinemat
 cached on disk. On a fresh install that cache is empty and compiling them takes longer than most traces. So, by
 default (``LINKWORK_JIT=auto``), a process that finds the cache cold traces with the *same* functions run as plain
 Python (numba's ``py_func``, rebound so that they call each other as Python too: identical arithmetic, no
-compile) and starts one background process that compiles the kernels into the cache for the next run.
+compile) and starts one background process that compiles the kernels into the cache for the next run; a long trace
+moves to the compiled kernels as soon as they are there (:class:`SwitchingKernels`). When the cache is warm, the
+kernels are loaded before the trace's clock starts, so a trace's reported time is tracing only.
+
+The hook: :class:`linkwork.kinematics.bifurcation.Workspace` holds ``kernels = march_kernels()``; the tracer and
+the bifurcation locator call ``ws.kernels.march``, ``ws.kernels.evaluate`` and ``ws.kernels.tangent_and_test``.
 
 ``LINKWORK_JIT=compiled`` always uses the compiled kernels, compiling them first in this process when the cache is
 cold (announced, and excluded from the trace's reported time); ``LINKWORK_JIT=python`` always uses plain Python.
@@ -32,6 +37,12 @@ ENTRY_POINTS = ("march", "evaluate", "tangent_and_test")
 """The functions of :mod:`linkwork.kinematics.march` that the tracer and the bifurcation locator call."""
 
 LOCK_NAME = "linkwork-compiling.lock"
+BACKGROUND_COMMAND = (
+    "from linkwork.kinematics.jit import compile_in_background; compile_in_background(); "
+    "from linkwork.synthesis.compiled import warm_up; warm_up()"
+)
+"""The background process: the tracing kernels first (holding the lock), then the synthesis search's, so that a
+later ``linkwork synth`` finds them cached too."""
 LOCK_STALE_SECONDS = 600.0
 
 _state: dict[str, Any] = {"compiling": False, "spawned": False, "compile_seconds": 0.0}
@@ -106,6 +117,8 @@ def march_kernels() -> Any:
     if chosen == "python":
         return plain_march_kernels()
     if kernels_cached():
+        if not march.march.signatures:
+            compile_now()  # loads the cached machine code now, so that the trace's clock counts tracing only
         return march
     if chosen == "compiled":
         compile_now(announce=True)
@@ -153,8 +166,9 @@ def plain_march_kernels() -> types.SimpleNamespace:
 
 
 def compile_now(announce: bool = False) -> float:
-    """Compile the tracing kernels in this process (into numba's cache) by tracing two small linkages with them;
-    returns the seconds it took (also kept as ``last_compile_seconds()``)."""
+    """Compile the tracing kernels in this process (into numba's cache), or load them from it when they are
+    there, by tracing a small linkage with them; returns the seconds it took (their sum is
+    ``compile_seconds()``)."""
     if announce:
         log.info("compiling kernels, first run only ...")
     started = time.perf_counter()
@@ -170,8 +184,8 @@ def compile_now(announce: bool = False) -> float:
     return seconds
 
 
-def last_compile_seconds() -> float:
-    """Seconds this process has spent compiling kernels (0 when it found them cached)."""
+def compile_seconds() -> float:
+    """Seconds this process has spent compiling kernels, or loading them from the cache, before tracing."""
     return float(_state["compile_seconds"])
 
 
@@ -218,8 +232,8 @@ def _lock_path() -> Path | None:
 
 
 def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
-    """Start (at most once per process, and not while another process is at it) a detached
-    ``python -m linkwork.kinematics.jit`` that fills the cache; returns whether one was started."""
+    """Start (at most once per process, and not while another process is at it) a detached Python process
+    running :func:`compile_in_background`, which fills the cache; returns whether one was started."""
     if _state["spawned"]:
         return False
     _state["spawned"] = True
@@ -232,7 +246,7 @@ def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
     )
     env = dict(os.environ, LINKWORK_JIT="compiled")
     (runner or subprocess.Popen)(
-        [sys.executable, "-m", "linkwork.kinematics.jit"],
+        [sys.executable, "-c", BACKGROUND_COMMAND],
         env=env,
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,
@@ -242,8 +256,8 @@ def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
     return True
 
 
-def _background_main() -> None:
-    """Body of the background compile: hold the lock file while compiling."""
+def compile_in_background() -> None:
+    """Compile the tracing kernels into the cache holding the lock file (the background process's first job)."""
     _touch_lock()
     try:
         compile_now()
@@ -251,7 +265,3 @@ def _background_main() -> None:
         lock = _lock_path()
         if lock is not None:
             lock.unlink(missing_ok=True)
-
-
-if __name__ == "__main__":
-    _background_main()
