@@ -21,6 +21,7 @@ from linkwork.kinematics.tracer import trace
 
 if TYPE_CHECKING:
     from linkwork.synthesis.problem import Problem
+    from linkwork.synthesis.result import SynthesisResult
 
 __version__ = "0.1.0"
 
@@ -92,7 +93,7 @@ def _file_units(spec: str | pathlib.Path, params: dict[str, Any]) -> dict[str, A
     return out
 
 
-def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> Any:
+def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> SynthesisResult:
     """Synthesise a chain of rigid links that approximates every design profile of ``problem``.
 
     ``problem`` is a :class:`linkwork.synthesis.problem.Problem`, the path of a problem TOML file, or the name of
