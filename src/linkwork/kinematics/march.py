@@ -17,7 +17,7 @@ from numba import njit
 
 from linkwork.kinematics.kernels import closure_jacobian, expand
 
-BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING = 0, 1, 2, 3, 4, 5, 6
+BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING, NO_PROGRESS = 0, 1, 2, 3, 4, 5, 6, 7
 STOP_REASONS = {
     BUDGET: "step budget",
     TARGET: "reached target",
@@ -26,6 +26,7 @@ STOP_REASONS = {
     SIGN_CHANGE: "bifurcation",
     LIMIT: "joint limit",
     TURNING: "drive turning point",
+    NO_PROGRESS: "no progress",
 }
 
 
@@ -39,23 +40,27 @@ def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, j
 
 @njit(cache=True)
 def correct(
-    twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, truncate, max_iter, q, res, jac
-):
+    twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, exact, roundoff, truncate, max_iter, q,
+    res, jac,
+):  # fmt: skip
     """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
 
     ``held`` is the unknown kept fixed (-1: none, minimum-norm correction over all unknowns). Returns
-    ``(converged, iterations, residual)``. Accepts a residual that stalls below ``100 tol`` (round-off floor of
-    very long loops) and reports it.
+    ``(converged, iterations, residual)``. Converged: a residual below ``exact``, or one that stalls (falls by
+    less than half in an iteration) below ``max(tol, roundoff * exact)``: the least-squares closure of a loop
+    whose parameters are off by up to ``tol`` (``Tolerances.closure``), or the round-off floor of a very long
+    loop.
     """
     m = u.shape[0]
     prev = np.inf
+    accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
         r = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
         if not np.isfinite(r):
             return False, it, r
-        if r < tol:
+        if r < exact:
             return True, it, r
-        if r < 100.0 * tol and r > 0.5 * prev:
+        if r < accept and r > 0.5 * prev:
             return True, it, r
         if it == max_iter or (it >= 2 and r > prev):
             return False, it, r
@@ -179,12 +184,12 @@ def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
 
 @njit(cache=True)
 def wrapped_distance(a, b, periodic):
-    """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to (-pi, pi]."""
+    """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to [-pi, pi)."""
     d = 0.0
     for i in range(a.shape[0]):
         diff = a[i] - b[i]
         if periodic[i]:
-            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # compiled copy of linkwork.geometry.angles.wrap
         d += diff * diff
     return np.sqrt(d)
 
@@ -210,8 +215,13 @@ def march(
     target,
     has_target,
     tol,
+    exact,
+    roundoff,
     truncate,
     max_iter,
+    advance,
+    stall_steps,
+    stall_length,
     max_steps,
     r_path,
     periodic,
@@ -229,6 +239,10 @@ def march(
     """March from ``(u0, t0)`` for at most ``max_steps`` steps; row 0 of the outputs is the start.
 
     ``u_home`` is where the path began (for closed-path detection across several calls).
+
+    An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h`` along
+    the tangent (the corrector pulled it back); the march stops with ``NO_PROGRESS`` when its last
+    ``stall_steps`` steps together advanced less than ``stall_length * hmax``.
 
     ``paper``: fixed steps of ``h0`` in the drive unknown (signed: negative steps move the drive down), corrector
     with the drive held (the paper's mode);
@@ -259,6 +273,7 @@ def march(
     s_total = 0.0
     basis_try = basis.copy()
     far = wrapped_distance(u0, u_home, periodic)
+    recent = np.zeros(max(stall_steps, 1))  # lengths of the last stall_steps steps (a ring)
     count = 1
     while count <= max_steps:
         landing = False
@@ -304,6 +319,8 @@ def march(
             u_try,
             held,
             tol,
+            exact,
+            roundoff,
             truncate,
             max_iter,
             q,
@@ -320,7 +337,12 @@ def march(
             for a in range(m):
                 dist += (u_try[a] - u[a]) ** 2
             dist = np.sqrt(dist)
-            if not paper and not landing and (turn < cos_turn or dist > 2.0 * step + 1e-300) and h > hmin:
+            ahead = 0.0
+            for a in range(m):
+                ahead += t[a] * (u_try[a] - u[a])
+            jumped = dist > 2.0 * step + 1e-300
+            pulled_back = ahead < advance * step
+            if not paper and not landing and (turn < cos_turn or jumped or pulled_back) and h > hmin:
                 ok = False
         if not ok:
             if paper:
@@ -341,7 +363,10 @@ def march(
         out_res[count] = r
         out_tau[count] = tau_new
         out_s[count] = s_total
+        recent[count % recent.shape[0]] = dist
         count += 1
+        if count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
+            return count, NO_PROGRESS, h
         if landing:
             return count, TARGET, h
         for a in range(m):
