@@ -77,7 +77,7 @@ def classify_point(
     dim = component_dimension(ws, u, tol)
     if dim >= 2:
         _, _, jac = ws.evaluate(u)
-        sigma = np.linalg.svd(jac, compute_uv=False)
+        sigma = np.asarray(np.linalg.svd(jac, compute_uv=False), dtype=float)
         tangents_u = np.zeros((0, len(u)))
         method, rank = "component", mech.n_unknowns - dim
     else:

@@ -26,6 +26,7 @@ from linkwork.kinematics.march import (
     NO_PROGRESS,
     SIGN_CHANGE,
     STOP_REASONS,
+    correct,
     march,
     tangent_and_test,
 )
@@ -192,6 +193,7 @@ class BranchMarcher:
                 return n_steps, STOP_REASONS[0]
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
+            limit_reason = self._land_on_limit(chunk) if chunk.code == LIMIT else None
             component = self._component_entry(chunk)
             if component is not None:
                 chunk.count = component + 1
@@ -212,14 +214,44 @@ class BranchMarcher:
                     self._end_on_known(chunk, known)
                     return n_steps, f"reached bifurcation {known}"
             elif chunk.code == CLOSED and self._turns_towards_target(chunk, u_home):
-                u_home = chunk.u[
-                    chunk.count - 1
-                ].copy()  # a full turn of the drive: the target is further round
+                # A full turn of the drive: the target is further round.
+                u_home = chunk.u[chunk.count - 1].copy()
             elif chunk.code != 0 or self.budget <= 0:
-                return n_steps, self._end_reason(chunk, paper)
+                return n_steps, limit_reason or self._end_reason(chunk, paper)
             if self.budget <= 0:
                 return n_steps, STOP_REASONS[0]
             u, t, h0 = chunk.u[chunk.count - 1].copy(), chunk.t[chunk.count - 1].copy(), chunk.h
+
+    def _land_on_limit(self, chunk: Chunk) -> str:
+        """Replace the chunk's last row (past a limit) by the point of the step where the joint is at its limit.
+
+        From the row before it, the predictor goes along the tangent to the limit's value and the corrector
+        holds that unknown there (as when landing on a target), so a branch ends exactly on the limit. Returns
+        the end reason, ``limit <joint>``.
+        """
+        cfg, c = self.cfg, chunk.count
+        u_a, t_a, u_b = chunk.u[c - 2], chunk.t[c - 2], chunk.u[c - 1]
+        over = np.flatnonzero((u_b < cfg.lo) | (u_b > cfg.hi))
+        reason = "limit " + ", ".join(self.mech.joint_names[self.mech.group_members()[g][0]] for g in over)
+        g = int(over[0])
+        bound = cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g]
+        if abs(t_a[g]) < 1e-12:
+            return reason
+        guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
+        guess[g] = bound
+        tol, ws = cfg.tol, self.ws
+        ok, _, r = correct(
+            *ws.kernel_arrays(), guess, g, tol.closure, tol.exact, tol.roundoff, tol.truncate, tol.max_iter,
+            ws.q, ws.res, ws.jac,
+        )  # fmt: skip
+        if not ok:
+            return reason
+        _, _, jac = ws.evaluate(guess)
+        chunk.u[c - 1] = guess
+        chunk.sigma[c - 1] = np.linalg.svd(jac, compute_uv=False)[: cfg.n_sigma]
+        chunk.res[c - 1] = r
+        chunk.s[c - 1] = chunk.s[c - 2] + float(np.linalg.norm(guess - u_a))
+        return reason
 
     def _turns_towards_target(self, chunk: Chunk, u_home: Array) -> bool:
         """Whether a closed path turned the (revolute) drive by whole turns towards a target still ahead."""
@@ -236,11 +268,6 @@ class BranchMarcher:
             if paper:
                 return "corrector failed at a fixed drive step (the drive cannot take that value here)"
             return f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
-        if chunk.code == LIMIT:
-            u = chunk.u[chunk.count - 1]
-            out = np.flatnonzero((u < self.cfg.lo) | (u > self.cfg.hi))
-            names = [self.mech.joint_names[self.mech.group_members()[g][0]] for g in out]
-            return "limit " + ", ".join(names)
         if chunk.code == NO_PROGRESS:
             return (
                 f"no progress ({self.cfg.tol.stall_steps} steps advanced less than "

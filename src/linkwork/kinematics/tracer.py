@@ -20,7 +20,7 @@ from linkwork.kinematics.march import STOP_REASONS
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
-from linkwork.kinematics.trace_result import Branch, Fold, Trace
+from linkwork.kinematics.trace_result import Branch, Trace
 from linkwork.kinematics.workspace import Workspace
 
 Array = NDArray[np.float64]
@@ -202,8 +202,10 @@ def _assemble(
         "max_misfit": float(max(marcher.max_misfit, float(np.max(np.concatenate(rows.res))))),
         "sign_changes_without_rank_drop": marcher.spurious,
     }
+    stats["has_target"] = until is not None
     if until is not None:
-        unmet = target_verdict(mech, until, branch_list[0].end_reason, angles[branch == 0], marcher.folds)
+        on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
+        unmet = target_verdict(mech, until, branch_list[0].end_reason, np.concatenate(on_branch))
         if unmet:
             stats["unmet"] = unmet
     stats["points"] = len(U)
@@ -233,10 +235,9 @@ def _branch_mobility(mobility: NDArray[np.int64]) -> int:
     return int(values[np.argmax(counts)])
 
 
-def target_verdict(
-    mech: Mechanism, until: tuple[str | int, float], reason: str, angles: Array, folds: list[Fold]
-) -> str | None:
-    """Why the target of ``until`` was not reached on the first branch, in one line (``None`` when it was)."""
+def target_verdict(mech: Mechanism, until: tuple[str | int, float], reason: str, angles: Array) -> str | None:
+    """Why the target of ``until`` was not reached on the first branch (``angles``: its points and folds), in
+    one line (``None`` when it was)."""
     if reason == STOP_REASONS[1]:
         return None
     j = mech.index(until[0])
