@@ -79,7 +79,7 @@ def classify_point(
         _, _, jac = ws.evaluate(u)
         sigma = np.asarray(np.linalg.svd(jac, compute_uv=False), dtype=float)
         tangents_u = np.zeros((0, len(u)))
-        method, rank = "component", mech.n_unknowns - dim
+        method, rank = "component", numerical_rank(sigma, tol)
     else:
         tangents_u, method, rank, sigma = branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
         if len(tangents_u) == 2:

@@ -82,13 +82,16 @@ class Tolerances:
         """These tolerances accepting a least-squares closure within ``closure`` (``--closure-tol``).
 
         Singular values at the scale of an accepted misfit carry no information, so ``floor`` (and ``loose``)
-        are raised to at least ``closure``: a loop whose parameters are off by that much is read as the
-        mobile loop it was meant to be.
+        and the corrector's ``truncate`` are raised to at least ``closure``: a loop whose parameters are off by
+        that much is read as the mobile loop it was meant to be, and Gauss-Newton does not chase the misfit
+        along the direction it would have been mobile in.
         """
         if not closure > 0.0:
             raise ValueError(f"closure tolerance {closure!r}: expected a positive number")
         floor = max(self.floor, closure)
-        return replace(self, closure=closure, floor=floor, loose=max(self.loose, 10.0 * floor))
+        return replace(
+            self, closure=closure, floor=floor, loose=max(self.loose, 10.0 * floor), truncate=max(self.truncate, floor)
+        )
 
 
 DEFAULT = Tolerances()
