@@ -90,7 +90,11 @@ class Tolerances:
             raise ValueError(f"closure tolerance {closure!r}: expected a positive number")
         floor = max(self.floor, closure)
         return replace(
-            self, closure=closure, floor=floor, loose=max(self.loose, 10.0 * floor), truncate=max(self.truncate, floor)
+            self,
+            closure=closure,
+            floor=floor,
+            loose=max(self.loose, 10.0 * floor),
+            truncate=max(self.truncate, floor),
         )
 
 

@@ -1,9 +1,11 @@
-"""Tracing a mechanism's motion: the predictor-corrector of Secs. 4-6 run branch by branch.
+"""Tracing a mechanism's motion: the predictor-corrector of Secs. 4-6 of Gan & Pellegrino (2006), branch by branch.
 
-:func:`trace` marches from the start configuration with the compiled kernel (:mod:`linkwork.kinematics.march`),
-stops at a target drive value (landing exactly on it), a closed path, a step budget, a joint limit or a reported
-corrector failure; locates every sign change of the test function to ``Tolerances.locate``; and, with
-``branches=True``, computes every branch tangent there and traces each new branch in both directions.
+:func:`trace` checks the request, starts the :class:`~linkwork.kinematics.marcher.BranchMarcher` on the start's
+branch (and, with ``branches=True``, on the other direction and every branch queued at a bifurcation point) and
+assembles the :class:`~linkwork.kinematics.trace_result.Trace`. Every branch ends with a reason: a target reached
+(landing exactly on it), a closed path (revolute angles modulo a full turn), a joint limit (landed on), a fold of
+the drive (paper mode), no progress, a step budget, a corrector failure, a known bifurcation point, or the entry
+into a higher-dimensional component.
 """
 
 from __future__ import annotations
@@ -75,26 +77,7 @@ def trace(
     m = mech.n_unknowns
     if m == 0:
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
-    if until is not None and drive is None:
-        drive = until[0]
-    if drive is None:
-        drive = mech.joint_names[int(np.flatnonzero(mech.groups >= 0)[0])]
-    d_joint = mech.index(drive)
-    d_unknown = int(mech.groups[d_joint])
-    if d_unknown < 0:
-        raise SpecError(f"the drive joint {mech.joint_names[d_joint]} is fixed; choose a free joint")
-    target = None
-    if until is not None:
-        t_joint = mech.index(until[0])
-        if t_joint != d_joint and mech.groups[t_joint] != d_unknown:
-            raise SpecError(
-                f"until names joint {mech.joint_names[t_joint]} but the drive is {mech.joint_names[d_joint]}; "
-                "they must be the same joint (or coupled)"
-            )
-        target = float(until[1]) - mech.offsets[t_joint]
-    if steps is not None and (target is None or steps < 1):
-        raise SpecError("steps (the paper's equal drive steps) needs until=(joint, value) and steps >= 1")
-
+    d_joint, d_unknown, target = _drive_and_target(mech, drive, until, steps)
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     ws = Workspace.of(mech)
     r0, _, jac0 = ws.evaluate(np.zeros(m))
@@ -131,6 +114,32 @@ def trace(
         marcher.branches.append(Branch(1, None, None, -1, n1, reason1))
     marcher.follow_queue()
     return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+
+
+def _drive_and_target(
+    mech: Mechanism, drive: str | int | None, until: tuple[str | int, float] | None, steps: int | None
+) -> tuple[int, int, float | None]:
+    """The drive joint, its unknown and the target in the unknowns (checked against each other and ``steps``)."""
+    if until is not None and drive is None:
+        drive = until[0]
+    if drive is None:
+        drive = mech.joint_names[int(np.flatnonzero(mech.groups >= 0)[0])]
+    d_joint = mech.index(drive)
+    d_unknown = int(mech.groups[d_joint])
+    if d_unknown < 0:
+        raise SpecError(f"the drive joint {mech.joint_names[d_joint]} is fixed; choose a free joint")
+    target = None
+    if until is not None:
+        t_joint = mech.index(until[0])
+        if t_joint != d_joint and mech.groups[t_joint] != d_unknown:
+            raise SpecError(
+                f"until names joint {mech.joint_names[t_joint]} but the drive is {mech.joint_names[d_joint]}; "
+                "they must be the same joint (or coupled)"
+            )
+        target = float(until[1]) - mech.offsets[t_joint]
+    if steps is not None and (target is None or steps < 1):
+        raise SpecError("steps (the paper's equal drive steps) needs until=(joint, value) and steps >= 1")
+    return d_joint, d_unknown, target
 
 
 def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances) -> int:
