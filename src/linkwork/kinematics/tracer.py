@@ -259,6 +259,6 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], reason: str,
     lo, hi = float(np.min(angles[:, j])), float(np.max(angles[:, j]))
     span = f"[{np.degrees(lo):.2f}, {np.degrees(hi):.2f}] deg" if revolute else f"[{lo:.6g}, {hi:.6g}]"
     if reason in (STOP_REASONS[2], STOP_REASONS[6]):
-        why = "" if reason == STOP_REASONS[2] else f" (it folds back at {show(float(angles[-1, j]))})"
+        why = "" if reason == STOP_REASONS[2] else f" (it turns back near {show(float(angles[-1, j]))})"
         return f"{name} never reaches {show(until[1])} on this path{why}: its range is {span}"
     return f"{name} did not reach {show(until[1])}: the path ended with '{reason}' (range so far {span})"
