@@ -382,7 +382,7 @@ def march(
                 for a in range(m):
                     diff = u_home[a] - u[a]
                     if periodic[a]:
-                        diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+                        diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # as geometry.angles.wrap
                     out_u[count - 1, a] = u[a] + diff
                 out_sigma[count - 1, :] = out_sigma[0, :]
                 out_res[count - 1] = out_res[0]
