@@ -388,3 +388,32 @@ def test_trace_help_documents_the_exit_codes_and_new_flags() -> None:
         "--closure-tol",
     ):
         assert fragment in " ".join(text.split()), fragment
+
+
+def rounded_bennett(tmp_path: Path) -> Path:
+    """examples/specs/bennett-hinge-lines.toml with every number rounded to 6 decimals: a rigid loop, strictly."""
+    text = (
+        Path(__file__).resolve().parents[2] / "examples" / "specs" / "bennett-hinge-lines.toml"
+    ).read_text()
+    rounded = re.sub(r"-?\d+\.\d{7,}", lambda m: f"{float(m.group()):.6f}", text)
+    file = tmp_path / "bennett-rounded.toml"
+    file.write_text(rounded)
+    return file
+
+
+def test_rounded_hinge_lines_are_refused_then_traced_within_the_closure_tolerance(tmp_path: Path) -> None:
+    spec = str(rounded_bennett(tmp_path))
+    refused = invoke("trace", spec, "--no-plots", "--out", str(tmp_path / "strict"))
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, "--closure-tol")
+    out = tmp_path / "out"
+    result = invoke("trace", spec, "--closure-tol", "1e-5", "--no-plots", "--out", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["branches"][0]["end_reason"] == "closed path"
+    assert report["closure_tol"] == 1e-5 and 1e-9 < report["max_misfit"] <= 1e-5
+    # Bennett's closed form (alpha 45/75 deg): tan(A/2) tan(B/2) = k, to the order of the rounding
+    _, col = read_csv(out / "path.csv")
+    a, b = np.radians(col["A"]) / 2, np.radians(col["B"]) / 2
+    k = np.sin(np.radians(60.0)) / np.sin(np.radians(15.0))
+    assert np.max(np.abs(np.sin(a) * np.sin(b) - k * np.cos(a) * np.cos(b))) < 1e-4

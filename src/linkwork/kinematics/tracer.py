@@ -148,8 +148,10 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances) -> int:
     mobility = m - r_path
     if mobility == 0:
         raise LinkworkError(
-            f"{mech.name}: the start is rigid (Jacobian rank {r_path} = number of unknowns); "
-            "an over-constrained loop needs its exact geometry to move"
+            f"{mech.name}: the start is rigid (Jacobian rank {r_path} = number of unknowns, smallest singular "
+            f"value {sigma[-1] / sigma[0]:.2e} of the largest); an over-constrained loop needs its exact geometry "
+            "to move: give its parameters to full precision, or accept play in the hinges (closure_tol / "
+            "--closure-tol)"
         )
     if mobility > 1:
         raise LinkworkError(
