@@ -241,8 +241,9 @@ def march(
     ``u_home`` is where the path began (for closed-path detection across several calls).
 
     An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h`` along
-    the tangent (the corrector pulled it back); the march stops with ``NO_PROGRESS`` when its last
-    ``stall_steps`` steps together advanced less than ``stall_length * hmax``.
+    the tangent (the corrector pulled it back); an adaptive march stops with ``NO_PROGRESS`` when its last
+    ``stall_steps`` steps together advanced less than ``stall_length * hmax`` (a paper-mode step always moves the
+    drive by its fixed amount).
 
     ``paper``: fixed steps of ``h0`` in the drive unknown (signed: negative steps move the drive down), corrector
     with the drive held (the paper's mode);
@@ -365,7 +366,7 @@ def march(
         out_s[count] = s_total
         recent[count % recent.shape[0]] = dist
         count += 1
-        if count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
+        if not paper and count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
             return count, NO_PROGRESS, h
         if landing:
             return count, TARGET, h

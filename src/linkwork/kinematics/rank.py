@@ -84,7 +84,7 @@ class Tolerances:
         Singular values at the scale of an accepted misfit carry no information, so ``floor`` (and ``loose``)
         and the corrector's ``truncate`` are raised to at least ``closure``: a loop whose parameters are off by
         that much is read as the mobile loop it was meant to be, and Gauss-Newton does not chase the misfit
-        along the direction it would have been mobile in.
+        along the direction it would have been mobile in. A tolerance below ``exact`` tightens ``exact`` too.
         """
         if not closure > 0.0:
             raise ValueError(f"closure tolerance {closure!r}: expected a positive number")
@@ -92,6 +92,7 @@ class Tolerances:
         return replace(
             self,
             closure=closure,
+            exact=min(self.exact, closure),
             floor=floor,
             loose=max(self.loose, 10.0 * floor),
             truncate=max(self.truncate, floor),
