@@ -18,6 +18,7 @@ import pytest
 import linkwork as lw
 from linkwork.kinematics.rank import Tolerances, numerical_rank
 from linkwork.kinematics.tracer import trace
+from linkwork.kinematics.workspace import Workspace
 from linkwork.linkages import REGISTRY
 from linkwork.linkages.sarrus import sarrus_hinges
 
@@ -223,3 +224,16 @@ def test_every_builtin_gives_a_clean_branch_graph(name: str) -> None:
     for br in tr.branches:
         assert br.steps > 0
         assert not br.end_reason.startswith(("step budget", "corrector failed", "no progress", "could not"))
+
+
+def test_branch_tangents_over_the_unknowns_are_a_field_that_replace_keeps() -> None:
+    mech = lw.load("guest-frame")
+    bif = trace(mech).bifurcations[0]
+    copy = dataclasses.replace(bif, step=0)
+    assert copy.tangents_u.shape == (2, mech.n_unknowns)
+    C = mech.coupling_matrix()
+    over_joints = np.array([C @ t / np.linalg.norm(C @ t) for t in copy.tangents_u])
+    np.testing.assert_allclose(over_joints, bif.tangents, atol=1e-15)
+    _, _, jac = Workspace.of(mech).evaluate(bif.u)
+    for t in copy.tangents_u:  # each is a null vector of the Jacobian there (to the located point's accuracy)
+        assert np.linalg.norm(jac @ t) < 1e-6
