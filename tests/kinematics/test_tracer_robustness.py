@@ -237,3 +237,33 @@ def test_branch_tangents_over_the_unknowns_are_a_field_that_replace_keeps() -> N
     _, _, jac = Workspace.of(mech).evaluate(bif.u)
     for t in copy.tangents_u:  # each is a null vector of the Jacobian there (to the located point's accuracy)
         assert np.linalg.norm(jac @ t) < 1e-6
+
+
+def test_a_branch_that_runs_on_the_sarrus_sheet_ends_once_as_a_component() -> None:
+    from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
+
+    mech = lw.load("sarrus")
+    meeting = next(b for b in trace(mech).bifurcations if b.kind == "component")
+    # a point of the sheet next to the meeting point (independent Newton), then march from it inside the sheet
+    J = np.column_stack([(sarrus_closure(meeting.angles + 1e-6 * e) - sarrus_closure(meeting.angles - 1e-6 * e)) / 2e-6
+                         for e in np.eye(6)])  # fmt: skip
+    null = np.linalg.svd(J)[2][-3:]
+    on_sheet = _newton_onto(meeting.angles + 0.05 * null[0])
+    assert fd_mobility(on_sheet) == 2
+    u0 = mech.u_from_q(mech.q_from_angles(on_sheet))
+    ws = Workspace.of(mech)
+    _, _, jac = ws.evaluate(u0)
+    U, _, Vt = np.linalg.svd(jac)
+    n = mech.n_unknowns
+    settings = MarchSettings(
+        drive=0, target=None, min_step=1e-9, max_step=2 * DEG, cos_turn=float(np.cos(10 * DEG)), r_path=5,
+        n_sigma=6, periodic=np.ones(n, dtype=bool), lo=np.full(n, -np.inf), hi=np.full(n, np.inf), tol=Tolerances(),
+    )  # fmt: skip
+    marcher = BranchMarcher(mech, settings, 5000, switch_branches=True)
+    steps, reason = marcher.run_branch(
+        0, u0, Vt[-1], np.ascontiguousarray(U[:, :5]), paper=False, h0=0.5 * DEG, stop_at_known=True
+    )
+    assert reason.startswith("entered a 2-dimensional component (mobility 2) at point")
+    assert steps <= Tolerances().component_points
+    assert 1 <= len(marcher.found) <= 2 and not marcher.queue  # no chain of points, no branch switching
+    assert all(p.kind == "component" and p.dimension == 2 for p in marcher.found)

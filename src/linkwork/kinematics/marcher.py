@@ -11,7 +11,7 @@ Gan & Pellegrino 2006; branch switching after Kumar & Pellegrino 2000).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,7 +31,7 @@ from linkwork.kinematics.march import (
     tangent_and_test,
 )
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.rank import Tolerances, numerical_ranks
+from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold
 from linkwork.kinematics.workspace import Workspace
 
@@ -310,9 +310,13 @@ class BranchMarcher:
         known = self._match(u)
         if known is None:
             bif = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u, 0.0, self.cfg)
+            if bif.kind != "component":  # the mobility along the branch says so, whatever the samples found
+                dim = self.mech.n_unknowns - numerical_rank(chunk.sigma[chunk.count - 1], self.cfg.tol)
+                empty = np.zeros((0, len(u)))
+                bif = replace(bif, kind="component", dimension=dim, tangents=empty, tangents_u=empty)
             self.found.append(bif)
             known = bif.id
-        dim = max(self.found[known].dimension, 2)
+        dim = self.found[known].dimension
         return f"entered a {dim}-dimensional component (mobility {dim}) at point {known}"
 
     def _scan_rank_minima(self, chunk: Chunk, branch_id: int, base: int) -> None:
