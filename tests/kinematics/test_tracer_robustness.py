@@ -217,6 +217,7 @@ def test_every_builtin_gives_a_clean_branch_graph(name: str) -> None:
     tr = trace(mech, branches=True)
     kinds = [b.kind for b in tr.bifurcations]
     assert (kinds.count("bifurcation"), kinds.count("component")) == EXPECTED[name]
+    assert len(kinds) == sum(EXPECTED[name])  # and no point labelled a fold
     assert tr.stats["sign_changes_without_rank_drop"] == 0
     for b in tr.bifurcations:
         if b.kind == "bifurcation":

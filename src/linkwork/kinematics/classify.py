@@ -72,7 +72,11 @@ def classify_point(
     cfg: MarchSettings,
 ) -> Bifurcation:
     """Classify a located point: rank, singular values, branch tangents (over the joints and the unknowns), or
-    the dimension of the component it lies on."""
+    the dimension of the component it lies on.
+
+    ``kind``: ``"component"`` (the configuration space has dimension 2 or more there), ``"bifurcation"`` (two or
+    more branch tangents), or ``"fold"`` (fewer than two real branch tangents: the path only touches the singular
+    set there and no other branch leaves it)."""
     tol = cfg.tol
     dim = component_dimension(ws, u, tol)
     if dim >= 2:
@@ -105,7 +109,7 @@ def classify_point(
         residual=res_norm,
         bracket=width,
         tangents_u=tangents_u,
-        kind="component" if dim >= 2 else "bifurcation",
+        kind="component" if dim >= 2 else ("bifurcation" if len(tangents_u) >= 2 else "fold"),
         dimension=dim,
     )
 

@@ -365,7 +365,7 @@ class BranchMarcher:
         known = self._match(u_star)
         if known is None:
             bif = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u_star, width, cfg)
-            if bif.kind == "bifurcation" and (len(bif.tangents_u) < 2 or bif.rank >= cfg.r_path):
+            if bif.kind != "component" and bif.rank >= cfg.r_path:
                 self.spurious += (
                     1  # the test function changed sign without a rank drop: not a point to report
                 )
