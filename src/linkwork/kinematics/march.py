@@ -18,6 +18,7 @@ from numba import njit
 from linkwork.kinematics.kernels import closure_jacobian, expand
 
 BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING, NO_PROGRESS = 0, 1, 2, 3, 4, 5, 6, 7
+TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
 STOP_REASONS = {
     BUDGET: "step budget",
     TARGET: "reached target",
@@ -195,6 +196,73 @@ def wrapped_distance(a, b, periodic):
 
 
 @njit(cache=True)
+def step_geometry(u, t, u_try, t_new):
+    """``(turn, dist, ahead)`` of a corrected step: the cosine between the tangents, the step's length and how far
+    it went along the old tangent."""
+    turn = 0.0
+    dist = 0.0
+    ahead = 0.0
+    for a in range(u.shape[0]):
+        du = u_try[a] - u[a]
+        turn += t_new[a] * t[a]
+        dist += du * du
+        ahead += t[a] * du
+    return turn, np.sqrt(dist), ahead
+
+
+@njit(cache=True)
+def snap_home(u, u_home, periodic, out):
+    """``out``: the start ``u_home`` written in the continuous angles of ``u`` (revolute unknowns differ from it
+    by whole turns), the last row of a closed path."""
+    for a in range(u.shape[0]):
+        diff = u_home[a] - u[a]
+        if periodic[a]:
+            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # compiled copy of linkwork.geometry.angles.wrap
+        out[a] = u[a] + diff
+
+
+@njit(cache=True)
+def predict(u, t, h, paper, drive, target, has_target, first, u_try):
+    """The predictor (Sec. 4.1): ``u_try = u + step t``; returns ``(step, landing, held)``.
+
+    Paper mode: ``step`` moves the drive by exactly ``h`` (on the first step ``t`` is turned, in place, to
+    point that way), the corrector holds the drive (``held``); ``held == TURNED`` means the drive has turned
+    back.
+    Adaptive mode: ``step = h`` along the tangent. Either way a step that would pass the target is shortened to
+    land on it (``landing``; the drive then held at the target).
+    """
+    m = u.shape[0]
+    landing = False
+    held = -1
+    if paper:
+        if abs(t[drive]) < 1e-9:
+            return 0.0, False, TURNED
+        step = h / t[drive]
+        if step < 0.0:
+            if not first:
+                return 0.0, False, TURNED
+            for a in range(m):  # first step: orient the tangent along the drive direction
+                t[a] = -t[a]
+            step = h / t[drive]
+        if has_target and abs(u[drive] + h - target) < 1e-9 * max(1.0, abs(target)):
+            landing = True
+        held = drive
+    else:
+        step = h
+        if has_target and abs(t[drive]) > 1e-12:
+            to_go = (target - u[drive]) / t[drive]
+            if 0.0 <= to_go <= h:
+                step = to_go
+                landing = True
+                held = drive
+    for a in range(m):
+        u_try[a] = u[a] + step * t[a]
+    if landing:
+        u_try[drive] = target
+    return step, landing, held
+
+
+@njit(cache=True)
 def march(
     twists,
     loop_joint,
@@ -277,70 +345,20 @@ def march(
     recent = np.zeros(max(stall_steps, 1))  # lengths of the last stall_steps steps (a ring)
     count = 1
     while count <= max_steps:
-        landing = False
-        held = -1
         # ---- predictor (Sec. 4.1)
-        if paper:
-            if abs(t[drive]) < 1e-9:
-                return count, TURNING, h
-            step = h / t[drive]
-            if step < 0.0:
-                if count > 1:  # the drive has turned back: equal drive steps cannot go on
-                    return count, TURNING, h
-                for a in range(m):  # first step: orient the tangent along the drive direction
-                    t[a] = -t[a]
-                step = h / t[drive]
-            if has_target and abs(u[drive] + h - target) < 1e-9 * max(1.0, abs(target)):
-                landing = True
-            for a in range(m):
-                u_try[a] = u[a] + step * t[a]
-            if landing:
-                u_try[drive] = target
-            held = drive
-        else:
-            step = h
-            if has_target and abs(t[drive]) > 1e-12:
-                to_go = (target - u[drive]) / t[drive]
-                if 0.0 <= to_go <= h:
-                    step = to_go
-                    landing = True
-            for a in range(m):
-                u_try[a] = u[a] + step * t[a]
-            if landing:
-                u_try[drive] = target
-                held = drive
+        step, landing, held = predict(u, t, h, paper, drive, target, has_target, count == 1, u_try)
+        if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
+            return count, TURNING, h
         # ---- corrector (Sec. 4.2, Eq. (28))
         ok, iters, r = correct(
-            twists,
-            loop_joint,
-            loop_sign,
-            loop_ptr,
-            rows,
-            groups,
-            u_try,
-            held,
-            tol,
-            exact,
-            roundoff,
-            truncate,
-            max_iter,
-            q,
-            res,
-            jac,
-        )
+            twists, loop_joint, loop_sign, loop_ptr, rows, groups, u_try, held, tol, exact, roundoff, truncate,
+            max_iter, q, res, jac,
+        )  # fmt: skip
+        turn, dist, tau_new = 1.0, 0.0, 0.0
         if ok:
             basis_try[:, :] = basis
             tau_new = tangent_and_test(jac, t, basis_try, r_path, t_new, sig)
-            turn = 0.0
-            for a in range(m):
-                turn += t_new[a] * t[a]
-            dist = 0.0
-            for a in range(m):
-                dist += (u_try[a] - u[a]) ** 2
-            dist = np.sqrt(dist)
-            ahead = 0.0
-            for a in range(m):
-                ahead += t[a] * (u_try[a] - u[a])
+            turn, dist, ahead = step_geometry(u, t, u_try, t_new)
             jumped = dist > 2.0 * step + 1e-300
             pulled_back = ahead < advance * step
             if not paper and not landing and (turn < cos_turn or jumped or pulled_back) and h > hmin:
@@ -377,14 +395,9 @@ def march(
             return count, SIGN_CHANGE, h
         if check_closed:
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
-            if d > far:
-                far = d
+            far = max(far, d)
             if far > 4.0 * hmax and d < 1.5 * abs(h):
-                for a in range(m):
-                    diff = u_home[a] - u[a]
-                    if periodic[a]:
-                        diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # as geometry.angles.wrap
-                    out_u[count - 1, a] = u[a] + diff
+                snap_home(u, u_home, periodic, out_u[count - 1])
                 out_sigma[count - 1, :] = out_sigma[0, :]
                 out_res[count - 1] = out_res[0]
                 out_tau[count - 1] = out_tau[0]
