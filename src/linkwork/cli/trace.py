@@ -17,7 +17,11 @@ from linkwork.cli.common import (
 from linkwork.outputs.staging import console
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from linkwork.io.spec import LoadedSpec
+    from linkwork.kinematics.mechanism import Mechanism
+    from linkwork.kinematics.trace_result import Trace
 
 
 def _parse_until(text: str | None) -> tuple[str, float] | None:
@@ -153,14 +157,7 @@ def trace(
         mech = mech.with_couplings(_parse_couple(couple), fixed or [])
     if max_step <= 0:
         raise fail(f"--max-step {max_step}: expected a positive number of degrees")
-    limits = {}
-    for name, (lo, hi) in limits_file.items():
-        j = mech.index(name)
-        scale = np.radians(1.0) if mech.joint_types[j] == "R" else 1.0
-        start = float(mech.offsets[j] / scale)
-        if not lo <= start <= hi:
-            raise fail(f"--limit {name}={lo:g}:{hi:g}: the start value {start:.6g} of {name} is outside it")
-        limits[name] = (float(lo * scale), float(hi * scale))
+    limits = _limits_in_api_units(mech, limits_file)
     until_rad = None
     if target is not None:
         j = mech.index(target[0])
@@ -176,36 +173,11 @@ def trace(
             f"start corrected onto the loop: residual {loaded.assembly.residual_before:.2e} -> "
             f"{loaded.assembly.residual_after:.2e}, joints moved by up to {worst:.3g} deg"
         )
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    total = steps if steps is not None else max_steps
-    with Progress(
-        TextColumn("tracing"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("{task.description}"),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    ) as progress:
-        task = progress.add_task("", total=total)
-
-        def report(done: float, what: str) -> None:
-            progress.update(task, advance=done, description=what)
-
-        path = run_trace(
-            mech,
-            drive=drive,
-            until=until_rad,
-            steps=steps,
-            max_step=float(np.radians(max_step)),
-            max_steps=max_steps,
-            branches=branches,
-            limits=limits,
-            closure_tol=closure_tol,
-            progress=report,
-        )
+    path = _run_with_progress(
+        run_trace, mech, total=steps if steps is not None else max_steps, drive=drive, until=until_rad,
+        steps=steps, max_step=float(np.radians(max_step)), max_steps=max_steps, branches=branches, limits=limits,
+        closure_tol=closure_tol,
+    )  # fmt: skip
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
 
     figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
@@ -223,3 +195,42 @@ def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:
     if "closure_tol" in inspect.signature(resolve_spec).parameters:
         return resolve_spec(spec, params, closure_tol=closure_tol)  # type: ignore[call-arg,unused-ignore]
     return resolve_spec(spec, params)
+
+
+def _limits_in_api_units(
+    mech: Mechanism, limits_file: dict[str, tuple[float, float]]
+) -> dict[str, tuple[float, float]]:
+    """``--limit`` values (degrees, or lengths) in the API's units (radians), each checked against the start."""
+    import numpy as np
+
+    limits = {}
+    for name, (lo, hi) in limits_file.items():
+        j = mech.index(name)
+        scale = np.radians(1.0) if mech.joint_types[j] == "R" else 1.0
+        start = float(mech.offsets[j] / scale)
+        if not lo <= start <= hi:
+            raise fail(f"--limit {name}={lo:g}:{hi:g}: the start value {start:.6g} of {name} is outside it")
+        limits[name] = (float(lo * scale), float(hi * scale))
+    return limits
+
+
+def _run_with_progress(run: Callable[..., Trace], mech: Mechanism, total: int, **options: Any) -> Trace:
+    """``run(mech, **options, progress=...)`` with a progress bar on a terminal (none otherwise)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn("tracing"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.description}"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    ) as progress:
+        task = progress.add_task("", total=total)
+
+        def report(done: float, what: str) -> None:
+            progress.update(task, advance=done, description=what)
+
+        return run(mech, **options, progress=report)
