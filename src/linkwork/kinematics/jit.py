@@ -8,8 +8,9 @@ compile) and starts one background process that compiles the kernels into the ca
 moves to the compiled kernels as soon as they are there (:class:`SwitchingKernels`). When the cache is warm, the
 kernels are loaded before the trace's clock starts, so a trace's reported time is tracing only.
 
-The hook: :class:`linkwork.kinematics.bifurcation.Workspace` holds ``kernels = march_kernels()``; the tracer and
-the bifurcation locator call ``ws.kernels.march``, ``ws.kernels.evaluate`` and ``ws.kernels.tangent_and_test``.
+The hook: :class:`linkwork.kinematics.workspace.Workspace` holds ``kernels = march_kernels()``; the marcher, the
+bifurcation locator and ``Workspace.evaluate`` call ``ws.kernels.march``, ``.evaluate``, ``.correct`` and
+``.tangent_and_test``.
 
 ``LINKWORK_JIT=compiled`` always uses the compiled kernels, compiling them first in this process when the cache is
 cold (announced, and excluded from the trace's reported time); ``LINKWORK_JIT=python`` always uses plain Python.
@@ -33,8 +34,8 @@ from numba.core.registry import CPUDispatcher
 log = logging.getLogger("linkwork.jit")
 
 MODES = ("auto", "compiled", "python")
-ENTRY_POINTS = ("march", "evaluate", "tangent_and_test")
-"""The functions of :mod:`linkwork.kinematics.march` that the tracer and the bifurcation locator call."""
+ENTRY_POINTS = ("march", "evaluate", "correct", "tangent_and_test")
+"""The functions of :mod:`linkwork.kinematics.march` that the tracer, the marcher and the locators call."""
 
 LOCK_NAME = "linkwork-compiling.lock"
 BACKGROUND_COMMAND = (
@@ -190,17 +191,19 @@ def compile_seconds() -> float:
 
 
 def _warm_up() -> None:
-    """Run every entry point with the argument types a trace uses: an adaptive trace with a target, a
-    paper-mode trace and an adaptive trace without a target, of a Bennett linkage."""
+    """Run every entry point with the argument types a trace uses: adaptive traces of a Bennett linkage with a
+    target, without one and up to a joint limit, and a paper-mode trace."""
     import math
 
     from linkwork.io.spec import resolve_spec
     from linkwork.kinematics.tracer import trace
 
     mech = resolve_spec("bennett", {}).mechanism
-    trace(mech, until=(mech.joint_names[0], mech.offsets[0] + 0.3))
-    trace(mech, until=(mech.joint_names[0], mech.offsets[0] + 0.3), steps=4)
+    a, start = mech.joint_names[0], float(mech.offsets[0])
+    trace(mech, until=(a, start + 0.3))
+    trace(mech, until=(a, start + 0.3), steps=4)
     trace(mech, max_steps=8, max_step=math.radians(5.0))
+    trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()
 
 
 def _compile_under_way() -> bool:
