@@ -126,6 +126,8 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         out["assembly"] = {
             "residual_before": float(assembly.residual_before),
             "residual_after": float(assembly.residual_after),
+            "misfit": float(getattr(assembly, "misfit", assembly.residual_after)),
+            "closure_tol": float(getattr(assembly, "closure_tol", 1e-12)),
             "correction_deg": dict(zip(names, map(float, np.degrees(assembly.correction)), strict=True)),
         }
     return out
