@@ -87,6 +87,7 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         "points": len(path.branch),
         "max_residual": float(path.residual.max()),
         "max_condition": path.max_condition,
+        "max_condition_raw": path.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
         "bifurcations": [
             {

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import AssemblyError
-from linkwork.geometry import log_se3, rot_x, rot_z, translation
+from linkwork.geometry import bracket, log_se3, rot_x, rot_z, translation
 from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.mechanism import Array, Mechanism
 
@@ -89,31 +89,37 @@ def _chain_twists(constants: Sequence[Array], thetas: Array, rotation_first: boo
 
 
 def close_serial_loop(
-    constants: Sequence[Array], thetas: Sequence[float], *, rotation_first: bool, max_iterations: int = 80
+    constants: Sequence[Array],
+    thetas: Sequence[float],
+    *,
+    rotation_first: bool,
+    keep: float = 1e-5,
+    max_iterations: int = 80,
 ) -> tuple[Array, float]:
     """Start angles moved onto the loop of the written constant transforms, and the closure misfit left.
 
     Gauss-Newton on the exact serial product ``G(theta)`` (never on a model linearised at the rounded start):
-    ``theta <- theta - J^+ log G`` with ``J`` the twists at the current angles and the truncated-SVD
-    pseudo-inverse of Eq. (28), so that the correction has minimum norm. A step that does not lower the residual
-    is halved. Iterates until the residual stops decreasing, so that a loop the parameters close ends at
-    round-off, and an over-constrained loop whose parameters do not close ends at its least-squares misfit.
+    ``theta <- theta - J^+ log G`` with ``J`` the derivative of ``log G`` (the twists at the current angles
+    through :func:`_dlog`) and the truncated-SVD pseudo-inverse of Eq. (28) keeping the singular values above
+    ``keep * sigma_1``, so that the correction has minimum norm and does not slide along a (near-)motion. A step
+    that does not lower the residual is halved; the iteration ends when the residual stops decreasing. A loop
+    the parameters close ends at round-off; an over-constrained loop whose parameters close no loop ends where
+    the residual is orthogonal to the directions kept: its least-squares misfit at the start, since along the
+    near-motion (the dropped direction) the misfit changes only slowly.
     """
     theta = np.asarray(thetas, dtype=float).copy()
     _, G = _chain_twists(constants, theta, rotation_first)
     err = log_se3(G)
     residual = float(np.linalg.norm(err))
-    stalled = 0
     for _ in range(max_iterations):
-        if residual == 0.0 or stalled >= 3:
+        if residual == 0.0:
             break
         twists, _ = _chain_twists(constants, theta, rotation_first)
-        U, s, Vt = np.linalg.svd(twists.T, full_matrices=False)
-        keep = s > 1e-10 * s[0]
-        step = -Vt[keep].T @ ((U[:, keep].T @ err) / s[keep])  # Eq. (28)
-        for _halving in range(40):
-            trial = theta + step
-            _, G = _chain_twists(constants, trial, rotation_first)
+        U, s, Vt = np.linalg.svd(_dlog(err) @ twists.T, full_matrices=False)
+        r = int(np.sum(s > keep * s[0]))
+        step = -Vt[:r].T @ ((U[:, :r].T @ err) / s[:r])  # Eq. (28)
+        for _halving in range(30):
+            _, G = _chain_twists(constants, theta + step, rotation_first)
             trial_err = log_se3(G)
             trial_residual = float(np.linalg.norm(trial_err))
             if trial_residual < residual:
@@ -121,9 +127,23 @@ def close_serial_loop(
             step = 0.5 * step
         else:
             break
-        stalled = stalled + 1 if trial_residual > 0.5 * residual else 0
-        theta, err, residual = trial, trial_err, trial_residual
+        progress = residual - trial_residual
+        theta, err, residual = theta + step, trial_err, trial_residual
+        if progress < 1e-6 * residual:
+            break
     return theta, residual
+
+
+def _dlog(y: Array) -> Array:
+    """``(6, 6)`` derivative of ``log(exp(x) exp(y))`` in ``x`` at 0: ``I - ad_y / 2 + ad_y^2 / 12 - ad_y^4 / 720``.
+
+    The Bernoulli series of ``z / (e^z - 1)`` (Baker-Campbell-Hausdorff); ``ad_y x = [y, x]``. Near a closed loop
+    ``y`` is small and the series is exact to round-off; it matters where a misfit is left, since the
+    least-squares stationary point of ``|log G|`` is defined by this derivative, not by the bare twists.
+    """
+    ad = np.array([bracket(y, e) for e in np.eye(6)]).T
+    ad2 = ad @ ad
+    return np.eye(6) - ad / 2.0 + ad2 / 12.0 - ad2 @ ad2 / 720.0
 
 
 def assemble_chain(
@@ -154,7 +174,13 @@ def assemble_chain(
     written = np.asarray(thetas, dtype=float)
     _, G0 = _chain_twists(constants, written, rotation_first)
     before = float(np.linalg.norm(log_se3(G0)))
+    # Well-determined directions first (no slide along a near-motion), then every direction above round-off
+    # (a loop at a near-singular start); the second pass is kept only when it closes the loop.
     closed, misfit = close_serial_loop(constants, written, rotation_first=rotation_first)
+    if not misfit <= closure_tol:
+        again, left = close_serial_loop(constants, closed, rotation_first=rotation_first, keep=1e-10)
+        if left <= closure_tol:
+            closed, misfit = again, left
     q = closed - written
     twists, _ = _chain_twists(constants, closed, rotation_first)
     sigma = np.linalg.svd(twists.T, compute_uv=False)
