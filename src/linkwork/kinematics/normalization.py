@@ -14,12 +14,15 @@ not:
   they all pass through ``c``, as in a spherical linkage, where every moment about ``c`` vanishes).
 * Translation rows divided by ``L``, and a prismatic joint's coordinate measured in ``L`` (its column stays the
   unit direction ``(0, d)``): the normalised Jacobian is dimensionless.
+* **Loop rows orthonormal over the cycle space** (:func:`cycle_metric`): a mechanism of several loops gives the
+  same singular values whichever cycle basis its body graph (and so the order of its joints) produced.
 
 ``c`` and ``L`` are taken from the hinge lines at the configuration itself (the joint axes in the base frame
 there), so that fixing another body as the base (relabelling the joints of a loop) also leaves the ratio
 unchanged. Under a rigid motion ``g = [R, t]`` every column becomes ``Ad(g) xi``, ``c`` becomes ``g c`` and ``L``
 is kept, so the normalised columns become ``(R w, R v_c / L)``: an orthogonal map of the rows, and the singular
-values are unchanged. Scaling every length by ``s`` scales ``v_c`` and ``L`` alike. Relabelling permutes columns.
+values are unchanged. Scaling every length by ``s`` scales ``v_c`` and ``L`` alike. Relabelling permutes columns
+(and may change the cycle basis, see above).
 """
 
 from __future__ import annotations
@@ -94,6 +97,21 @@ def _axes(jac: Array, n_loops: int) -> Array:
     return axes
 
 
+def cycle_metric(mech: Mechanism) -> Array:
+    """``W = (Z Z^T)^(-1/2)`` for the signed loop-joint incidence ``Z (loops, n)``: loop rows made orthonormal.
+
+    Another cycle basis is ``Z' = M Z`` with ``M`` unimodular, and its Jacobian rows are combined by ``M``;
+    ``W' M = Q W`` with ``Q`` orthogonal, so the rows ``W J`` have the same singular values whichever basis the
+    body graph gave. For a single loop of ``n`` joints ``W = 1 / sqrt(n)``.
+    """
+    Z = np.zeros((len(mech.loops), mech.n_joints))
+    for k, loop in enumerate(mech.loops):
+        for j, sign in zip(loop.joints, loop.signs, strict=True):
+            Z[k, j] += sign
+    values, vectors = np.linalg.eigh(Z @ Z.T)
+    return (vectors / np.sqrt(np.maximum(values, 1e-300))) @ vectors.T
+
+
 def normalized_jacobians(mech: Mechanism, angles: ArrayLike) -> Array:
     """:func:`normalized_jacobian` at every row of ``angles (N, n)``: ``(N, n_equations, n_unknowns)``."""
     values = np.atleast_2d(np.asarray(angles, dtype=float))
@@ -107,6 +125,7 @@ def normalized_jacobians(mech: Mechanism, angles: ArrayLike) -> Array:
     blocks = np.concatenate([w, moments], axis=2)
     prismatic = np.array([t == "P" for t in mech.joint_types])
     blocks[..., prismatic] *= L[:, None, None, None]
+    blocks = np.einsum("kl,Nlrn->Nkrn", cycle_metric(mech), blocks)
     kept = blocks[:, :, list(mech.rows), :].reshape(N, n_loops * len(mech.rows), n)
     return kept @ mech.coupling_matrix()
 
