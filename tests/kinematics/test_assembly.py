@@ -25,8 +25,9 @@ import linkwork as lw
 from linkwork.errors import AssemblyError
 from linkwork.io.results import report_dict
 from linkwork.io.spec import load_spec, resolve_spec
-from linkwork.kinematics.closure import jacobian
+from linkwork.kinematics.closure import closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.normalization import normalized_jacobian
 
 ROOT = Path(__file__).resolve().parents[2]
 BENNETT = ROOT / "examples" / "specs" / "bennett-dh.toml"
@@ -303,3 +304,43 @@ def test_mechanism_copies_and_freezes_its_arrays() -> None:
             array[0] = 1
     coupled = mech.with_couplings([["A", "C"]])
     assert not coupled.groups.flags.writeable and coupled.twists is not twists
+
+
+# ------------------------------------------------------------------------------------------------------------
+# hinge lines a rounding away from a mobile linkage
+def _rounded_lines(decimals: int) -> str:
+    text = (ROOT / "examples" / "specs" / "bennett-hinge-lines.toml").read_text()
+
+    def shorten(match: re.Match[str]) -> str:
+        values = ", ".join(repr(round(float(x), decimals)) for x in match.group(2).split(","))
+        return f"{match.group(1)}[{values}]"
+
+    return re.sub(r"((?:point|direction) = )\[([^\]]*)\]", shorten, text)
+
+
+@pytest.mark.parametrize("decimals", [3, 6])
+def test_rounded_hinge_lines_are_diagnosed_and_accepted_within_tolerance(
+    tmp_path: Path, decimals: int
+) -> None:
+    path = write(tmp_path, _rounded_lines(decimals), f"lines-{decimals}.toml")
+    with pytest.raises(AssemblyError) as info:
+        load_spec(path)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(f"{path}: ")
+    assert "joints A, B, C, D" in message and "closure tolerance 1e-12" in message
+    mech = load_spec(path, closure_tol=1e-3).mechanism
+    # The number reported is what it says: one radian along the near-motion leaves that closure misfit.
+    sigma = np.linalg.svd(jacobian(mech, np.zeros(4)), compute_uv=False)
+    assert 1e-9 < sigma[-1] / sigma[0] < 1e-3  # rigid by a hair (a generic 4R loop is far from this)
+    shown = float(re.search(r"closure misfit of ([0-9.e+-]+) per radian", message).group(1))  # type: ignore[union-attr]
+    # Along the near-motion (the normalised Jacobian's last right singular vector), turning the most-moving
+    # joint by h leaves h times that misfit: the closure residual itself, evaluated on the loop product.
+    h = 1e-7  # second-order terms (h^2) stay far below the first-order misfit
+    _, _, Vt = np.linalg.svd(normalized_jacobian(mech, mech.offsets))
+    step = h * Vt[-1] / np.max(np.abs(Vt[-1]))
+    assert np.linalg.norm(closure_residual(mech, step)) / h == pytest.approx(shown, rel=1e-2)
+    assert shown > 0.5 * sigma[-1]
+
+
+def test_hinge_lines_to_full_precision_load_without_a_word() -> None:
+    assert load_spec(ROOT / "examples" / "specs" / "bennett-hinge-lines.toml").mechanism.n_joints == 4

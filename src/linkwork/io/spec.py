@@ -53,6 +53,7 @@ from linkwork.geometry import line_twist
 from linkwork.geometry.names import default_joint_name
 from linkwork.kinematics.chains import Assembly, from_dh, from_rods
 from linkwork.kinematics.mechanism import Array, Mechanism
+from linkwork.kinematics.normalization import near_mobility
 
 __all__ = ["CONVENTIONS", "LoadedSpec", "dump_spec", "load_spec", "resolve_spec"]
 
@@ -189,7 +190,24 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     couple, fixed = couplings
     if couple or fixed:
         mech = mech.with_couplings(couple, fixed)
+    if assembly is None:
+        _check_not_near_mobile(mech, source, closure_tol)
     return LoadedSpec(mechanism=mech, assembly=assembly, source=path)
+
+
+def _check_not_near_mobile(mech: Mechanism, source: str, closure_tol: float) -> None:
+    """Hinge lines a rounding away from a mobile linkage: one line with the numbers, unless within tolerance."""
+    near = near_mobility(mech)
+    if near is None or near.misfit <= closure_tol:
+        return
+    raise AssemblyError(
+        f"{source}: {mech.name}: the joint lines are rigid by a hair, not mobile: smallest singular value "
+        f"{near.relative:.3g} of the largest (normalised Jacobian), a closure misfit of {near.misfit:.3g} per "
+        f"radian of the near-motion of joints {', '.join(near.joints)} > closure tolerance {closure_tol:.3g}; "
+        "an over-constrained linkage typed with rounded coordinates? Give them to full precision, or accept the "
+        "misfit as play in the hinges with a closure tolerance above it",
+        residual=near.misfit,
+    )
 
 
 def resolve_spec(

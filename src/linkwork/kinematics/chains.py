@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from linkwork.errors import AssemblyError
 from linkwork.geometry import bracket, log_se3, rot_x, rot_z, translation
@@ -90,7 +91,7 @@ def _chain_twists(constants: Sequence[Array], thetas: Array, rotation_first: boo
 
 def close_serial_loop(
     constants: Sequence[Array],
-    thetas: Sequence[float],
+    thetas: ArrayLike,
     *,
     rotation_first: bool,
     keep: float = 1e-5,
@@ -183,7 +184,7 @@ def assemble_chain(
             closed, misfit = again, left
     q = closed - written
     twists, _ = _chain_twists(constants, closed, rotation_first)
-    sigma = np.linalg.svd(twists.T, compute_uv=False)
+    sigma: Array = np.linalg.svd(twists.T, compute_uv=False).astype(float)
     if np.max(np.abs(q), initial=0.0) > max_correction:
         worst = int(np.argmax(np.abs(q)))
         raise AssemblyError(

@@ -300,7 +300,7 @@ class Mechanism:
 
 def _frozen(values: ArrayLike, dtype: type) -> Any:
     """A contiguous copy of ``values`` that cannot be written to, so that no caller's array aliases a field."""
-    out = np.array(values, dtype=dtype, order="C", copy=True)
+    out: np.ndarray = np.array(values, dtype=dtype, order="C", copy=True)
     out.flags.writeable = False
     return out
 

@@ -28,12 +28,14 @@ values are unchanged. Scaling every length by ``s`` scales ``v_c`` and ``L`` ali
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from linkwork.kinematics.kernels import closure_jacobian
 from linkwork.kinematics.mechanism import Array, Mechanism
+from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank
 
 
 def hinge_centres(axes: ArrayLike, joint_types: Sequence[str]) -> tuple[Array, Array]:
@@ -167,3 +169,47 @@ def condition_ratios(mech: Mechanism, angles: ArrayLike, rank: ArrayLike, chunk:
         sigma = np.linalg.svd(normalized_jacobians(mech, values[part]), compute_uv=False)
         out[part] = [robustness_ratio(s, int(r)) for s, r in zip(sigma, ranks[part], strict=True)]
     return out
+
+
+NEAR_MOBILE = 1e-3
+"""A rigid start whose smallest normalised singular value is below this fraction of the largest is near-mobile."""
+
+
+@dataclass(frozen=True)
+class NearMobility:
+    """A start that is rigid only by a hair: the loops would move if the smallest singular value were zero.
+
+    ``relative`` is that singular value over the largest (normalised Jacobian); ``misfit`` the closure residual
+    (2-norm of the stacked loop logarithms, as the tracer measures it) that the near-motion leaves, to first
+    order, when its most-moving joint turns by one radian; ``joints`` the joints that move in it.
+    """
+
+    relative: float
+    misfit: float
+    joints: tuple[str, ...]
+
+
+def near_mobility(
+    mech: Mechanism, angles: ArrayLike | None = None, tol: Tolerances = DEFAULT
+) -> NearMobility | None:
+    """Diagnose link geometry that is almost, but not, mobile (an over-constrained loop typed with rounded lines).
+
+    At ``angles`` (default: the reference configuration) the numerical rank of the normalised Jacobian leaves
+    no motion, yet its smallest singular value is below ``NEAR_MOBILE`` times the largest: the hinge lines are a
+    rounding away from a mobile linkage (a generic rigid loop has a ratio of order 0.1). ``None`` when the start
+    is mobile or clearly rigid.
+    """
+    values = mech.offsets if angles is None else np.asarray(angles, dtype=float)
+    J = normalized_jacobian(mech, values)
+    m = J.shape[1]
+    if m == 0 or J.shape[0] < m:
+        return None
+    _, s, Vt = np.linalg.svd(J)
+    if s[0] <= 0.0 or numerical_rank(s, tol) < m or s[m - 1] >= NEAR_MOBILE * s[0]:
+        return None
+    C = mech.coupling_matrix()
+    motion = C @ Vt[m - 1] / np.max(np.abs(C @ Vt[m - 1]))  # the near-motion, largest joint moving 1 rad
+    joints = tuple(name for name, x in zip(mech.joint_names, motion, strict=True) if abs(x) > 0.1)
+    jac = _full_jacobians(mech, np.atleast_2d(values - mech.offsets))[0]
+    raw = jac.reshape(len(mech.loops), 6, -1)[:, list(mech.rows), :].reshape(-1, mech.n_joints)
+    return NearMobility(float(s[m - 1] / s[0]), float(np.linalg.norm(raw @ motion)), joints)
