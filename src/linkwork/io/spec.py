@@ -205,7 +205,7 @@ def _check_not_near_mobile(mech: Mechanism, source: str, closure_tol: float) -> 
         f"{near.relative:.3g} of the largest (normalised Jacobian), a closure misfit of {near.misfit:.3g} per "
         f"radian of the near-motion of joints {', '.join(near.joints)} > closure tolerance {closure_tol:.3g}; "
         "an over-constrained linkage typed with rounded coordinates? Give them to full precision, or accept the "
-        "misfit as play in the hinges with a closure tolerance above it",
+        "misfit as play in the hinges with a closure tolerance above it (closure_tol / --closure-tol)",
         residual=near.misfit,
     )
 

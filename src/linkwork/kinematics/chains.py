@@ -210,7 +210,7 @@ def _misfit_message(
         f"> closure tolerance {closure_tol:.3g} (residual {before:.3g} at the start as written; smallest "
         f"singular value of the closure Jacobian {sigma[-1]:.3g}, largest {sigma[0]:.3g}); an over-constrained "
         "loop typed with rounded lengths or twists? Give them to full precision, or accept the misfit as play "
-        "in the hinges with a closure tolerance above it"
+        "in the hinges with a closure tolerance above it (closure_tol / --closure-tol)"
     )
 
 
