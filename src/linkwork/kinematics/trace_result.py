@@ -8,12 +8,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.normalization import condition_ratios
 
 Array = NDArray[np.float64]
 
@@ -120,14 +122,32 @@ class Trace:
 
     @property
     def max_condition(self) -> float:
-        """Largest ratio of largest to smallest non-zero singular value along the path (Sec. 5)."""
-        ratios = [
-            s[0] / s[r - 1] for s, r in zip(self.sigma, self.rank, strict=True) if r > 0 and s[r - 1] > 0
-        ]
-        return float(max(ratios)) if ratios else float("nan")
+        """Largest robustness ratio along the path (Sec. 5), on the normalised Jacobian.
+
+        The ratio of the largest to the smallest non-zero singular value of the closure Jacobian with moments
+        about the linkage's own centre and lengths in its own scale
+        (:mod:`linkwork.kinematics.normalization`): unchanged when the linkage is moved, turned, scaled or
+        relabelled. :attr:`max_condition_raw` is the same ratio of the raw singular values in :attr:`sigma`.
+        """
+        ratios = self.condition()
+        return float(np.nanmax(ratios)) if np.any(np.isfinite(ratios)) else float("nan")
 
     def condition(self) -> Array:
-        """``(N,)`` ratio of the largest to the smallest non-zero singular value at every point."""
+        """``(N,)`` robustness ratio at every point, on the normalised Jacobian (see :attr:`max_condition`)."""
+        return self._normalized_condition.copy()
+
+    @cached_property
+    def _normalized_condition(self) -> Array:
+        return condition_ratios(self.mechanism, self.angles, self.rank)
+
+    @property
+    def max_condition_raw(self) -> float:
+        """Largest ratio of the raw singular values (:attr:`sigma`, base frame and file units) along the path."""
+        ratios = self.condition_raw()
+        return float(np.nanmax(ratios)) if np.any(np.isfinite(ratios)) else float("nan")
+
+    def condition_raw(self) -> Array:
+        """``(N,)`` ratio of the largest to the smallest non-zero raw singular value at every point."""
         out = np.full(len(self.rank), np.nan)
         for i, (s, r) in enumerate(zip(self.sigma, self.rank, strict=True)):
             if r > 0 and s[r - 1] > 0:

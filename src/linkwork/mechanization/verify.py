@@ -210,7 +210,7 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
     for j in range(1, chain.count):
         path = trace(mech, drive=drive, until=(drive, float(v[j])), max_step=max_step, max_steps=max_steps)
         paths.append(path)
-        max_cond = max(max_cond, path.max_condition)
+        max_cond = max(max_cond, path.max_condition_raw)  # raw, like the untraced check above
         where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
         end = path.branches[0].end_reason
         if path.bifurcations:
