@@ -19,7 +19,7 @@ def joint_positions(folder: Path, values: dict[str, float]) -> dict[str, np.ndar
     spec = tomllib.loads((folder / "mechanism.toml").read_text())["mechanism"]["joints"]
     kinds = zip(mech.joint_names, mech.joint_types, strict=True)
     q = np.array([math.radians(values[n]) if t == "R" else values[n] for n, t in kinds])
-    poses = body_poses(mech, q)
+    poses = body_poses(mech, q=q)
     out = {}
     for joint in spec:
         x, y = joint["point"][:2]

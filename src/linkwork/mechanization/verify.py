@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.errors import AssemblyError
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
@@ -122,7 +123,12 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
     max_steps
         Step budget of each trace (a passing design's path is the same as with the CLI's larger budget).
     """
-    mech = loaded_mechanism(design)
+    try:
+        mech = loaded_mechanism(design)
+    except AssemblyError as exc:
+        # the spec reader's assembly check: the links make the chain rigid but for a hair (a near-singular design)
+        reason = str(exc).split(": ", 2)[-1].split("; ")[0]
+        return Verification(False, "branch", f"branch defect: {reason}", 0, 0, design.drive)
     chain = design.chain
     ideal = design.ideal_values()
     names = list(mech.joint_names)
