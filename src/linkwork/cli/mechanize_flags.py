@@ -7,14 +7,29 @@ from typing import Annotated, Any
 
 import typer
 
-Dof = Annotated[int | None, typer.Option(help="Degrees of freedom (number of actuators); key dof.")]
-Drive = Annotated[str | None, typer.Option(help="The driven joint (default: chosen); key drive.")]
-Root = Annotated[str | None, typer.Option(help="The chain body guided first (default: tried in turn).")]
+PANEL = "Mechanization (each also a problem-file key)"
+
+Dof = Annotated[
+    int | None, typer.Option(rich_help_panel=PANEL, help="Degrees of freedom (number of actuators); key dof.")
+]
+Drive = Annotated[
+    str | None, typer.Option(rich_help_panel=PANEL, help="The driven joint (default: chosen); key drive.")
+]
+Root = Annotated[
+    str | None,
+    typer.Option(rich_help_panel=PANEL, help="The chain body guided first (default: tried in turn)."),
+]
 Anchors = Annotated[
-    str | None, typer.Option(help="Dyads to 'ground', between bodies too ('any'), or 'auto'; key anchors.")
+    str | None,
+    typer.Option(
+        rich_help_panel=PANEL, help="Dyads to 'ground', between bodies too ('any'), or 'auto'; key anchors."
+    ),
 ]
 Actuator = Annotated[
-    str | None, typer.Option(help="'revolute' (a crank) or 'prismatic' (a linear actuator); key actuator.")
+    str | None,
+    typer.Option(
+        rich_help_panel=PANEL, help="'revolute' (a crank) or 'prismatic' (a linear actuator); key actuator."
+    ),
 ]
 BinaryLinks = Annotated[
     str | None,
@@ -31,21 +46,34 @@ GroundRegion = Annotated[
 ]
 LinkOffset = Annotated[
     float | None,
-    typer.Option(help="Moving pivots up to this many body lengths off the chain; key link_offset."),
+    typer.Option(
+        rich_help_panel=PANEL,
+        help="Moving pivots up to this many body lengths off the chain; key link_offset.",
+    ),
 ]
 MaxLink = Annotated[
-    float | None, typer.Option(help="Longest link, times the profiles' largest extent; key max_link.")
+    float | None,
+    typer.Option(
+        rich_help_panel=PANEL, help="Longest link, times the profiles' largest extent; key max_link."
+    ),
 ]
 MinTransmission = Annotated[
-    float | None, typer.Option(help="Smallest transmission angle (degrees); key min_transmission.")
+    float | None,
+    typer.Option(rich_help_panel=PANEL, help="Smallest transmission angle (degrees); key min_transmission."),
 ]
-Attempts = Annotated[int | None, typer.Option(help="Designs traced at most per root and anchor choice.")]
+Attempts = Annotated[
+    int | None, typer.Option(rich_help_panel=PANEL, help="Designs traced at most per root and anchor choice.")
+]
 Designs = Annotated[
     int | None,
-    typer.Option(help="Passing designs to find and rank by quality factor (1: the first); key designs."),
+    typer.Option(
+        rich_help_panel=PANEL,
+        help="Passing designs to find and rank by quality factor (1: the first); key designs.",
+    ),
 ]
 TimeLimit = Annotated[
-    float | None, typer.Option(help="Seconds after which the search stops; key time_limit.")
+    float | None,
+    typer.Option(rich_help_panel=PANEL, help="Seconds after which the search stops; key time_limit."),
 ]
 
 

@@ -43,6 +43,7 @@ def synth(
         bool | None,
         typer.Option(
             "--mechanize/--no-mechanize",
+            rich_help_panel=mf.PANEL,
             help="Also mechanize the chain (default: the problem's `mechanize` key, or any mechanization flag).",
         ),
     ] = None,
