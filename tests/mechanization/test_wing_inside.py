@@ -24,14 +24,17 @@ CHORD = 1.0  # the cruise profile's chord, the shortest of the three
 
 
 @pytest.fixture(scope="module")
-def inside(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object]:
+def inside(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object, tuple]:
     result = synthesize(load_problem(WING / "mechanize.toml"))
     size = build_chain(result).size
     options = MechanizeOptions(ground_region="inside", max_link=CHORD / size, designs=1, time_limit=60.0)
-    found = mechanize(result, options)
+    calls: list[tuple[int, int, str]] = []
+    found = mechanize(
+        result, options, progress=lambda done, total, message: calls.append((done, total, message))
+    )
     folder = tmp_path_factory.mktemp("wing-inside")
     write_mechanization(found, folder)
-    return folder, result
+    return folder, result, (calls, found.attempts)
 
 
 def _outline(name: str) -> np.ndarray:
@@ -40,7 +43,7 @@ def _outline(name: str) -> np.ndarray:
 
 def test_every_ground_pivot_is_inside_every_airfoil(inside: tuple) -> None:
     mpath = pytest.importorskip("matplotlib.path")
-    folder, _ = inside
+    folder, _, _ = inside
     report = json.loads((folder / "mechanization.json").read_text())
     pivots = [d["ground_pivot"] for d in report["dyads"] if d["ground_pivot"] is not None]
     assert pivots, "at least the root's links are pivoted on the ground"
@@ -55,7 +58,7 @@ def test_every_ground_pivot_is_inside_every_airfoil(inside: tuple) -> None:
 
 
 def test_the_written_mechanism_traces_through_every_profile(inside: tuple) -> None:
-    folder, result = inside
+    folder, result, _ = inside
     report = json.loads((folder / "mechanization.json").read_text())
     mech = load_spec(folder / "mechanism.toml").mechanism
     drive = report["drive"]
@@ -73,7 +76,7 @@ def test_the_written_mechanism_traces_through_every_profile(inside: tuple) -> No
 
 
 def test_transmission_angles_are_the_triangle_angles_at_the_moving_pivots(inside: tuple) -> None:
-    folder, _ = inside
+    folder, _, _ = inside
     report = json.loads((folder / "mechanization.json").read_text())
     names = {d["name"] for d in report["dyads"]}
     at = [joint_positions(folder, p["angles"]) for p in report["profiles"]]
@@ -90,7 +93,7 @@ def test_transmission_angles_are_the_triangle_angles_at_the_moving_pivots(inside
 
 
 def test_quality_factor_is_the_documented_product(inside: tuple) -> None:
-    folder, _ = inside
+    folder, _, _ = inside
     report = json.loads((folder / "mechanization.json").read_text())
     sweep = abs(
         report["profiles"][-1]["drive_value"] - report["profiles"][0]["drive_value"]
@@ -100,3 +103,10 @@ def test_quality_factor_is_the_documented_product(inside: tuple) -> None:
     expected = math.sin(math.radians(mu)) * min(lengths) / max(lengths) * min(1.0, 180.0 / sweep)
     assert abs(report["quality"]["quality"] - expected) <= 1e-12
     assert report["designs"][0]["quality"] == report["quality"]["quality"]
+
+
+def test_the_search_reports_progress_after_every_design(inside: tuple) -> None:
+    _, _, (calls, attempts) = inside
+    assert [done for done, _, _ in calls] == list(range(1, attempts + 1))  # one call per design traced
+    assert all(done <= total for done, total, _ in calls)
+    assert calls[-1][2].startswith("1 passed")  # designs = 1: the search stops at the first pass
