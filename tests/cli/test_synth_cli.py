@@ -207,7 +207,7 @@ def test_summary_table_and_figures(problem: Path, tmp_path: Path) -> None:
         "Error matrix after joining",
         "E_max",
         "E_mean",
-        "Joint ranges (merge below 5 deg)",
+        "Joint ranges, Eq. 34 (merge below 5 deg, on the targets)",
         "viewer.html",
     ):
         assert text in result.output

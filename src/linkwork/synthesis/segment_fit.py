@@ -59,7 +59,7 @@ class SegmentFitter:
     def errors(self, kind: str, starts: Sequence[int], counts: Sequence[int]) -> Array:
         """``(p,)`` errors ``E_j^e`` (Eq. 21) of a segment of ``kind`` spanning the given pieces."""
         self.evaluations += 1
-        key = (kind, tuple(int(s) for s in starts), tuple(int(m) for m in counts))
+        key = (kind, tuple(map(int, starts)), tuple(map(int, counts)))
         if self.cached:
             hit = self.cache.get(key)
             if hit is not None:
@@ -81,8 +81,13 @@ class SegmentFitter:
 
     def error_matrix(self, design: str, segment_matrix: IntArray) -> Array:
         """``(q, p)`` error matrix ``EM`` of a segment matrix (Sec. 4)."""
-        starts = segment_starts(segment_matrix)
-        return np.vstack([self.errors(k, starts[e], segment_matrix[e]) for e, k in enumerate(design)])
+        rows = np.asarray(segment_matrix).tolist()
+        first = [0] * len(rows[0])
+        out = []
+        for kind, counts in zip(design, rows, strict=True):
+            out.append(self.errors(kind, first, counts))
+            first = [f + m for f, m in zip(first, counts, strict=True)]
+        return np.vstack(out)
 
     def segment(self, kind: SegmentKind, starts: Sequence[int], counts: Sequence[int]) -> Segment:
         """The full :class:`Segment` (shape, instances, errors) for the given pieces."""

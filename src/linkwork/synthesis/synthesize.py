@@ -66,13 +66,15 @@ def _check_initial(problem: Problem, designs: list[str], pieces: list[int]) -> N
     if sm is None:
         return
     key = "initial_segment_matrix"
+    src = None if problem.source is None else str(problem.source)
     if len(designs) != 1:
-        raise SpecError("needs a design vector, not design 'auto'", key=key)
+        raise SpecError("needs a design vector, not design 'auto'", source=src, key=key)
     design = designs[0]
     arr = np.asarray(sm)
     if arr.shape != (len(design), len(pieces)):
         raise SpecError(
             f"has shape {arr.shape}; expected one entry per segment ({len(design)}) and profile ({len(pieces)})",
+            source=src,
             key=key,
         )
     if not is_valid(arr.astype(np.int64), design, pieces, problem.min_pieces):
@@ -80,6 +82,7 @@ def _check_initial(problem: Problem, designs: list[str], pieces: list[int]) -> N
             f"is not a valid segment matrix for design {design}: each profile's entries must sum to its "
             f"pieces {pieces}, M-segments must have equal entries on every profile, every entry >= "
             f"min_pieces {problem.min_pieces}",
+            source=src,
             key=key,
         )
 
