@@ -24,7 +24,9 @@ from linkwork.synthesis.search import (
     chain_joints,
     evaluate_design,
     rigid_fit_rms,
+    segment_design,
 )
+from linkwork.synthesis.segment_fit import SegmentFitter
 from linkwork.synthesis.targets import target_profiles
 
 SETS = {
@@ -44,10 +46,10 @@ def naca_problem(codes: tuple[str, ...], kind: str, **kw: Any) -> Problem:
 def chord_gap(outcome: SkippedDesign | JoinedDesign, problem: Problem, j: int) -> tuple[float, float]:
     """(reach gap of the chain's chords on profile j, 2 x the sum of its segmentation errors there)."""
     opt = outcome.segmented.options[0]
-    lengths = [
-        float(np.linalg.norm(seg.local_points(j)[-1] - seg.local_points(j)[0])) for seg in opt.segments
-    ]
-    target = target_profiles(problem)[j].points
+    targets = target_profiles(problem)
+    segments = SegmentFitter(targets).segments(outcome.design, opt.segment_matrix)
+    lengths = [float(np.linalg.norm(seg.local_points(j)[-1] - seg.local_points(j)[0])) for seg in segments]
+    target = targets[j].points
     span = 0.0 if problem.kind == "closed" else float(np.linalg.norm(target[-1] - target[0]))
     return reach_gap(lengths, span), 2.0 * float(opt.error_matrix[:, j].sum())
 
@@ -179,3 +181,17 @@ def test_rank_by_joints_within_the_tolerance() -> None:
     tight = synthesize(Problem(**{**base.__dict__, "rank_by": "joints", "e_max_tolerance": 1e-9}))
     assert tight.design == by_error.design  # nothing acceptable: the best error
     assert chain_joints("MCMC", "open") == 3 + 2 and chain_joints("MCMC", "fixed-end") == 3 + 2 + 2
+
+
+def test_compiled_search_makes_the_python_search_decisions() -> None:
+    problem = naca_problem(SETS["0012-2412-4412"], "closed", segments=6, starts=3, min_pieces=3)
+    targets = target_profiles(problem)
+    fast, plain = SegmentFitter(targets), SegmentFitter(targets, compiled=False)
+    for design in ("CMCMCM", "MMCCMC", "CCCCCC", "MCMMMM"):
+        a = segment_design(problem, design, targets, fast)
+        b = segment_design(problem, design, targets, plain)
+        np.testing.assert_array_equal(a.options[0].segment_matrix, b.options[0].segment_matrix)
+        np.testing.assert_array_equal(a.options[0].error_matrix, b.options[0].error_matrix)
+        assert a.history == b.history and a.iterations == b.iterations
+        # the compiled RMS bound is the RMS of the rigid fits of the segments that are joined
+        assert a.bound == pytest.approx(b.bound, rel=1e-12)

@@ -239,7 +239,10 @@ def _polish(residual: Fn, jac: Fn, constraint: Fn | None, constraint_jac: Fn | N
         trial_cost = float(r_trial @ r_trial)
         if trial_cost > cost * (1.0 + 1e-12) + 1e-300:
             break  # no longer a descent step: we are at rounding level
+        settled = cost - trial_cost <= 1e-14 * cost
         u, cost = trial, trial_cost
+        if settled:
+            break  # the cost no longer falls beyond rounding
         if np.max(np.abs(step)) <= 1e-15 * (1.0 + np.max(np.abs(u))):
             break
     return u

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import ConvergenceError
+from linkwork.synthesis.compiled_search import MAX_ENTRIES, compiled_rms_bound, compiled_search
 from linkwork.synthesis.joining import join_chain
 from linkwork.synthesis.problem import Problem
 from linkwork.synthesis.refine import refine_segment_matrix
@@ -28,13 +29,17 @@ Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
+#: The bound is lowered by this relative margin so that rounding differences between the compiled fits and
+#: the segments that are joined can never lift it above a joined ``E_max``.
+BOUND_MARGIN = 1e-9
+
+
 @dataclass(frozen=True)
 class Segmentation:
-    """One segment matrix of a design vector, its errors, segments and the bound on its joined ``E_max``."""
+    """One segment matrix of a design vector, its errors and the lower bound on its joined ``E_max``."""
 
     segment_matrix: IntArray
     error_matrix: Array
-    segments: tuple[Segment, ...]
     bound: float
 
 
@@ -60,6 +65,7 @@ class JoinedDesign:
 
     design: str
     segmentation: Segmentation
+    segments: tuple[Segment, ...]
     joined: tuple[JoinedProfile, ...]
     joined_e_max: float
     segmented: SegmentedDesign
@@ -95,17 +101,36 @@ def chain_joints(design: str, kind: str) -> int:
 def joined_error_bound(segments: Sequence[Segment], targets: Sequence[TargetProfile]) -> float:
     """A lower bound on the ``E_max`` of any joining of these segments (Sec. 5, Eq. 21 on the joined chain).
 
-    Joining moves each segment's fixed shape rigidly, so on each profile the segment's sum of squared
-    point-to-point distances is at least that of its best rigid (least-squares) fit; its largest distance is
-    at least the root mean square of that fit. The bound is the largest such RMS over segments and profiles.
+    Joining moves each segment's fixed shape rigidly, so on each profile its largest point-to-point distance is
+    at least :func:`rigid_fit_bound` of its shape against the target points it spans; the bound is the largest
+    over segments and profiles.
     """
     worst = 0.0
     for seg in segments:
         for j, target in enumerate(targets):
             shape = seg.local_points(j)
             start = int(seg.starts[j])
-            worst = max(worst, rigid_fit_rms(shape, target.points[start : start + len(shape)]))
+            worst = max(worst, rigid_fit_bound(shape, target.points[start : start + len(shape)]))
     return worst
+
+
+def rigid_fit_bound(source: Array, target: Array) -> float:
+    """A lower bound on the largest distance of any rigid placement of ``source`` against ``target``.
+
+    The largest of: :func:`rigid_fit_rms` of all points, of the first, middle and last points alone (the
+    largest distance is at least the RMS of any subset, which is at least that subset's best fit), and half the
+    change of their three mutual distances (``d_a + d_b >= | |S_a - S_b| - |T_a - T_b| |``, rigid motions keep
+    distances). The compiled search uses the same bound (``compiled.fit_bound``).
+    """
+    n = len(source)
+    idx = [0, n // 2, n - 1]
+    s3, t3 = source[idx], target[idx]
+    pairs = [(0, 1), (0, 2), (1, 2)]
+    half = [
+        0.5 * abs(float(np.linalg.norm(s3[a] - s3[b])) - float(np.linalg.norm(t3[a] - t3[b])))
+        for a, b in pairs
+    ]
+    return max(rigid_fit_rms(source, target), rigid_fit_rms(s3, t3), *half)
 
 
 def rigid_fit_rms(source: Array, target: Array) -> float:
@@ -140,27 +165,37 @@ def segment_design(
     starts = initial_segment_matrices(design, pieces, problem.min_pieces, problem.starts, rng)
     if problem.initial_segment_matrix is not None:
         starts[0] = np.asarray(problem.initial_segment_matrix, dtype=np.int64)
-    outcome = search_segment_matrix(
-        design,
-        starts,
-        lambda sm: fitter.error_matrix(design, sm),
-        problem.min_pieces,
-        on_start_done=on_start_done,
-    )
+    if fitter.compiled_tables is not None and len(design) * len(pieces) <= MAX_ENTRIES:
+        outcome = compiled_search(design, starts, problem.min_pieces, fitter.compiled_tables)
+        fitter.evaluations += outcome.iterations * len(design)  # fits computed, no cache
+        for _ in starts:
+            if on_start_done is not None:
+                on_start_done()
+    else:
+        outcome = search_segment_matrix(
+            design,
+            starts,
+            lambda sm: fitter.error_matrix(design, sm),
+            problem.min_pieces,
+            on_start_done=on_start_done,
+        )
     matrices = [(outcome.segment_matrix, outcome.error_matrix)]
     if search == "refined":
         matrices.append(refine_segment_matrix(design, outcome.segment_matrix, fitter, problem.min_pieces))
     options = []
     for sm, em in matrices:
-        segments = fitter.segments(design, sm)
-        options.append(Segmentation(sm, em, segments, joined_error_bound(segments, targets)))
+        if fitter.compiled_tables is not None:
+            bound = compiled_rms_bound(design, sm, fitter.compiled_tables)
+        else:
+            bound = joined_error_bound(fitter.segments(design, sm), targets)
+        options.append(Segmentation(sm, em, bound * (1.0 - BOUND_MARGIN)))
     return SegmentedDesign(
         design, tuple(options), outcome.history, outcome.iterations, float(outcome.error_matrix.max())
     )
 
 
 def join_design(
-    problem: Problem, segmented: SegmentedDesign, targets: Sequence[TargetProfile]
+    problem: Problem, segmented: SegmentedDesign, targets: Sequence[TargetProfile], fitter: SegmentFitter
 ) -> JoinedDesign | SkippedDesign:
     """Join every option of a segmented design (Sec. 5); the option with the lower joined error wins.
 
@@ -170,13 +205,14 @@ def join_design(
     best: JoinedDesign | None = None
     reason = ""
     for opt in segmented.options:
+        segments = fitter.segments(segmented.design, opt.segment_matrix)
         try:
-            joined = join_chain(opt.segments, targets, problem.kind)
+            joined = join_chain(segments, targets, problem.kind)
         except ConvergenceError as exc:
             reason = f"design {segmented.design}: {exc}"
             continue
         e_max = max(float(prof.errors.max()) for prof in joined)
-        cand = JoinedDesign(segmented.design, opt, joined, e_max, segmented)
+        cand = JoinedDesign(segmented.design, opt, segments, joined, e_max, segmented)
         if best is None or cand.rank_key < best.rank_key:
             best = cand
     if best is None:
@@ -192,4 +228,5 @@ def evaluate_design(problem: Problem, design: str, search: str = "paper") -> Joi
     """
     targets = target_profiles(problem)
     fitter = SegmentFitter(targets)
-    return join_design(problem, segment_design(problem, design, targets, fitter, search=search), targets)
+    segmented = segment_design(problem, design, targets, fitter, search=search)
+    return join_design(problem, segmented, targets, fitter)

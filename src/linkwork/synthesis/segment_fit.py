@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.synthesis.arc_segment import fit_arc_segment
+from linkwork.synthesis.compiled_search import CompiledTables
 from linkwork.synthesis.error_kernels import ProfileTables
 from linkwork.synthesis.frames import to_local_frame
 from linkwork.synthesis.mean_segment import fit_mean_segment
@@ -39,10 +40,18 @@ class SegmentFitter:
         Keep every error vector computed (on by default).
     vectorised
         Use the numpy fits; ``False`` uses the plain-Python reference (the benchmark's baseline).
+    compiled
+        Run the segment-matrix search compiled (:mod:`~linkwork.synthesis.compiled_search`, same decisions);
+        ``False`` runs it in Python through :meth:`error_matrix` and its cache. Needs ``vectorised``.
     """
 
     def __init__(
-        self, targets: Sequence[TargetProfile], *, cached: bool = True, vectorised: bool = True
+        self,
+        targets: Sequence[TargetProfile],
+        *,
+        cached: bool = True,
+        vectorised: bool = True,
+        compiled: bool = True,
     ) -> None:
         self.points = [t.points for t in targets]
         self.tables = ProfileTables(self.points)
@@ -51,6 +60,7 @@ class SegmentFitter:
         self.cache: dict[tuple[str, tuple[int, ...], tuple[int, ...]], Array] = {}
         self.evaluations = 0
         self.hits = 0
+        self.compiled_tables = CompiledTables.from_tables(self.tables) if compiled and vectorised else None
 
     def pieces(self, starts: Sequence[int], counts: Sequence[int]) -> list[Array]:
         """Each profile's piece: ``counts[j] + 1`` points from ``starts[j]``."""

@@ -16,7 +16,7 @@ import numpy as np
 from linkwork.errors import RequestNotMetError, SpecError
 from linkwork.synthesis.compound import merge_joints
 from linkwork.synthesis.problem import Problem
-from linkwork.synthesis.result import DesignScore, SearchStats, SynthesisResult
+from linkwork.synthesis.result import DesignScore, SearchStats, SynthesisResult, TargetProfile
 from linkwork.synthesis.search import (
     JoinedDesign,
     SegmentedDesign,
@@ -99,7 +99,12 @@ def _ranked(joined: list[JoinedDesign], problem: Problem) -> list[JoinedDesign]:
 
 
 def _join_pruned(
-    problem: Problem, segmented: list[SegmentedDesign], targets: tuple, prune: bool, tick: Callable[[], None]
+    problem: Problem,
+    segmented: list[SegmentedDesign],
+    targets: tuple[TargetProfile, ...],
+    fitter: SegmentFitter,
+    prune: bool,
+    tick: Callable[[], None],
 ) -> tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign]]:
     """Join the designs in the order of their lower bounds; skip those whose bound cannot beat the best.
 
@@ -115,7 +120,7 @@ def _join_pruned(
         if prune and seg.bound > best and seg.bound > tol:
             pruned.append(seg)
         else:
-            outcome = join_design(problem, seg, targets)
+            outcome = join_design(problem, seg, targets, fitter)
             if isinstance(outcome, SkippedDesign):
                 skipped.append(outcome)
             else:
@@ -199,7 +204,7 @@ def synthesize(
         segment_design(problem, design, targets, fitter, search=search, on_start_done=tick)
         for design in designs
     ]
-    joined, skipped, pruned = _join_pruned(problem, segmented, targets, prune, tick)
+    joined, skipped, pruned = _join_pruned(problem, segmented, targets, fitter, prune, tick)
     if not joined:
         reasons = "; ".join(s.reason for s in skipped[:3]) + ("; ..." if len(skipped) > 3 else "")
         raise RequestNotMetError(f"no design vector of the {len(designs)} tried could be joined: {reasons}")
@@ -212,7 +217,7 @@ def synthesize(
         compound = merge_joints(
             chosen.design,
             opt.segment_matrix,
-            opt.segments,
+            chosen.segments,
             targets,
             chosen.joined,
             problem.merge_below,
@@ -245,7 +250,7 @@ def synthesize(
         error_matrix=opt.error_matrix,
         e_max=float(opt.error_matrix.max()),  # Eq. (22)
         e_mean=float(opt.error_matrix.mean()),  # Eq. (24)
-        segments=opt.segments,
+        segments=chosen.segments,
         joined_error_matrix=joined_em,
         joined_e_max=float(joined_em.max()),
         joined=chosen.joined,
