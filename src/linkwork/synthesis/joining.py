@@ -206,9 +206,16 @@ def join_profile(
         _check_reach(chain, t_map, b, span, closed)
         starts = [u0, _target_start(chain, z, t_map, b, nf)]
         free_angles = slice(nf, None)
-        u = _constrained(residual, jac, constraint, constraint_jac, starts, free_angles)
-        u = _polish(residual, jac, constraint, constraint_jac, u)
-        u = _project(constraint, constraint_jac, u, free_angles)
+        feasible = _constrained(residual, jac, constraint, constraint_jac, starts, free_angles)
+        try:
+            u = _project(
+                constraint,
+                constraint_jac,
+                _polish(residual, jac, constraint, constraint_jac, feasible),
+                free_angles,
+            )
+        except ConvergenceError:
+            u = feasible  # the polish left the constraint for good: keep the optimiser's feasible point
     s, th = unpack(u)
     pts = chain.points(s, th)
     dist = np.linalg.norm(pts - z, axis=1)
