@@ -180,6 +180,11 @@ def test_rank_by_joints_within_the_tolerance() -> None:
     assert loose.joined_e_max == min(e for d, e in errors.items() if chain_joints(d, "open") == fewest)
     tight = synthesize(Problem(**{**base.__dict__, "rank_by": "joints", "e_max_tolerance": 1e-9}))
     assert tight.design == by_error.design  # nothing acceptable: the best error
+    # pruning keeps the choice of the joints ranking too (tolerance between the best and the worst error)
+    middle = Problem(
+        **{**base.__dict__, "rank_by": "joints", "e_max_tolerance": float(np.median(list(errors.values())))}
+    )
+    assert synthesize(middle).design == synthesize(middle, prune=False).design
     assert chain_joints("MCMC", "open") == 3 + 2 and chain_joints("MCMC", "fixed-end") == 3 + 2 + 2
 
 
