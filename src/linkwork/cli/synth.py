@@ -60,6 +60,14 @@ def synth(
     attempts: mf.Attempts = None,
     designs: mf.Designs = None,
     time_limit: mf.TimeLimit = None,
+    exhaustive: Annotated[
+        bool,
+        typer.Option(
+            "--exhaustive",
+            help="Join every design vector of design = 'auto' (no pruning by the lower bound on E_max; the "
+            "chosen design is the same, only slower).",
+        ),
+    ] = False,
 ) -> None:
     """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
 
@@ -115,7 +123,7 @@ def synth(
         def progress(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        result = synthesize(spec, progress=progress, search=search)  # type: ignore[arg-type]
+        result = synthesize(spec, progress=progress, search=search, prune=not exhaustive)  # type: ignore[arg-type]
 
     plots = not no_plots
     if plots and not have_matplotlib():

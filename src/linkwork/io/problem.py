@@ -20,8 +20,13 @@ Example
     seed = 1
     names = ["cruise", "climb", "landing"]   # optional; file stems by default
     mechanize = false                   # optional; the mechanization options (dof, drive, actuator,
-                                        # ground_region, link_offset, max_link, min_transmission, anchors,
-                                        # attempts, time_limit, root) are keys too: docs/mechanization.md
+                                        # binary_links, ground_region, link_offset, max_link, min_transmission,
+                                        # anchors, attempts, designs, time_limit, root) are keys too:
+                                        # docs/mechanization.md
+    merge_on = "targets"                # targets | chain: where merge_below's joint ranges are measured
+    rank_by = "error"                   # error | joints (fewest joints with E_max <= e_max_tolerance)
+    e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
+    initial_segment_matrix = [[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]]  # Eq. 11: a row per profile
 """
 
 from __future__ import annotations
@@ -37,7 +42,7 @@ import numpy as np
 from linkwork.errors import SpecError
 from linkwork.io.profiles import COINCIDENT, load_profile
 from linkwork.mechanization.options import OPTION_KEYS, options_from_values
-from linkwork.synthesis.problem import Problem, ProfileKind
+from linkwork.synthesis.problem import MergeOn, Problem, ProfileKind, RankBy
 
 KINDS = ("open", "closed", "fixed-end")
 """The values of ``type``."""
@@ -56,6 +61,10 @@ KEYS = (
     "mechanize",
     "description",
     *OPTION_KEYS,
+    "merge_on",
+    "rank_by",
+    "e_max_tolerance",
+    "initial_segment_matrix",
 )
 """Every key a problem file may hold (``description`` is free text for the reader and is ignored)."""
 
@@ -175,6 +184,37 @@ def _design(keys: _Keys) -> tuple[str | None, int | None]:
     return design, len(design)
 
 
+def _initial_segment_matrix(keys: _Keys, profiles: int) -> np.ndarray | None:
+    """``initial_segment_matrix``: as printed in the paper (Eq. 11), one row of whole numbers per profile;
+    returned transposed, ``(q, p)``, as the API holds segment matrices."""
+    raw = keys.get(
+        "initial_segment_matrix",
+        None,
+        lambda v: (
+            v
+            if isinstance(v, list)
+            and v
+            and all(
+                isinstance(row, list)
+                and row
+                and all(isinstance(m, int) and not isinstance(m, bool) for m in row)
+                for row in v
+            )
+            else None
+        ),
+        "a list of rows of whole numbers, one row per profile (the paper's Eq. 11)",
+    )
+    if raw is None:
+        return None
+    if len(raw) != profiles or len({len(row) for row in raw}) != 1:
+        raise keys.error(
+            "initial_segment_matrix",
+            f"has {len(raw)} rows of lengths {sorted({len(row) for row in raw})}; expected {profiles} rows "
+            "(one per profile) of equal length (one entry per segment)",
+        )
+    return np.asarray(raw, dtype=np.int64).T
+
+
 def load_problem(path: str | Path) -> Problem:
     """Read a synthesis problem from a TOML file and its profile files.
 
@@ -227,6 +267,23 @@ def load_problem(path: str | Path) -> Problem:
     mechanize = keys.get("mechanize", False, _boolean, "true or false")
     mechanize_options = {key: table[key] for key in OPTION_KEYS if key in table}
     options_from_values(mechanize_options, source=source)  # checked here: a mistake is found before synthesis
+    merge_on: MergeOn = keys.get(
+        "merge_on", "targets", lambda v: v if v in ("targets", "chain") else None, 'one of "targets", "chain"'
+    )
+    rank_by: RankBy = keys.get(
+        "rank_by", "error", lambda v: v if v in ("error", "joints") else None, 'one of "error", "joints"'
+    )
+    e_max_tolerance = keys.get("e_max_tolerance", None, _positive, "a positive number (profile units)")
+    if rank_by == "joints" and e_max_tolerance is None:
+        raise keys.error("e_max_tolerance", 'missing; rank_by = "joints" needs the largest acceptable E_max')
+    initial_sm = _initial_segment_matrix(keys, len(files))
+    if initial_sm is not None and design is None:
+        raise keys.error("initial_segment_matrix", 'needs a design vector, not design = "auto"')
+    if initial_sm is not None and design is not None and initial_sm.shape[0] != len(design):
+        raise keys.error(
+            "initial_segment_matrix",
+            f'has {initial_sm.shape[0]} entries per row but design "{design}" has {len(design)} segments',
+        )
     keys.get("description", "", lambda v: v if isinstance(v, str) else None, "a string")
     stems = [Path(name).stem for name in files]
     names = keys.get("names", stems, _string_list, f"a list of {len(files)} non-empty names")
@@ -268,4 +325,8 @@ def load_problem(path: str | Path) -> Problem:
         source=path,
         mechanize=mechanize,
         mechanize_options=mechanize_options,
+        merge_on=merge_on,
+        rank_by=rank_by,
+        e_max_tolerance=e_max_tolerance,
+        initial_segment_matrix=initial_sm,
     )

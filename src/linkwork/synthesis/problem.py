@@ -11,6 +11,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
+RankBy = Literal["error", "joints"]
+MergeOn = Literal["targets", "chain"]
 
 
 @dataclass(frozen=True)
@@ -23,7 +25,8 @@ class Problem:
         The design curves, each a polyline of shape ``(N_j, 2)``. A closed profile's polyline returns to its
         first point (its last row equals its first).
     kind
-        ``"open"``, ``"closed"`` or ``"fixed-end"`` (both ends pinned to where profile 1 has them).
+        ``"open"``, ``"closed"`` or ``"fixed-end"`` (each profile's chain pinned at that profile's own first
+        and last points, Eq. 32).
     piece_length
         The desired piece length ``s_d`` of the target profiles (Sec. 2 of the paper).
     min_pieces
@@ -37,6 +40,18 @@ class Problem:
     merge_below
         Joint-range threshold (radians) below which adjacent segments are merged into a compound segment
         (Sec. 6); ``0`` disables merging.
+    merge_on
+        Where the joint ranges that ``merge_below`` is compared with are measured (Eq. 34): ``"targets"``, on
+        the target profiles as the paper does, or ``"chain"``, on the joined chain.
+    rank_by
+        How the design vectors of ``design = None`` are ranked: ``"error"``, by the joined ``E_max``;
+        ``"joints"``, fewest joints among those whose joined ``E_max`` is at most ``e_max_tolerance``, then by
+        error (the trade-off of Sec. 5).
+    e_max_tolerance
+        The largest acceptable joined ``E_max`` (profile units) for ``rank_by = "joints"``.
+    initial_segment_matrix
+        ``(q, p)`` the segment matrix the search starts from (Eq. 11, transposed: one row per segment), or
+        ``None`` for the even split.
     seed
         Seed of the random generator of the initial segment matrices.
     names
@@ -63,6 +78,10 @@ class Problem:
     source: Path | None = None
     mechanize: bool = False
     mechanize_options: Mapping[str, Any] = field(default_factory=dict)
+    merge_on: MergeOn = "targets"
+    rank_by: RankBy = "error"
+    e_max_tolerance: float | None = None
+    initial_segment_matrix: NDArray[np.int64] | None = None
 
     @property
     def count(self) -> int:
