@@ -487,7 +487,12 @@ def test_mechanism_viewer_opens_fixed_with_the_target_profiles(browser: Browser,
     assert ink > 0.01
     browser.screenshot(tmp_path / "wing-mechanism.png")
     browser.js("document.getElementById('centred').click()")  # the steady view moves: no profiles drawn there
-    steady, _ = canvas(browser)
+    assert browser.js("document.getElementById('centred').checked") is True
+    for _ in range(50):  # the page redraws on its next animation frame
+        steady, _ = canvas(browser)
+        if steady != fixed:
+            break
+        time.sleep(0.1)
     assert steady != fixed
     assert browser.errors() == []
     assert_offline(browser)
