@@ -227,7 +227,8 @@ def mechanize(
             break
     seconds = time.perf_counter() - state.started
     if state.passed:
-        ranked = tuple(sorted(state.passed, key=lambda r: -r.quality.factor))
+        # ties (the same weakest link) keep the order found: rounding keeps that order stable to the last bits
+        ranked = tuple(sorted(state.passed, key=lambda r: -round(r.quality.factor, 9)))
         best = ranked[0]
         return Mechanization(
             best.design, best.verification, state.attempts, tuple(state.rejected), seconds, ranked
