@@ -35,7 +35,7 @@ def robustness_dict(result: RobustnessResult, source: str = "") -> dict[str, Any
     setup = result.setup
     mech = setup.mech
     model = setup.model
-    drive = mech.joint_names[int(np.flatnonzero(mech.groups == setup.drive_unknown)[0])]
+    drive = setup.drive
     revolute = mech.joint_types[mech.index(drive)] == "R"
     drive_values = np.degrees(setup.drive_values) if revolute else setup.drive_values
     fo = result.first_order_max
@@ -102,7 +102,7 @@ def run_and_write_robustness(
     from linkwork.studies.parquet import SampleWriter
 
     mech = setup.mech
-    drive = int(np.flatnonzero(mech.groups == setup.drive_unknown)[0])
+    drive = mech.index(setup.drive)
     figures: list[Path] = []
     with staged_output(out) as stage:
         with SampleWriter(stage / "samples.parquet", setup.drive_values, mech.joint_types[drive] == "R") as w:

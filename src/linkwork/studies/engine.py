@@ -10,6 +10,7 @@ schedule; at most a few chunks per worker are in flight, so memory stays bounded
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import uuid
 from collections.abc import Callable, Iterator, Sequence
@@ -61,6 +62,7 @@ def dask_client(scheduler: str | None, workers: int | None = None) -> Iterator[A
             processes=True,
             host="127.0.0.1",
             dashboard_address=None,
+            silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,
     ):

@@ -51,6 +51,7 @@ class RobustnessSetup:
     lines: HingeLines
     scale: MisfitScale
     u_path: Array
+    drive: str
     drive_values: Array
     drive_unknown: int
     normal: Array
@@ -108,6 +109,7 @@ def prepare(
         lines=lines,
         scale=scale,
         u_path=u_path,
+        drive=mech.joint_names[drive_joint],
         drive_values=path.angles[first, drive_joint],
         drive_unknown=drive_unknown,
         normal=normal,
