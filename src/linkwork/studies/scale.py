@@ -3,7 +3,7 @@
 A closure misfit is a small twist ``(omega, v)`` (rotation and translation left over when the loop is forced
 shut). Its size is measured as ``|(L omega, v + omega x c)|``: the rotation times the linkage's length scale plus
 the translation of the point ``c``, so that the number is a length, in the linkage's units, and does not change
-when the linkage is moved, turned or relabelled, and scales with it.
+when the linkage is moved or turned, and scales with it.
 
 ``c`` is the point nearest (least squares) to every revolute hinge line, ``L`` the root-mean-square distance of
 the hinge lines from ``c`` (for concurrent lines, e.g. a spherical linkage, the RMS distance of their reference
