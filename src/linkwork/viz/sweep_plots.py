@@ -98,6 +98,6 @@ def write_sweep_figures(study: Study, rows: list[dict[str, Any]], folder: Path) 
             continue
         if numeric_params:
             figures.append(plot_lines(study, rows, metric, Path(folder) / f"sweep_{metric}.png"))
-        if len(study.grid) == 2:
+        if len(study.grid) == 2 and len(rows) == np.prod([len(v) for v in study.grid.values()]):
             figures.append(plot_heatmap(study, rows, metric, Path(folder) / f"heatmap_{metric}.png"))
     return figures
