@@ -132,12 +132,16 @@ def test_design_search_one_task_per_design_matches_auto(tmp_path):
     from linkwork.synthesis import synthesize
 
     study = prepare_study(
-        load_study(_write(tmp_path, 'problem = "closed"\n[grid]\nsegments = [3]\ndesign = "each"\nstarts = [1]\n'))
+        load_study(
+            _write(tmp_path, 'problem = "closed"\n[grid]\nsegments = [3]\ndesign = "each"\nstarts = [1]\n')
+        )
     )
     rows = [row for row, _ in run_sweep(study, workers=0)]
     assert [row["design"] for row in rows] == ["MMM", "MMC", "MCM", "MCC", "CMM", "CMC", "CCM", "CCC"]
     ok = [row for row in rows if not row["error"]]
-    assert "MMM" in [row["design"] for row in rows if row["error"]]  # no C-segment: infeasible, with its reason
+    assert "MMM" in [
+        row["design"] for row in rows if row["error"]
+    ]  # no C-segment: infeasible, with its reason
     auto = synthesize(replace(load_problem(data.example("closed")), design=None, segments=3, starts=1))
     best = min(ok, key=lambda row: (row["e_max"], row["e_mean"]))
     assert best["design"] == auto.design and best["e_max"] == pytest.approx(auto.e_max, rel=1e-12)
