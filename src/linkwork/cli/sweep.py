@@ -14,7 +14,7 @@ from linkwork.outputs.staging import console
 @friendly_errors
 def sweep(
     study_file: Annotated[
-        Path, typer.Argument(help="The study file (TOML): a linkage or problem and a [grid].")
+        Path, typer.Argument(help="The study file (TOML): a linkage or problem and a \\[grid] table.")
     ],
     scheduler: Annotated[
         str | None,
