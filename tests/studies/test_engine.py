@@ -10,6 +10,8 @@ from linkwork.errors import LinkworkError
 from linkwork.studies.engine import map_chunks, scheduler_address
 from linkwork.studies.imperfections import ImperfectionModel
 from linkwork.studies.robustness import robustness
+from linkwork.studies.study_file import load_study
+from linkwork.studies.sweep import run_sweep
 
 
 def _same(a, b) -> None:
@@ -30,12 +32,20 @@ def test_chunking_does_not_change_any_sample(bennett):
     assert not np.array_equal(other.misfit_max, whole.misfit_max)
 
 
-def test_two_worker_cluster_gives_the_local_numbers(bennett):
+def test_two_worker_cluster_gives_the_local_numbers(bennett, tmp_path):
     from dask.distributed import Client, LocalCluster
 
     mech, path = bennett
     model = ImperfectionModel(1e-4, np.radians(0.01))
     local = robustness(mech, path, model, 80, seed=3, workers=0)
+    study_file = tmp_path / "study.toml"
+    study_file.write_text(
+        'linkage = "bennett"\n[trace]\nuntil = "A=90"\nsteps = 8\n[grid]\nalpha1 = [30, 40, 50]\n'
+        "[robustness]\nsamples = 20\nhinge_position_tol = 1e-4\nhinge_direction_tol = 0.01\n",
+        encoding="utf-8",
+    )
+    study = load_study(study_file)
+    local_rows = [row for row, _ in run_sweep(study, workers=0)]
     seen: list[tuple[int, int]] = []
     with (
         LocalCluster(
@@ -46,7 +56,9 @@ def test_two_worker_cluster_gives_the_local_numbers(bennett):
         remote = robustness(
             mech, path, model, 80, seed=3, client=client, chunk=20, progress=lambda d, t: seen.append((d, t))
         )
+        remote_rows = [row for row, _ in run_sweep(study, client=client)]
     _same(local, remote)
+    assert remote_rows == local_rows  # every number of every grid point, exactly
     assert seen[-1] == (4, 4)
 
 
