@@ -49,7 +49,7 @@ def test_two_worker_cluster_gives_the_local_numbers(bennett, tmp_path):
     seen: list[tuple[int, int]] = []
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=None
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=":0"
         ) as cluster,
         Client(cluster) as client,
     ):

@@ -61,7 +61,7 @@ def dask_client(scheduler: str | None, workers: int | None = None) -> Iterator[A
             threads_per_worker=1,
             processes=True,
             host="127.0.0.1",
-            dashboard_address=None,
+            dashboard_address=":0",
             silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,
