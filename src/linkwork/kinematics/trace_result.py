@@ -23,7 +23,11 @@ class Bifurcation:
     """A located bifurcation point.
 
     ``angles`` are the joint values (radians) there, ``tangents`` the branch tangents as unit vectors over the
-    joints (one per line through the point), ``sigma`` the Jacobian's singular values.
+    joints (one per line through the point) and ``tangents_u`` the same over the unknowns, ``sigma`` the
+    Jacobian's singular values. ``kind`` is ``"bifurcation"`` (an isolated point with two or more branch
+    tangents), ``"fold"`` (a rank drop with fewer than two real branch tangents: the path touches the singular
+    set and no other branch leaves it) or ``"component"`` (where the path meets a higher-dimensional component of
+    the configuration space: ``dimension`` is its dimension, the mobility on it; no branch is switched to there).
     """
 
     id: int
@@ -37,11 +41,31 @@ class Bifurcation:
     method: str
     residual: float
     bracket: float
+    tangents_u: Array = field(default_factory=lambda: np.zeros((0, 0)))
+    kind: str = "bifurcation"
+    dimension: int = 0
+
+
+@dataclass(frozen=True)
+class Fold:
+    """A fold (limit point) of the drive on a branch: the drive stops and turns back there.
+
+    ``value`` is the drive's extreme value (radians, or length for a prismatic drive), ``angles`` every joint
+    there, ``step`` the step of the branch just before it.
+    """
+
+    branch: int
+    step: int
+    value: float
+    angles: Array
 
 
 @dataclass(frozen=True)
 class Branch:
-    """One traced branch: where it starts (parent branch and bifurcation, or the start), direction, end."""
+    """One traced branch: where it starts (parent branch and bifurcation, or the start), direction, end.
+
+    ``mobility`` is the mobility (unknowns minus rank) that holds along the branch away from its ends.
+    """
 
     id: int
     parent: int | None
@@ -49,6 +73,7 @@ class Branch:
     direction: int
     steps: int
     end_reason: str
+    mobility: int = 1
 
 
 @dataclass(frozen=True)
@@ -86,6 +111,7 @@ class Trace:
     bifurcations: tuple[Bifurcation, ...]
     branches: tuple[Branch, ...]
     stats: Mapping[str, Any] = field(default_factory=dict)
+    folds: tuple[Fold, ...] = ()
 
     @property
     def mobility(self) -> NDArray[np.int64]:
