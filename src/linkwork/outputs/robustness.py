@@ -141,3 +141,18 @@ def print_robustness_summary(summary: dict[str, Any]) -> None:
         f"{tol['distribution']}, {tol['errors']} errors; misfit in length units, L = {summary['scale']['length']:.4g}"
     )
     console.print(f"mobility kept by {100.0 * (summary['mobility_kept'] or 0.0):.1f} % of the samples")
+    b = summary["bands"]
+    key = "drive_deg" if "drive_deg" in b else "drive"
+    unit = " deg" if key == "drive_deg" else ""
+    median = np.array([np.nan if v is None else v for v in b["p50"]], dtype=float)
+    ratio = np.array([np.nan if v is None else v for v in b["ratio"]], dtype=float)
+    if np.any(np.isfinite(median)) and np.nanmax(median) > 0:
+        k = int(np.nanargmax(median))
+        console.print(
+            f"median misfit largest at {summary['drive']} = {b[key][k]:.5g}{unit} (point {k}): {median[k]:.4g}"
+        )
+    if np.any(np.isfinite(ratio)):
+        k = int(np.nanargmax(ratio))
+        console.print(
+            f"Sec. 5 ratio largest at {summary['drive']} = {b[key][k]:.5g}{unit} (point {k}): {ratio[k]:.4g}"
+        )
