@@ -145,3 +145,11 @@ def test_design_search_one_task_per_design_matches_auto(tmp_path):
     auto = synthesize(replace(load_problem(data.example("closed")), design=None, segments=3, starts=1))
     best = min(ok, key=lambda row: (row["e_max"], row["e_mean"]))
     assert best["design"] == auto.design and best["e_max"] == pytest.approx(auto.e_max, rel=1e-12)
+
+
+def test_spec_file_study_is_one_point(tmp_path):
+    spec = Path(__file__).resolve().parents[2] / "examples" / "specs" / "four-bar.toml"
+    study = load_study(_write(tmp_path, f'spec = "{spec}"\n[trace]\nuntil = "A=100"\nsteps = 11\n'))
+    [(row, _)] = run_sweep(study, workers=0)
+    assert row["error"] == "" and row["mobility"] == 1 and row["points"] == 12
+    assert row["A_min"] == pytest.approx(45.0) and row["A_max"] == pytest.approx(100.0)
