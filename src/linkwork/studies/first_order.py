@@ -113,7 +113,8 @@ def first_order_misfit(G: Array, errors: Array) -> Array:
     so that a sample's numbers never depend on how many others share its chunk.
     """
     S = errors.shape[0]
-    K, _, P = G.shape
-    rows = np.array([int(np.flatnonzero(np.any(G[k] != 0.0, axis=1)).max(initial=-1)) + 1 for k in range(K)])
+    P = G.shape[2]
+    used = np.any(G != 0.0, axis=2)  # (K, E): the rows of each G_k inside its left null space
+    rows = np.where(used.any(axis=1), used.shape[1] - np.argmax(used[:, ::-1], axis=1), 0).astype(np.int64)
     delta = np.ascontiguousarray(errors.reshape(S, P))
-    return _first_order_kernel(np.ascontiguousarray(G), rows.astype(np.int64), delta)
+    return _first_order_kernel(np.ascontiguousarray(G), rows, delta)
