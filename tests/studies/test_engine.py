@@ -75,3 +75,17 @@ def test_scheduler_address_from_the_environment(monkeypatch):
     assert scheduler_address(None) is None
     with pytest.raises(LinkworkError):
         scheduler_address("nonsense")
+
+
+def test_a_samples_seed_reproduces_it_alone(bennett):
+    from linkwork.studies.imperfections import hinge_errors, perturbed_twists
+    from linkwork.studies.misfit import misfit_batch
+    from linkwork.studies.robustness import MAX_ITER, prepare, run_chunk
+
+    mech, path = bennett
+    setup = prepare(mech, path, ImperfectionModel(1e-4, np.radians(0.01)), seed=12)
+    chunk = run_chunk(setup, 30, 40)
+    seed = chunk.seed[7:8]  # sample 37, as samples.parquet records it
+    twists = perturbed_twists(hinge_errors(seed, setup.mech, setup.model, setup.lines), setup.lines)
+    alone = misfit_batch(twists, *setup.kernel_args(), MAX_ITER)
+    assert alone.max() == chunk.misfit_max[7]
