@@ -49,23 +49,28 @@ def line_points(mech: Mechanism, centre: Array | None = None) -> Array:
 
 def misfit_scale(mech: Mechanism) -> MisfitScale:
     """The centre, length scale and weight map of ``mech`` (see the module docstring)."""
-    w = mech.twists[:, :3]
-    revolute = np.einsum("ij,ij->i", w, w) > 0.5
-    if not np.any(revolute):
-        centre, length = np.zeros(3), 1.0
-    else:
-        p0 = line_points(mech)[revolute]
-        wr = w[revolute]
-        proj = np.eye(3)[None, :, :] - wr[:, :, None] * wr[:, None, :]
-        A = proj.sum(axis=0)
-        b = np.einsum("kij,kj->i", proj, p0)
-        centre = np.linalg.lstsq(A, b, rcond=1e-10)[0]
-        pts = line_points(mech, centre)[revolute]
-        length = float(np.sqrt(np.mean(np.sum((pts - centre) ** 2, axis=1))))
-        if length < 1e-12:
-            length = float(np.sqrt(np.mean(np.sum((p0 - centre) ** 2, axis=1)))) or 1.0
+    centre, length = centre_and_length(mech)
     T = np.zeros((6, 6))
     T[:3, :3] = length * np.eye(3)
     T[3:, 3:] = np.eye(3)
     T[3:, :3] = -hat3(centre)  # omega x c = -c x omega
     return MisfitScale(centre=centre, length=length, weight=T)
+
+
+def centre_and_length(mech: Mechanism) -> tuple[Array, float]:
+    """The linkage's centre ``c`` and length ``L`` at its reference (the one place that defines them)."""
+    w = mech.twists[:, :3]
+    revolute = np.einsum("ij,ij->i", w, w) > 0.5
+    if not np.any(revolute):
+        return np.zeros(3), 1.0
+    p0 = line_points(mech)[revolute]
+    wr = w[revolute]
+    proj = np.eye(3)[None, :, :] - wr[:, :, None] * wr[:, None, :]
+    A = proj.sum(axis=0)
+    b = np.einsum("kij,kj->i", proj, p0)
+    centre = np.linalg.lstsq(A, b, rcond=1e-10)[0]
+    pts = line_points(mech, centre)[revolute]
+    length = float(np.sqrt(np.mean(np.sum((pts - centre) ** 2, axis=1))))
+    if length < 1e-12:
+        length = float(np.sqrt(np.mean(np.sum((p0 - centre) ** 2, axis=1)))) or 1.0
+    return centre, length
