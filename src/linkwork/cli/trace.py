@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -189,12 +188,10 @@ def trace(
 
 
 def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:
-    """The spec, assembled accepting a closure misfit within ``closure_tol`` where the loader supports it."""
+    """The spec, assembled accepting a closure misfit within ``closure_tol`` (play in the hinges)."""
     from linkwork.io.spec import resolve_spec
 
-    if "closure_tol" in inspect.signature(resolve_spec).parameters:
-        return resolve_spec(spec, params, closure_tol=closure_tol)  # type: ignore[call-arg,unused-ignore]
-    return resolve_spec(spec, params)
+    return resolve_spec(spec, params, closure_tol=closure_tol)
 
 
 def _limits_in_api_units(

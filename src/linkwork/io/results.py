@@ -105,6 +105,7 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         "target_reached": ("unmet" not in path.stats) if path.stats.get("has_target") else None,
         "unmet": path.stats.get("unmet"),
         "max_condition": path.max_condition,
+        "max_condition_raw": path.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
         "bifurcations": [
             {
@@ -158,6 +159,8 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         out["assembly"] = {
             "residual_before": float(assembly.residual_before),
             "residual_after": float(assembly.residual_after),
+            "misfit": float(getattr(assembly, "misfit", assembly.residual_after)),
+            "closure_tol": float(getattr(assembly, "closure_tol", 1e-12)),
             "correction_deg": dict(zip(names, map(float, np.degrees(assembly.correction)), strict=True)),
         }
     return out

@@ -18,7 +18,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.kinematics.closure import hessian, reduce
-from linkwork.kinematics.march import tangent_and_test
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank
 from linkwork.kinematics.workspace import Workspace
@@ -105,7 +104,7 @@ def locate(
     def evaluate_at(u: Array) -> tuple[float, Array]:
         _, _, jac = ws.evaluate(u)
         t = np.empty_like(t_a)
-        value = tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
+        value = ws.kernels.tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
         return float(value), t
 
     f_lo, _ = evaluate_at(u_a)

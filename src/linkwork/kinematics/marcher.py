@@ -26,9 +26,6 @@ from linkwork.kinematics.march import (
     NO_PROGRESS,
     SIGN_CHANGE,
     STOP_REASONS,
-    correct,
-    march,
-    tangent_and_test,
 )
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
@@ -154,7 +151,7 @@ class BranchMarcher:
             res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty(n + 1), count=0, code=0, h=h0,
         )  # fmt: skip
         ws = self.ws
-        out.count, out.code, out.h = march(
+        out.count, out.code, out.h = ws.kernels.march(
             twists=ws.twists, loop_joint=ws.loop_joint, loop_sign=ws.loop_sign, loop_ptr=ws.loop_ptr,
             rows=ws.rows, groups=ws.groups, u0=u, t0=t, u_home=u_home, basis=basis, paper=paper,
             drive=cfg.drive, h0=h0, hmin=cfg.min_step, hmax=cfg.max_step, cos_turn=cfg.cos_turn,
@@ -240,7 +237,7 @@ class BranchMarcher:
         guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
         guess[g] = bound
         tol, ws = cfg.tol, self.ws
-        ok, _, r = correct(
+        ok, _, r = ws.kernels.correct(
             *ws.kernel_arrays(), guess, g, tol.closure, tol.exact, tol.roundoff, tol.truncate, tol.max_iter,
             ws.q, ws.res, ws.jac,
         )  # fmt: skip
@@ -415,7 +412,9 @@ class BranchMarcher:
         """The oriented range basis at point ``u`` (as the march kept it), recomputed for the locator."""
         _, _, jac = self.ws.evaluate(u)
         basis = basis_prev.copy()
-        tangent_and_test(jac, t.copy(), basis, self.cfg.r_path, np.empty_like(t), np.empty(min(jac.shape)))
+        self.ws.kernels.tangent_and_test(
+            jac, t.copy(), basis, self.cfg.r_path, np.empty_like(t), np.empty(min(jac.shape))
+        )
         return basis
 
     def _match(self, u: Array) -> int | None:

@@ -73,13 +73,14 @@ def trace(
     A target that is not reached (the path closes or folds back first, or ends for another reason) does not
     raise: ``stats["unmet"]`` then says why in one line (the command line exits with code 3 on it).
     """
-    started = time.perf_counter()
     m = mech.n_unknowns
     if m == 0:
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
     d_joint, d_unknown, target = _drive_and_target(mech, drive, until, steps)
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
+    # Workspace.of picks compiled or plain-Python kernels (and compiles or loads them) before the clock starts.
     ws = Workspace.of(mech)
+    started = time.perf_counter()
     r0, _, jac0 = ws.evaluate(np.zeros(m))
     if r0 > tol.start_slack * tol.closure:
         raise LinkworkError(f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first")

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.kinematics.march import evaluate
+from linkwork.kinematics.jit import march_kernels
 from linkwork.kinematics.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -19,7 +20,9 @@ class Workspace:
 
     ``twists``, ``loop_joint``, ``loop_sign``, ``loop_ptr``, ``rows`` and ``groups`` are the arrays of
     :meth:`Mechanism.loop_arrays` and friends, in the layout :func:`linkwork.kinematics.march.march` takes;
-    ``q``, ``res`` and ``jac`` are overwritten by every :meth:`evaluate`.
+    ``q``, ``res`` and ``jac`` are overwritten by every :meth:`evaluate`. ``kernels`` is the implementation of
+    the :mod:`~linkwork.kinematics.march` kernels to call (compiled, or the same functions as plain Python while
+    numba's cache is cold; chosen by :func:`linkwork.kinematics.jit.march_kernels`).
     """
 
     twists: Array
@@ -31,6 +34,7 @@ class Workspace:
     q: Array
     res: Array
     jac: Array
+    kernels: Any
 
     @classmethod
     def of(cls, mech: Mechanism) -> Workspace:
@@ -46,6 +50,7 @@ class Workspace:
             q=np.empty(mech.n_joints),
             res=np.empty(mech.n_equations),
             jac=np.empty((mech.n_equations, mech.n_unknowns)),
+            kernels=march_kernels(),
         )
 
     def kernel_arrays(
@@ -58,5 +63,7 @@ class Workspace:
 
     def evaluate(self, u: Array) -> tuple[float, Array, Array]:
         """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
-        r = evaluate(*self.kernel_arrays(), np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac)
+        r = self.kernels.evaluate(
+            *self.kernel_arrays(), np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac
+        )
         return float(r), self.res.copy(), self.jac.copy()
