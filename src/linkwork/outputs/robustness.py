@@ -81,7 +81,7 @@ def robustness_dict(result: RobustnessResult, source: str = "") -> dict[str, Any
             "first_order_p50": _list(result.band(0.50, first_order=True)),
             "first_order_p95": _list(result.band(0.95, first_order=True)),
             "ratio": _list(result.ratio_paper),
-            "ratio_weighted": _list(setup.ratio_weighted),
+            "ratio_normalised": _list(setup.ratio_normalised),
         },
     }
 

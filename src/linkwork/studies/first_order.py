@@ -60,29 +60,23 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
     return J @ mech.coupling_matrix(), B.reshape(mech.n_equations, 4 * n)
 
 
-def sensitivity_maps(
-    mech: Mechanism, u_path: Array, lines: HingeLines, T: Array
-) -> tuple[Array, Array, Array]:
+def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array) -> tuple[Array, Array]:
     """Per path point: the map ``G_k = N_k^T T B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
-    space), ``(K,)`` the ratio of largest to smallest non-zero singular value of ``T J_k`` (the Sec. 5 ratio on the
-    weighted Jacobian), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's
-    tangent (the last right singular vector), in which the misfit is minimised."""
+    space), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's tangent (the last
+    right singular vector), in which the misfit is minimised."""
     K = u_path.shape[0]
     E = mech.n_equations
     m = mech.n_unknowns
     G = np.zeros((K, E, 4 * mech.n_joints))
-    ratio = np.full(K, np.nan)
     normal = np.zeros((K, m, m - 1))
     for k in range(K):
         J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T)
         U, sigma, Vt = np.linalg.svd(J, full_matrices=True)
         rank = numerical_rank(sigma)
-        if rank > 0 and sigma[rank - 1] > 0:
-            ratio[k] = sigma[0] / sigma[rank - 1]
         normal[k] = Vt[: m - 1].T
         N = U[:, rank:]
         G[k, : N.shape[1], :] = N.T @ B
-    return G, ratio, normal
+    return G, normal
 
 
 @njit(cache=True, fastmath=True)

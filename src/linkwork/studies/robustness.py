@@ -56,7 +56,7 @@ class RobustnessSetup:
     drive_unknown: int
     normal: Array
     G: Array
-    ratio_weighted: Array
+    ratio_normalised: Array
     keep_tol: float
 
     def kernel_args(self) -> tuple[Any, ...]:
@@ -99,7 +99,7 @@ def prepare(
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
-    G, ratio, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
+    G, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
@@ -114,7 +114,7 @@ def prepare(
         drive_unknown=drive_unknown,
         normal=normal,
         G=G,
-        ratio_weighted=ratio,
+        ratio_normalised=path.condition()[first],
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,
     )
 

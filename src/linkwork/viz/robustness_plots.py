@@ -54,7 +54,9 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     ratio = _positive(b["ratio"])
     twin = ax.twinx()
     twin.plot(x, ratio, color="tab:gray", lw=1.0, label="Sec. 5 ratio (paper)")
-    twin.plot(x, _positive(b["ratio_weighted"]), color="tab:green", lw=1.0, label="ratio (scaled Jacobian)")
+    twin.plot(
+        x, _positive(b["ratio_normalised"]), color="tab:green", lw=1.0, label="ratio (normalised Jacobian)"
+    )
     if np.any(np.isfinite(ratio)):
         twin.set_yscale("log")
     twin.set_ylabel("largest / smallest non-zero singular value")
