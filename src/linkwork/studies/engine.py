@@ -133,7 +133,13 @@ def _run_on(
     finished = 0
     for fut in done_set:
         index = futures.pop(fut)
-        ready[index] = fut.result()
+        try:
+            ready[index] = fut.result()
+        except ImportError as exc:
+            raise LinkworkError(
+                f"a Dask worker cannot import what the study needs ({exc}); install linkwork (the same version) "
+                "on every worker"
+            ) from None
         fut.release()
         finished += 1
         if progress is not None:
