@@ -51,11 +51,12 @@ class RobustnessSetup:
     lines: HingeLines
     scale: MisfitScale
     u_path: Array
+    drive: str
     drive_values: Array
     drive_unknown: int
     normal: Array
     G: Array
-    ratio_weighted: Array
+    ratio_normalised: Array
     keep_tol: float
 
     def kernel_args(self) -> tuple[Any, ...]:
@@ -98,7 +99,7 @@ def prepare(
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
-    G, ratio, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
+    G, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
@@ -108,11 +109,12 @@ def prepare(
         lines=lines,
         scale=scale,
         u_path=u_path,
+        drive=mech.joint_names[drive_joint],
         drive_values=path.angles[first, drive_joint],
         drive_unknown=drive_unknown,
         normal=normal,
         G=G,
-        ratio_weighted=ratio,
+        ratio_normalised=path.condition()[first],
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,
     )
 

@@ -133,7 +133,14 @@ def prepare_study(study: Study) -> Study:
             from linkwork import data
 
             target = str(data.example(target))
-        return replace(study, extra={"problem": load_problem(target)})
+        problem = load_problem(target)
+        if "each" in [str(v).lower() for v in study.grid.get("design", [])]:
+            if [str(v).lower() for v in study.grid["design"]] != ["each"]:
+                raise SpecError('design "each" cannot be mixed with other designs', key="grid.design")
+            if problem.segments is None and "segments" not in study.grid:
+                raise SpecError('design "each" needs the number of segments', key="grid.segments")
+            study = replace(study, grid={**study.grid, "design": ["each"]})
+        return replace(study, extra={"problem": problem, "segments": problem.segments})
     from linkwork.io.spec import resolve_spec
 
     if study.grid:  # a built-in: its name and parameter names must be right (values are checked per point)
@@ -163,7 +170,8 @@ def run_sweep(
     progress: Callable[[int, int], None] | None = None,
 ) -> list[tuple[Row, Any]]:
     """Every grid point's row (and robustness result when figures are asked), in grid order."""
-    study = prepare_study(study)
+    if not (study.kind == "synthesis" and "problem" in study.extra):
+        study = prepare_study(study)
     func = synthesis_point if study.kind == "synthesis" else linkage_point
     chunks = [(i,) for i in range(len(study.points()))]
     return list(
