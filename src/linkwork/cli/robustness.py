@@ -143,8 +143,8 @@ def robustness(
     ) as bar:
         task = bar.add_task("", total=samples)
 
-        def report(done: int, total: int) -> None:
-            bar.update(task, completed=min(samples, round(samples * done / max(total, 1))))
+        def report(done: int, total: int | None) -> None:
+            bar.update(task, completed=min(samples, round(samples * done / max(total or 1, 1))))
 
         result, figures = run_and_write_robustness(
             setup,

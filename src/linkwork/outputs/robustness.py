@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
+from linkwork.progress import Progress
 from linkwork.studies.robustness import (
     RobustnessResult,
     RobustnessSetup,
@@ -95,7 +95,7 @@ def run_and_write_robustness(
     source: str = "",
     plots: bool = True,
     engine: dict[str, Any] | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
 ) -> tuple[RobustnessResult, list[Path]]:
     """Run the study with its samples streamed to ``samples.parquet``, then write ``robustness.json`` and (if
     matplotlib is there) the figures, all into ``out`` or nothing."""

@@ -17,9 +17,9 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar
 
 from linkwork.errors import LinkworkError
+from linkwork.progress import Progress
 
 T = TypeVar("T")
-Progress = Callable[[int, int], None]
 
 ENV_SCHEDULER = "LINKWORK_SCHEDULER"
 

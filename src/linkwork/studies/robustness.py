@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
+from linkwork.progress import Progress
 from linkwork.studies import bands
 from linkwork.studies.engine import default_workers, map_chunks
 from linkwork.studies.first_order import first_order_misfit, sensitivity_maps
@@ -222,7 +223,7 @@ def run_study(
     workers: int | None = None,
     client: Any = None,
     chunk: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
     sink: Callable[[ChunkResult], None] | None = None,
 ) -> RobustnessResult:
     """Run ``samples`` samples of a prepared study on the Dask engine and merge them."""

@@ -9,13 +9,13 @@ path ended (and the misfit percentiles with ``[robustness]``); for a synthesis t
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.progress import Progress
 from linkwork.studies.engine import map_chunks
 from linkwork.studies.study_file import Study
 
@@ -167,7 +167,7 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     client: Any = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
 ) -> list[tuple[Row, Any]]:
     """Every grid point's row (and robustness result when figures are asked), in grid order."""
     if not (study.kind == "synthesis" and "problem" in study.extra):
