@@ -14,6 +14,7 @@ from typing import Literal
 import numpy as np
 
 from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.progress import Progress
 from linkwork.synthesis.compound import merge_joints
 from linkwork.synthesis.problem import Problem
 from linkwork.synthesis.result import DesignScore, SearchStats, SynthesisResult, TargetProfile
@@ -29,7 +30,6 @@ from linkwork.synthesis.segment_fit import SegmentFitter
 from linkwork.synthesis.segment_matrix import check_design, check_feasible, design_vectors, is_valid
 from linkwork.synthesis.targets import target_profiles
 
-Progress = Callable[[int, int], None]
 SearchMethod = Literal["paper", "refined"]
 
 
