@@ -47,7 +47,9 @@ def _points(folder: Path) -> tuple[list[str], np.ndarray]:
 
 
 @pytest.mark.parametrize(("name", "suffix"), [("hoop", ".stl"), ("hoop", ".3mf"), ("four-bar", ".stl")])
-def test_every_part_is_one_closed_solid(traces: dict[str, Path], tmp_path: Path, name: str, suffix: str) -> None:
+def test_every_part_is_one_closed_solid(
+    traces: dict[str, Path], tmp_path: Path, name: str, suffix: str
+) -> None:
     out = tmp_path / f"model{suffix}"
     result = invoke("export", "stl", traces[name], "--point", "7", "-o", out)
     assert result.exit_code == 0, result.stderr

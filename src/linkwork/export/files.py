@@ -6,9 +6,10 @@ import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 
-def write_whole(file: str | Path, write: Callable[[Path], None]) -> Path:
+def write_whole(file: str | Path, write: Callable[[Path], Any]) -> Path:
     """Call ``write(tmp)`` on a temporary path in ``file``'s folder, then move it to ``file``: a failure part way
     leaves no half-written file (and any earlier ``file`` as it was)."""
     file = Path(file)

@@ -89,11 +89,15 @@ def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
         pad = " " * depth
         lines.append(f'{pad}<body name={quoteattr(body)} pos="0 0 0">')
         if joint is not None:
-            lines.append(pad + " " + _joint_xml(mech, joint, points, flip=mech.joint_bodies[joint][1] != body))
+            lines.append(
+                pad + " " + _joint_xml(mech, joint, points, flip=mech.joint_bodies[joint][1] != body)
+            )
         lines.extend(pad + " " + g for g in _capsules(mech, body, points, radius))
         for j in cuts:
             if mech.joint_bodies[j][0] == body:
-                lines.append(f'{pad} <body name={quoteattr(cut_body(body, mech.joint_names[j]))} pos="0 0 0">')
+                lines.append(
+                    f'{pad} <body name={quoteattr(cut_body(body, mech.joint_names[j]))} pos="0 0 0">'
+                )
                 lines.append(pad + "  " + _joint_xml(mech, j, points, flip=False))
                 lines.append(f'{pad}  <geom type="sphere" pos="{_vec(points[j])}" size="{radius:.6g}"/>')
                 lines.append(f"{pad} </body>")

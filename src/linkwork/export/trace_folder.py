@@ -64,7 +64,9 @@ def read_trace_folder(folder: str | Path) -> TracedFolder:
     header, body = rows[0], rows[1:]
     missing = [n for n in mech.joint_names if n not in header]
     if missing or not body:
-        raise SpecError(f"{folder / 'path.csv'}: expected columns branch, step and {', '.join(mech.joint_names)}")
+        raise SpecError(
+            f"{folder / 'path.csv'}: expected columns branch, step and {', '.join(mech.joint_names)}"
+        )
     cols = [header.index(n) for n in mech.joint_names]
     values = np.array([[float(r[c]) for c in cols] for r in body])
     revolute = np.array([t == "R" for t in mech.joint_types])

@@ -20,6 +20,7 @@ Example
     seed = 1
     names = ["cruise", "climb", "landing"]   # optional; file stems by default
     mechanize = false                   # optional
+    units = "mm"                        # optional: length unit of the profile files, carried into DXF/SVG
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from linkwork.errors import SpecError
-from linkwork.io.profiles import COINCIDENT, load_profile
+from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
 from linkwork.synthesis.problem import Problem, ProfileKind
 
 KINDS = ("open", "closed", "fixed-end")
@@ -51,6 +52,7 @@ KEYS = (
     "seed",
     "names",
     "mechanize",
+    "units",
     "description",
 )
 """Every key a problem file may hold (``description`` is free text for the reader and is ignored)."""
@@ -221,6 +223,9 @@ def load_problem(path: str | Path) -> Problem:
     )
     seed = keys.get("seed", 0, _integer(0), "a whole number >= 0")
     mechanize = keys.get("mechanize", False, _boolean, "true or false")
+    units: str | None = keys.get(
+        "units", None, lambda v: v if v in LENGTH_UNITS else None, f"one of {', '.join(LENGTH_UNITS)}"
+    )
     keys.get("description", "", lambda v: v if isinstance(v, str) else None, "a string")
     stems = [Path(name).stem for name in files]
     names = keys.get("names", stems, _string_list, f"a list of {len(files)} non-empty names")
@@ -261,4 +266,5 @@ def load_problem(path: str | Path) -> Problem:
         names=tuple(names),
         source=path,
         mechanize=mechanize,
+        units=units,
     )

@@ -629,7 +629,9 @@ def _read_points(reader: _Reader, value: Any, mech: Mechanism) -> list[dict[str,
         taken.add(name)
         body = reader.require(entry, "body", here, f"one of the bodies {', '.join(mech.bodies)}")
         if body not in mech.bodies:
-            raise reader.error(_key(here, "body"), f"expected one of {', '.join(mech.bodies)}, got {_show(body)}")
+            raise reader.error(
+                _key(here, "body"), f"expected one of {', '.join(mech.bodies)}, got {_show(body)}"
+            )
         position = reader.vector(entry, "position", here, sizes=(2, 3))
         position = np.append(position, 0.0) if position.size == 2 else position
         out.append({"name": name, "body": body, "position": [float(x) for x in position]})
@@ -769,7 +771,10 @@ def dump_spec(mech: Mechanism) -> str:
         lines.append(f"value = {_toml_float(reading)}")
     for point in mech.meta.get("points", ()):
         lines += ["", "[[points]]", f"name = {_toml_string(str(point['name']))}"]
-        lines += [f"body = {_toml_string(str(point['body']))}", f"position = {_toml_vector(point['position'])}"]
+        lines += [
+            f"body = {_toml_string(str(point['body']))}",
+            f"position = {_toml_vector(point['position'])}",
+        ]
     return "\n".join(lines) + "\n"
 
 

@@ -18,7 +18,9 @@ def slider_position(crank: float, rod: float, offset: float, theta: float) -> fl
     """Slider x at crank angle ``theta``: ``r cos(theta) + sqrt(l^2 - (r sin(theta) - e)^2)`` (closed form)."""
     rise = crank * np.sin(theta) - offset
     if abs(rise) > rod:
-        raise SpecError(f"slider-crank: the rod cannot reach the guide at crank angle {np.degrees(theta):.6g} deg")
+        raise SpecError(
+            f"slider-crank: the rod cannot reach the guide at crank angle {np.degrees(theta):.6g} deg"
+        )
     return float(crank * np.cos(theta) + np.sqrt(rod * rod - rise * rise))
 
 

@@ -42,6 +42,9 @@ class Problem:
         A name per profile (file stem by default).
     source
         The problem file this came from, if any (for messages and relative paths).
+    units
+        The length unit of the profile files (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``, ``"um"``), carried
+        into the DXF (``$INSUNITS``) and SVG (width and height) drawings; ``None``: unitless.
     """
 
     profiles: tuple[NDArray[np.float64], ...]
@@ -56,6 +59,7 @@ class Problem:
     names: tuple[str, ...] = field(default=())
     source: Path | None = None
     mechanize: bool = False
+    units: str | None = None
 
     @property
     def count(self) -> int:
