@@ -99,7 +99,58 @@ def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
     return Path(file)
 
 
+def plot_points(path: Trace, file: Path) -> Path:
+    """Paths of the named points (a four-bar's coupler curve) and of the joints in the plane, and the transmission
+    angle against the drive angle when the mechanism declares one."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from linkwork.kinematics.points import named_points, positions, transmission_angles
+
+    mech = path.mechanism
+    joints, named = positions(mech, path.angles)
+    mu = transmission_angles(mech, joints)
+    fig, axes = plt.subplots(
+        1, 2 if mu is not None else 1, figsize=(10.0, 4.4), layout="constrained", squeeze=False
+    )
+    ax = axes[0, 0]
+    for j, name in enumerate(mech.joint_names):
+        ax.plot(joints[:, j, 0], joints[:, j, 1], lw=0.8, color="0.6")
+        ax.annotate(name, joints[0, j, :2], fontsize=8)
+    for k, point in enumerate(named_points(mech)):
+        ax.plot(named[:, k, 0], named[:, k, 1], lw=1.6, label=f"{point['name']} (on {point['body']})")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (length unit of the mechanism)")
+    ax.set_ylabel("y (length unit of the mechanism)")
+    ax.set_title("paths of the joints (grey) and named points", fontsize=10)
+    if named.shape[1]:
+        ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    if mu is not None:
+        d = mech.index(path.drive)
+        for br in path.branches:
+            mask = path.of_branch(br.id)
+            axes[0, 1].plot(np.degrees(path.angles[mask, d]), np.degrees(mu[mask]), lw=1.4)
+        axes[0, 1].axhline(40.0, color="k", lw=0.8, ls="--", label="40 deg, a common lower limit")
+        axes[0, 1].set_xlabel(f"θ{path.drive} (deg)")
+        axes[0, 1].set_ylabel("transmission angle (deg)")
+        axes[0, 1].set_title("transmission angle", fontsize=10)
+        axes[0, 1].legend(fontsize=8)
+        axes[0, 1].grid(alpha=0.3)
+    fig.suptitle(f"{mech.name}: positions", fontsize=10)
+    fig.savefig(file, dpi=120)
+    fig.savefig(Path(file).with_suffix(".svg"))
+    plt.close(fig)
+    return Path(file)
+
+
 def write_trace_figures(path: Trace, out: Path) -> list[Path]:
-    """All trace figures into folder ``out``; returns the PNG paths."""
+    """All trace figures into folder ``out``; returns the PNG paths (``points.png`` for a planar mechanism or one
+    with named points)."""
     out = Path(out)
-    return [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]
+    figures = [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]
+    if path.mechanism.planar or path.mechanism.meta.get("points"):
+        figures.append(plot_points(path, out / "points.png"))
+    return figures
