@@ -10,8 +10,30 @@ import numpy as np
 from linkwork.kinematics.trace_result import Trace
 
 
-def _unwrap_branch(path: Trace, mask: np.ndarray) -> np.ndarray:
-    return np.degrees(path.angles[mask])
+def branch_degrees(path: Trace, mask: np.ndarray) -> np.ndarray:
+    """Joint values of the points ``mask`` for plotting: revolute joints in degrees wrapped into [-180, 180)
+    (:func:`linkwork.geometry.angles.wrap`), prismatic joints as they are. Guest's 13 branches, which turn
+    hinges through whole revolutions, stay in one window."""
+    return display_degrees(path, path.angles[mask])
+
+
+def display_degrees(path: Trace, values: np.ndarray) -> np.ndarray:
+    """``values`` (radians, ``(..., n)``) with the revolute joints wrapped into [-180, 180) deg."""
+    from linkwork.geometry.angles import wrap
+
+    out = np.array(values, dtype=float)
+    revolute = np.array([t == "R" for t in path.mechanism.joint_types])
+    out[..., revolute] = np.degrees(wrap(out[..., revolute]))
+    return out
+
+
+def broken_at_wraps(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x``, ``y`` with a NaN put between points where either jumps by more than 180 (a wrap), so the plotted
+    line breaks there instead of crossing the figure."""
+    if len(x) < 2:
+        return x, y
+    jumps = np.flatnonzero((np.abs(np.diff(x)) > 180.0) | (np.abs(np.diff(y)) > 180.0)) + 1
+    return np.insert(x.astype(float), jumps, np.nan), np.insert(y.astype(float), jumps, np.nan)
 
 
 def plot_angles(path: Trace, file: Path) -> Path:
@@ -27,15 +49,13 @@ def plot_angles(path: Trace, file: Path) -> Path:
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     styles = ["-", "--", ":", "-."]
     for br in path.branches:
-        mask = path.of_branch(br.id)
-        deg = _unwrap_branch(path, mask)
+        deg = branch_degrees(path, path.of_branch(br.id))
         for j, name in enumerate(mech.joint_names):
             if j == d:
                 continue
             # One line style per joint, so that coincident curves (B = D = F) stay visible as dashes.
             ax.plot(
-                deg[:, d],
-                deg[:, j],
+                *broken_at_wraps(deg[:, d], deg[:, j]),
                 styles[j % len(styles)],
                 color=colors[j % len(colors)],
                 lw=2.2 - 0.3 * (j % len(styles)) if br.id == 0 else 0.8,
@@ -43,10 +63,10 @@ def plot_angles(path: Trace, file: Path) -> Path:
                 label=f"θ{name}" if br.id == 0 else None,
             )
     for b in path.bifurcations:
-        a = np.degrees(b.angles)
+        a = display_degrees(path, b.angles)
         ax.plot(np.full(len(a) - 1, a[d]), np.delete(a, d), "ko", ms=4)
-    ax.set_xlabel(f"θ{path.drive} (deg)")
-    ax.set_ylabel("hinge angle (deg)")
+    ax.set_xlabel(f"θ{path.drive} (deg, wrapped to [-180, 180))")
+    ax.set_ylabel("hinge angle (deg, wrapped to [-180, 180))")
     title = f"{mech.name}: hinge angles"
     if len(path.branches) > 1:
         title += f" ({len(path.branches)} branches, {len(path.bifurcations)} bifurcation points ●)"
@@ -66,10 +86,12 @@ def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from linkwork.viz.labels import number
+
     mech = path.mechanism
     d = mech.index(path.drive)
     mask = path.of_branch(branch)
-    x = np.degrees(path.angles[mask, d])
+    x = branch_degrees(path, mask)[:, d]
     s = path.sigma[mask]
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), layout="constrained")
     steps = path.step[mask]
@@ -82,10 +104,13 @@ def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
     axes[0].set_ylim(0, None)
     for i in range(s.shape[1]):
         axes[1].semilogy(steps, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
-    axes[1].set_xlabel(f"step (θ{path.drive} from {x[0]:.4g}° to {x[-1]:.4g}°)")
+    unit = "°" if mech.joint_types[d] == "R" else ""
+    span = float(np.ptp(x)) if len(x) else 1.0
+    low, high = (number(v, scale=max(span, 1.0)) for v in (x[0], x[-1]))
+    axes[1].set_xlabel(f"step (θ{path.drive} from {low}{unit} to {high}{unit})")
     axes[1].set_ylim(1e-17, None)
     for ax in axes:
-        ax.set_ylabel("singular value")
+        ax.set_ylabel("singular value (1 and length per rad)")
         ax.grid(alpha=0.3, which="both")
     for b in path.bifurcations:
         if b.branch == branch:
