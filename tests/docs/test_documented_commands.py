@@ -93,7 +93,9 @@ def test_documented_commands_run(doc: Path, workspace: tuple[Path, dict[str, str
     for command in documented_commands(doc):
         if command in done:
             continue
-        run = subprocess.run(command, shell=True, cwd=folder, env=env, capture_output=True, text=True, timeout=900)
+        run = subprocess.run(
+            command, shell=True, cwd=folder, env=env, capture_output=True, text=True, timeout=900
+        )
         done[command] = doc.name
         assert run.returncode == 0, f"{doc.name}: `{command}` exited {run.returncode}: {run.stderr[-2000:]}"
         assert "Traceback" not in run.stderr, f"{doc.name}: `{command}`: {run.stderr[-2000:]}"

@@ -26,7 +26,11 @@ def _mean(counts: tuple[int, ...]) -> float:
 def test_printed_mean_piece_length_belongs_to_75_89_98_pieces() -> None:
     assert _mean((76, 90, 99)) == pytest.approx(0.3460, abs=5e-5)  # what the printed counts give
     assert _mean((75, 89, 98)) == pytest.approx(0.3499, abs=1e-4)  # the printed 0.3499
-    assert [int(np.ceil(c / S_D)) for c in ARC] == [75, 89, 99]  # Eq. 3: the procedure only goes down from here
+    assert [int(np.ceil(c / S_D)) for c in ARC] == [
+        75,
+        89,
+        99,
+    ]  # Eq. 3: the procedure only goes down from here
 
 
 def test_fixed_end_counts_cannot_be_75_89_98() -> None:

@@ -120,7 +120,7 @@ def test_mjcf_loops_close_at_our_traced_points(traces: dict[str, Path], tmp_path
     assert invoke("export", "mjcf", traces[name], "-o", out).exit_code == 0
     model, data = _model(out)
     names, q, _ = _traced(traces[name])
-    assert model.neq == 1  # one loop, one weld
+    assert model.neq == 1  # one loop, one weld (no couplings in these three)
     adr = [model.jnt_qposadr[model.joint(n).id] for n in names]  # hinges named after our joints
     equality = mujoco.mjtConstraint.mjCNSTR_EQUALITY
     worst = 0.0
@@ -154,3 +154,26 @@ def test_driving_the_drive_joint_follows_our_path(traces: dict[str, Path], tmp_p
             worst = max(worst, float(np.abs(data.qpos[adr] - ours).max()))
     assert data.qpos[adr[0]] > 0.9 * q[-1, 0]  # it moved most of the way
     assert worst < 1e-3  # radians: the welds are soft constraints (solimp 0.9999)
+
+
+def test_mjcf_keeps_the_couplings_of_the_eight_rod_hoop() -> None:
+    """Hedgepeth's eight-rod hoop has mobility 3 without the paper's symmetry A = C = E = G, B = D = F = H: the
+    model carries it as joint equalities, so the traced path satisfies every constraint and the model's free
+    motion is the traced one (the constraint Jacobian leaves one direction: rank 8 - 1)."""
+    import linkwork as lw
+    from linkwork.export.mjcf import mjcf
+
+    mech = lw.load("hedgepeth-rods", n=8)
+    model = mujoco.MjModel.from_xml_string(mjcf(mech, "A"))
+    data = mujoco.MjData(model)
+    assert model.neq == 1 + 6  # one weld, six couplings
+    adr = [model.jnt_qposadr[model.joint(n).id] for n in mech.joint_names]
+    tr = lw.trace(mech, steps=20, until=("A", mech.offsets[0] + np.radians(60.0)))
+    equality = mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    for row in tr.angles:
+        data.qpos[adr] = row - mech.offsets
+        mujoco.mj_forward(model, data)
+        assert np.abs(data.efc_pos[data.efc_type == equality]).max() < 1e-6
+    J = data.efc_J.reshape(data.nefc, model.nv)[data.efc_type == equality]
+    sigma = np.linalg.svd(J, compute_uv=False)
+    assert np.sum(sigma > 1e-8 * sigma[0]) == model.nv - 1  # mobility one, as traced

@@ -1,5 +1,6 @@
 """The mechanism as a MuJoCo model (MJCF): one body per link, a hinge (slide) joint named after each of our joints,
-and one ``weld`` equality constraint closing each loop.
+and one ``weld`` equality constraint closing each loop (plus a ``joint`` equality for every coupled or fixed
+joint).
 
 Every body's frame is the world frame in the mechanism's reference configuration, so a joint's ``pos`` and
 ``axis`` are its axis line there and its ``qpos`` is our displacement ``q = value - offset`` (MuJoCo's ``qpos0 =
@@ -112,6 +113,7 @@ def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
         f'body2={quoteattr(mech.joint_bodies[j][1])} relpose="0 0 0 1 0 0 0"/>'
         for j in cuts
     ]
+    welds += _coupling_constraints(mech)
     d = mech.index(drive if drive is not None else 0)
     head = [
         f"<mujoco model={quoteattr(mech.name)}>",
@@ -134,6 +136,25 @@ def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
         "</mujoco>",
     ]
     return "\n".join(head + lines + tail) + "\n"
+
+
+def _coupling_constraints(mech: Mechanism) -> list[str]:
+    """``joint`` equality constraints for couplings (a coupled joint turns as the first of its group: equal
+    displacements from the start) and fixed joints (held at the start)."""
+    out = []
+    for members in mech.group_members():
+        first = quoteattr(mech.joint_names[members[0]])
+        for j in members[1:]:
+            out.append(
+                f"    <joint name={quoteattr('couple_' + mech.joint_names[j])} "
+                f'joint1={quoteattr(mech.joint_names[j])} joint2={first} polycoef="0 1 0 0 0"/>'
+            )
+    for j in np.flatnonzero(mech.groups < 0):
+        name = mech.joint_names[j]
+        out.append(
+            f'    <joint name={quoteattr("fixed_" + name)} joint1={quoteattr(name)} polycoef="0 0 0 0 0"/>'
+        )
+    return out
 
 
 def joint_offsets(mech: Mechanism) -> dict[str, float]:
