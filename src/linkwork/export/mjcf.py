@@ -149,8 +149,8 @@ def _coupling_constraints(mech: Mechanism) -> list[str]:
                 f"    <joint name={quoteattr('couple_' + mech.joint_names[j])} "
                 f'joint1={quoteattr(mech.joint_names[j])} joint2={first} polycoef="0 1 0 0 0"/>'
             )
-    for j in np.flatnonzero(mech.groups < 0):
-        name = mech.joint_names[j]
+    for k in np.flatnonzero(mech.groups < 0).tolist():
+        name = mech.joint_names[k]
         out.append(
             f'    <joint name={quoteattr("fixed_" + name)} joint1={quoteattr(name)} polycoef="0 0 0 0 0"/>'
         )
