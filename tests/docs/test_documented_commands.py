@@ -1,20 +1,24 @@
 """Every command the README and docs/ show runs as written.
 
 The fenced ``bash`` and ``console`` blocks of README.md and docs/**/*.md are read; each command (a ``bash`` line,
-or a ``console`` line after its ``$`` prompt) is run by the shell in one shared temporary folder that holds a copy
+or a ``console`` line after its ``$`` prompt) is run in one shared temporary folder that holds a copy
 of the repository's ``examples/``, in the order the files list them, each distinct command once (so a later
 command can use what an earlier one wrote, and the wing is synthesised once for every page that shows it). A block
 is left out only when the line before its fence says why: ``<!-- docs-test: skip: REASON -->`` (installing the
-package, for instance). Commands added to the docs later are picked up without touching this file.
+package, for instance). Commands added to the docs later are picked up without touching this file. ``linkwork``
+commands run in this process through typer's test runner (the shell would pay the start-up and kernel loading
+once per command); anything else goes to the shell.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
+import traceback
 from pathlib import Path
 
 import pytest
@@ -86,19 +90,46 @@ def test_the_parser_reads_commands_and_skips_what_it_should(tmp_path: Path) -> N
 
 @pytest.mark.slow
 @pytest.mark.parametrize("doc", DOCS, ids=[str(d.relative_to(ROOT)) for d in DOCS])
-def test_documented_commands_run(doc: Path, workspace: tuple[Path, dict[str, str]]) -> None:
+def test_documented_commands_run(
+    doc: Path, workspace: tuple[Path, dict[str, str]], monkeypatch: pytest.MonkeyPatch
+) -> None:
     folder, done = workspace
-    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
-    env.setdefault("MPLBACKEND", "Agg")
+    monkeypatch.chdir(folder)
     for command in documented_commands(doc):
         if command in done:
             continue
-        run = subprocess.run(
-            command, shell=True, cwd=folder, env=env, capture_output=True, text=True, timeout=900
-        )
         done[command] = doc.name
-        assert run.returncode == 0, f"{doc.name}: `{command}` exited {run.returncode}: {run.stderr[-2000:]}"
-        assert "Traceback" not in run.stderr, f"{doc.name}: `{command}`: {run.stderr[-2000:]}"
+        code, errors = run_documented(command, folder)
+        assert code == 0, f"{doc.name}: `{command}` exited {code}: {errors[-2000:]}"
+        assert "Traceback" not in errors, f"{doc.name}: `{command}`: {errors[-2000:]}"
+
+
+def run_documented(command: str, folder: Path) -> tuple[int, str]:
+    """Run one documented command in ``folder``: a plain ``linkwork ...`` (optionally ``> FILE``) in this process
+    (the compiled kernels stay loaded, so the docs test stays affordable), anything else by the shell."""
+    words = shlex.split(command)
+    target = None
+    if len(words) > 2 and words[-2] == ">":
+        words, target = words[:-2], words[-1]
+    if words and words[0] == "linkwork" and not set(words) & {"|", "&&", ";", ">", "<", "||"}:
+        from typer.testing import CliRunner
+
+        from linkwork.cli import app
+
+        result = CliRunner().invoke(app, words[1:])
+        if target is not None:
+            (folder / target).write_text(result.stdout)
+        errors = result.stderr + (
+            "".join(traceback.format_exception(result.exc_info[1]))
+            if result.exc_info and not isinstance(result.exc_info[1], SystemExit)
+            else ""
+        )
+        return result.exit_code, errors
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
+    run = subprocess.run(
+        command, shell=True, cwd=folder, env=env, capture_output=True, text=True, timeout=900
+    )
+    return run.returncode, run.stderr
 
 
 def test_docs_refer_to_nothing_outside_the_repository() -> None:
