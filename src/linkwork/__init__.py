@@ -20,6 +20,7 @@ from linkwork.kinematics.tracer import trace
 
 if TYPE_CHECKING:
     from linkwork.synthesis.problem import Problem
+    from linkwork.synthesis.result import SynthesisResult
 
 __version__ = "0.1.0"
 
@@ -61,7 +62,7 @@ def load(spec: str | pathlib.Path, **params: Any) -> Mechanism:
     return resolve_spec(spec, params).mechanism
 
 
-def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> Any:
+def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> SynthesisResult:
     """Synthesise a chain of rigid links that approximates every design profile of ``problem``.
 
     ``problem`` is a :class:`linkwork.synthesis.problem.Problem` or the path of a problem TOML file.

@@ -1,5 +1,5 @@
-"""``linkwork trace``, ``linkages`` and ``show``: the contract files (DESIGN.md, "Contract: commands and
-outputs"), the paper's deployment of the six-rod Hedgepeth hoop, and bad input as one line with exit code 2.
+"""``linkwork trace``, ``linkages`` and ``show``: the contract files (docs/architecture.md, "Contracts":
+commands and outputs), the paper's deployment of the six-rod Hedgepeth hoop, and bad input as one line with exit code 2.
 
 References come from the paper: the deployed angle of the n = 6 hoop, theta_A = 87.0067 deg (Eq. 10), the
 symmetry A = C = E, B = D = F along its whole path (Sec. 5), rank 5 and mobility 1, no bifurcation, and the

@@ -50,7 +50,7 @@ def shift(x: float, z: float) -> np.ndarray:
 
 
 def dh_product(thetas: Sequence[float], links: Sequence[tuple[float, float, float]]) -> np.ndarray:
-    """``prod Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` for links ``(d, a, alpha)`` (DESIGN.md convention)."""
+    """``prod Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` for links ``(d, a, alpha)`` (the spec file convention, docs/spec-format.md)."""
     g = np.eye(4)
     for t, (d, a, al) in zip(thetas, links, strict=True):
         g = g @ rz(t) @ shift(0.0, d) @ shift(a, 0.0) @ rx(al)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import typer
 
-from linkwork.cli import demo, export, linkages, mechanize, synth, trace
+from linkwork.cli import demo, export, linkages, mechanize, robustness, sweep, synth, trace
 
 app = typer.Typer(
     name="linkwork",
@@ -23,6 +23,8 @@ app.command("show")(linkages.show)
 app.command("synth")(synth.synth)
 app.command("mechanize")(mechanize.mechanize)
 app.command("demo")(demo.demo)
+app.command("robustness")(robustness.robustness)
+app.command("sweep")(sweep.sweep)
 app.add_typer(export.app, name="export")
 
 

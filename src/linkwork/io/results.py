@@ -1,7 +1,7 @@
 """Result files of a trace: ``path.csv`` (one row per traced point) and ``report.json`` (the summary).
 
 Angles are written in degrees (prismatic joints in length units); the column and key names are a contract
-(DESIGN.md, "Contract: commands and outputs").
+(docs/architecture.md, "Contracts").
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ file, the key path and what was expected, for example
 Two forms (see ``docs/spec-format.md`` for every key):
 
 * ``[loop]``: one closed loop of revolute joints in loop order, in the ``dh``, ``hinge-lines`` or ``rods``
-  convention (DESIGN.md, "Contract: linkage spec file");
+  convention (docs/spec-format.md; docs/architecture.md, "Contracts");
 * ``[mechanism]``: joints between named bodies, each a revolute (``R``) or prismatic (``P``) joint on a
   line in the start configuration; the loops are a cycle basis of the body graph, ``planar = true`` keeps
   the three planar closure equations per loop.

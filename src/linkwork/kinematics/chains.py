@@ -31,7 +31,7 @@ class Assembly:
 
 
 def dh_transform(theta: float, d: float, a: float, alpha: float) -> Array:
-    """Denavit-Hartenberg link transform ``Rz(theta) Tz(d) Tx(a) Rx(alpha)`` (DESIGN.md convention)."""
+    """Denavit-Hartenberg link transform ``Rz(theta) Tz(d) Tx(a) Rx(alpha)`` (the spec file convention, docs/spec-format.md)."""
     return rot_z(theta) @ translation([0.0, 0.0, d]) @ translation([a, 0.0, 0.0]) @ rot_x(alpha)
 
 

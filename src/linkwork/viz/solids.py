@@ -32,6 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from linkwork.geometry.fit import kabsch
 from linkwork.kinematics.closure import body_poses
 from linkwork.kinematics.mechanism import Mechanism
 
@@ -417,7 +418,7 @@ def _to_reference(
         dst = _line_pair_points(ref_points[a], ref_dirs[a], ref_points[b], ref_dirs[b])
         if src is None or dst is None:
             return None
-        T = _kabsch(src, dst)
+        T = kabsch(src, dst)
         moved = src @ T[:3, :3].T + T[:3, 3]
         if np.max(np.abs(moved - dst)) > 1e-7 * max(scale, 1.0):
             return None
@@ -435,19 +436,6 @@ def _line_pair_points(p1: Array, d1: Array, p2: Array, d2: Array) -> Array | Non
         return None
     f1, f2 = common_normal(p1, d1, p2, d2)
     return np.array([f1, f1 + d1, f2, f2 + d2])
-
-
-def _kabsch(src: Array, dst: Array) -> Array:
-    """The 4x4 proper rigid transform minimising ``sum |T src - dst|^2``."""
-    cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    H = (src - cs).T @ (dst - cd)
-    U, _, Vt = np.linalg.svd(H)
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = cd - R @ cs
-    return T
 
 
 def _rod_frames(mech: Mechanism) -> list[Array]:

@@ -172,7 +172,7 @@ def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
     ValueError
         If segment ``index`` is not an M-segment.
     """
-    from linkwork.synthesis.registration import register
+    from linkwork.geometry.fit import register
 
     segment = result.segments[index]
     if segment.kind != "M":
