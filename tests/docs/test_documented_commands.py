@@ -33,7 +33,7 @@ def documented_commands(file: Path) -> list[str]:
     """The commands of ``file``'s bash and console blocks, in order (blocks marked to skip left out)."""
     commands: list[str] = []
     lines = file.read_text(encoding="utf-8").splitlines()
-    inside, kind, skipped = False, "", False
+    inside, kind, skipped, pending = False, "", False, False
     for i, line in enumerate(lines):
         fence = FENCE.match(line.strip())
         if fence and not inside:
@@ -46,6 +46,12 @@ def documented_commands(file: Path) -> list[str]:
         if not inside or skipped or kind not in ("bash", "console", "sh", "shell"):
             continue
         text = line.strip()
+        if commands and pending:
+            commands[-1] = (
+                commands[-1][:-1].rstrip() + " " + _without_comment(text)
+            )  # after a trailing backslash
+            pending = commands[-1].endswith("\\")
+            continue
         if kind == "console":
             if not text.startswith("$ "):
                 continue  # output shown after a command
@@ -53,6 +59,7 @@ def documented_commands(file: Path) -> list[str]:
         if not text or text.startswith("#"):
             continue
         commands.append(_without_comment(text))
+        pending = commands[-1].endswith("\\")
     return commands
 
 
@@ -83,9 +90,14 @@ def test_the_parser_reads_commands_and_skips_what_it_should(tmp_path: Path) -> N
         "```bash\nlinkwork linkages   # the built-ins\n# a comment\n```\n"
         "<!-- docs-test: skip: installs the package -->\n```bash\npip install linkwork\n```\n"
         "```console\n$ linkwork show bennett > b.toml\noutput line\n```\n"
+        "```bash\nlinkwork trace bennett \\\n    --steps 5   # continued\n```\n"
         "```toml\nname = 'x'\n```\n"
     )
-    assert documented_commands(page) == ["linkwork linkages", "linkwork show bennett > b.toml"]
+    assert documented_commands(page) == [
+        "linkwork linkages",
+        "linkwork show bennett > b.toml",
+        "linkwork trace bennett --steps 5",
+    ]
 
 
 @pytest.mark.slow
@@ -96,9 +108,10 @@ def test_documented_commands_run(
     folder, done = workspace
     monkeypatch.chdir(folder)
     for command in documented_commands(doc):
-        if command in done:
+        key = re.sub(r"\s+", " ", command.replace(" -o ", " --out "))  # the same command spelt two ways
+        if key in done:
             continue
-        done[command] = doc.name
+        done[key] = doc.name
         code, errors = run_documented(command, folder)
         assert code == 0, f"{doc.name}: `{command}` exited {code}: {errors[-2000:]}"
         assert "Traceback" not in errors, f"{doc.name}: `{command}`: {errors[-2000:]}"
