@@ -37,8 +37,9 @@ def stl(
         float, typer.Option("--scale", help="Multiply every length (e.g. to millimetres).")
     ] = 1.0,
 ) -> None:
-    """Every part (link or rod, and a pin on every joint) at one traced point as a separate closed solid: STL (one
-    `solid` per part), or 3MF when FILE ends in .3mf."""
+    """Every part of a traced mechanism at one point as a separate closed solid (STL, or 3MF by suffix).
+
+    Parts are the links or rods and a pin on every joint; an STL has one `solid` per part, a 3MF one object."""
     from linkwork.errors import SpecError
     from linkwork.export.files import write_whole
     from linkwork.export.solids import parts, write_3mf, write_stl
@@ -73,8 +74,9 @@ def mjcf(
         typer.Option("--drive", help="Joint the position actuator turns (default: the trace's drive)."),
     ] = None,
 ) -> None:
-    """The mechanism for the MuJoCo simulator: a body per link, hinges named after our joints, one weld closing
-    each loop, a position actuator on the drive joint."""
+    """The mechanism as a MuJoCo model (MJCF).
+
+    A body per link, hinges named after our joints, one weld closing each loop, a position actuator on the drive."""
     from linkwork.export.files import write_whole
     from linkwork.export.mjcf import mjcf as to_mjcf
 
@@ -108,8 +110,9 @@ def dxf(
         ),
     ] = None,
 ) -> None:
-    """A planar mechanism's links and pivots as a DXF drawing (at a traced point for a trace folder, else at its
-    start), $INSUNITS set from --units or from the synthesis problem's `units`."""
+    """A planar mechanism's links and pivots as a DXF drawing.
+
+    At a traced point for a trace folder, else at its start; $INSUNITS from --units or the problem's `units`."""
     from linkwork.errors import SpecError
     from linkwork.export.dxf import write_mechanism_dxf
     from linkwork.export.files import write_whole
