@@ -10,13 +10,14 @@ ride on their body.
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from linkwork.kinematics.closure import body_poses
+from linkwork.geometry import exp_se3
 from linkwork.kinematics.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -54,6 +55,26 @@ def named_points(mech: Mechanism) -> list[Mapping[str, Any]]:
     return list(mech.meta.get("points", ()))
 
 
+def body_poses_along(mech: Mechanism, angles: ArrayLike) -> dict[str, Array]:
+    """Displacement ``(N, 4, 4)`` of every body from the reference at every row of joint values ``(N, n)``
+    (radians): :func:`linkwork.kinematics.closure.body_poses` over many rows at once (same spanning tree)."""
+    q = mech.q_from_angles(np.atleast_2d(np.asarray(angles, dtype=float)))
+    root = "ground" if "ground" in mech.bodies else mech.bodies[0]
+    adjacency: dict[str, list[tuple[int, str, int]]] = {b: [] for b in mech.bodies}
+    for j, (a, b) in enumerate(mech.joint_bodies):
+        adjacency[a].append((j, b, 1))
+        adjacency[b].append((j, a, -1))
+    poses = {root: np.broadcast_to(np.eye(4), (len(q), 4, 4))}
+    queue = deque([root])
+    while queue:
+        body = queue.popleft()
+        for j, other, sign in adjacency[body]:
+            if other not in poses:
+                poses[other] = poses[body] @ exp_se3(sign * mech.twists[j] * q[:, j, None])
+                queue.append(other)
+    return poses
+
+
 def positions(mech: Mechanism, angles: ArrayLike) -> tuple[Array, Array]:
     """World coordinates of the joints ``(N, n, 3)`` and of the named points ``(N, p, 3)`` at joint values.
 
@@ -64,20 +85,18 @@ def positions(mech: Mechanism, angles: ArrayLike) -> tuple[Array, Array]:
     angles
         ``(N, n)`` reported joint values in radians (rows of ``Trace.angles``), or one row ``(n,)``.
     """
-    rows = np.atleast_2d(np.asarray(angles, dtype=float))
+    poses = body_poses_along(mech, angles)
+    count = len(next(iter(poses.values())))
     ref = reference_joint_points(mech)
     extra = named_points(mech)
-    ref_named = np.array([np.asarray(p["position"], dtype=float) for p in extra]).reshape(len(extra), 3)
-    joints = np.empty((len(rows), mech.n_joints, 3))
-    points = np.empty((len(rows), len(extra), 3))
-    for i, row in enumerate(rows):
-        poses = body_poses(mech, mech.q_from_angles(row))
-        for j in range(mech.n_joints):
-            g = poses[_carrier(mech, j)]
-            joints[i, j] = g[:3, :3] @ ref[j] + g[:3, 3]
-        for k, p in enumerate(extra):
-            g = poses[str(p["body"])]
-            points[i, k] = g[:3, :3] @ ref_named[k] + g[:3, 3]
+    joints = np.empty((count, mech.n_joints, 3))
+    for j in range(mech.n_joints):
+        g = poses[_carrier(mech, j)]
+        joints[:, j] = g[:, :3, :3] @ ref[j] + g[:, :3, 3]
+    points = np.empty((count, len(extra), 3))
+    for k, p in enumerate(extra):
+        g = poses[str(p["body"])]
+        points[:, k] = g[:, :3, :3] @ np.asarray(p["position"], dtype=float) + g[:, :3, 3]
     return joints, points
 
 
