@@ -333,7 +333,7 @@ def test_goldberg_links_come_from_two_bennett_loops() -> None:
 def test_sarrus_top_plate_translates_along_the_common_perpendicular() -> None:
     mech = sarrus_module.sarrus()
     for q in step_along(mech, steps=10, size=0.05):
-        poses = body_poses(mech, q)
+        poses = body_poses(mech, q=q)
         relative = np.linalg.inv(poses["link2"]) @ poses["link5"]  # top plate seen from the bottom plate
         assert np.max(np.abs(relative[:3, :3] - np.eye(3))) < 1e-12
         assert np.max(np.abs(relative[:2, 3])) < 1e-12

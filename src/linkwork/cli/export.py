@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from linkwork.cli import help
 from linkwork.cli.common import friendly_errors, parse_assignments
 from linkwork.outputs.staging import console
 
@@ -15,6 +16,7 @@ if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
 
 app = typer.Typer(
+    cls=help.Group,
     help="Export a mechanism: solids to 3-D print (stl, 3mf), a MuJoCo model (mjcf), a DXF drawing (dxf).",
     no_args_is_help=True,
 )
@@ -26,7 +28,7 @@ Point = Annotated[
 ]
 
 
-@app.command("stl")
+@app.command("stl", cls=help.Command)
 @friendly_errors
 def stl(
     trace_dir: Annotated[Path, typer.Argument(help="A folder written by `linkwork trace --out`.")],
@@ -56,7 +58,7 @@ def stl(
     console.print(f"wrote {out}: {len(meshes)} parts (branch {branch}, point {point})")
 
 
-@app.command("mjcf")
+@app.command("mjcf", cls=help.Command)
 @friendly_errors
 def mjcf(
     spec: Annotated[
@@ -88,7 +90,7 @@ def mjcf(
     )
 
 
-@app.command("dxf")
+@app.command("dxf", cls=help.Command)
 @friendly_errors
 def dxf(
     spec: Annotated[

@@ -245,7 +245,7 @@ def run_study(
 def nominal_ratio(path: Trace) -> Array:
     """``(K,)`` the paper's Sec. 5 ratio at the points of the path's first branch."""
     first = path.branch == (path.branches[0].id if path.branches else 0)
-    return path.condition()[first]
+    return path.condition_raw()[first]  # the raw ratio, as printed in the paper (condition() is normalised)
 
 
 def robustness(

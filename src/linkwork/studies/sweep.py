@@ -56,7 +56,7 @@ def linkage_point(study: Study, index: int) -> tuple[Row, Any]:
         row[f"{name}_min"] = float(deg.min())
         row[f"{name}_max"] = float(deg.max())
     row["bifurcations"] = len(path.bifurcations)
-    row["ratio_max"] = float(path.max_condition)
+    row["ratio_max"] = float(path.max_condition_raw)  # the paper's Sec. 5 ratio, raw
     row["end"] = path.branches[0].end_reason if path.branches else ""
     result = None
     if study.robustness is not None:

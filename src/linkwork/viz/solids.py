@@ -121,7 +121,7 @@ def posed_meshes(mech: Mechanism, angles: ArrayLike, *, pins: bool = True) -> li
     """Every body's mesh (``mech.bodies`` order), then the pins (joint order), at the joint values ``angles``.
 
     ``angles`` are the reported joint values in radians (a row of ``Path.angles``); bodies are placed by
-    ``body_poses(mech, mech.q_from_angles(angles))``, a pin by the pose of the body after its joint.
+    ``body_poses(mech, angles=angles)``, a pin by the pose of the body after its joint.
     """
     bodies, pin_meshes = _drawing(mech)
     return place(mech, bodies, pin_meshes if pins else [], angles)
@@ -132,7 +132,7 @@ def place(mech: Mechanism, bodies: Mapping[str, Mesh], pins: list[Mesh], angles:
 
     Use it to pose many frames without rebuilding the meshes.
     """
-    poses = body_poses(mech, mech.q_from_angles(angles))
+    poses = body_poses(mech, angles=angles)
     out = [mesh.transformed(poses[name]) for name, mesh in bodies.items()]
     by_joint = {name: j for j, name in enumerate(mech.joint_names)}
     for pin in pins:
