@@ -19,7 +19,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.points import reference_joint_points
+from linkwork.kinematics.positions import joint_points
 
 #: Capsule radius and pin length as fractions of the median distance between a body's joints.
 CAPSULE_RADIUS = 0.03
@@ -80,7 +80,7 @@ def _capsules(mech: Mechanism, body: str, points: np.ndarray, radius: float) -> 
 def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
     """The MJCF text of ``mech`` (see the module docstring); ``drive`` (default: the first joint) gets a position
     actuator."""
-    points = reference_joint_points(mech)
+    points = joint_points(mech)
     spread = np.linalg.norm(points - points.mean(axis=0), axis=1)
     radius = CAPSULE_RADIUS * float(np.median(spread[spread > 0])) if np.any(spread > 0) else 0.03
     root, children, cuts = spanning_tree(mech)
