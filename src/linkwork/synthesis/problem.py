@@ -57,6 +57,9 @@ class Problem:
         A name per profile (file stem by default).
     source
         The problem file this came from, if any (for messages and relative paths).
+    units
+        The length unit of the profile files (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``, ``"um"``), carried
+        into the DXF (``$INSUNITS``) and SVG (width and height) drawings; ``None``: unitless.
     """
 
     profiles: tuple[NDArray[np.float64], ...]
@@ -75,6 +78,7 @@ class Problem:
     rank_by: RankBy = "error"
     e_max_tolerance: float | None = None
     initial_segment_matrix: NDArray[np.int64] | None = None
+    units: str | None = None
 
     @property
     def count(self) -> int:
