@@ -11,7 +11,7 @@ from typing import Annotated
 
 import typer
 
-from linkwork.cli import demo, help, linkages, mechanize, robustness, sweep, synth, trace
+from linkwork.cli import demo, export, help, linkages, mechanize, robustness, sweep, synth, trace
 
 EXIT_CODES = (
     "Exit codes: 0 done as asked; 2 bad input (one line on stderr names the file, key or flag and what was "
@@ -36,6 +36,7 @@ app.command("mechanize", cls=help.Command)(mechanize.mechanize)
 app.command("demo", cls=help.Command)(demo.demo)
 app.command("robustness", cls=help.Command)(robustness.robustness)
 app.command("sweep", cls=help.Command)(sweep.sweep)
+app.add_typer(export.app, name="export")
 
 
 def _print_version(value: bool) -> None:

@@ -27,6 +27,7 @@ Example
     rank_by = "error"                   # error | joints (fewest joints with E_max <= e_max_tolerance)
     e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
     initial_segment_matrix = [[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]]  # Eq. 11: a row per profile
+    units = "mm"                        # optional: length unit of the profile files, carried into DXF/SVG
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from linkwork.errors import SpecError
-from linkwork.io.profiles import COINCIDENT, load_profile
+from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
 from linkwork.mechanization.options import OPTION_KEYS, options_from_values
 from linkwork.synthesis.problem import MergeOn, Problem, ProfileKind, RankBy
 
@@ -59,6 +60,7 @@ KEYS = (
     "seed",
     "names",
     "mechanize",
+    "units",
     "description",
     *OPTION_KEYS,
     "merge_on",
@@ -284,6 +286,9 @@ def load_problem(path: str | Path) -> Problem:
             "initial_segment_matrix",
             f'has {initial_sm.shape[0]} entries per row but design "{design}" has {len(design)} segments',
         )
+    units: str | None = keys.get(
+        "units", None, lambda v: v if v in LENGTH_UNITS else None, f"one of {', '.join(LENGTH_UNITS)}"
+    )
     keys.get("description", "", lambda v: v if isinstance(v, str) else None, "a string")
     stems = [Path(name).stem for name in files]
     names = keys.get("names", stems, _string_list, f"a list of {len(files)} non-empty names")
@@ -329,4 +334,5 @@ def load_problem(path: str | Path) -> Problem:
         rank_by=rank_by,
         e_max_tolerance=e_max_tolerance,
         initial_segment_matrix=initial_sm,
+        units=units,
     )

@@ -63,6 +63,9 @@ class Problem:
     mechanize_options
         The mechanization keys of the problem file, in file units (degrees), already checked; read them with
         :func:`linkwork.mechanization.options_from_values`.
+    units
+        The length unit of the profile files (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``, ``"um"``), carried
+        into the DXF (``$INSUNITS``) and SVG (width and height) drawings; ``None``: unitless.
     """
 
     profiles: tuple[NDArray[np.float64], ...]
@@ -82,6 +85,7 @@ class Problem:
     rank_by: RankBy = "error"
     e_max_tolerance: float | None = None
     initial_segment_matrix: NDArray[np.int64] | None = None
+    units: str | None = None
 
     @property
     def count(self) -> int:
