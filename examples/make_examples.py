@@ -395,18 +395,17 @@ def write_mechanize(folder: Path, name: str, design_line: str | None) -> None:
 
 
 def main(root: Path = ROOT) -> None:
-    """Write every example set into ``root/examples/`` and copy it to ``root/src/linkwork/data/examples/``."""
+    """Write every example set into ``root/src/linkwork/data/examples/``, the one bundled copy (reached with
+    ``linkwork.data.example(name)``; ``linkwork synth NAME`` runs it)."""
     bundled = root / "src" / "linkwork" / "data" / "examples"
     for name, make in SETS.items():
-        folder = root / "examples" / name
+        folder = bundled / name
         if folder.exists():
             shutil.rmtree(folder)
         folder.mkdir(parents=True)
         lengths = make(folder)
         if name in MECHANIZE:
             write_mechanize(folder, name, MECHANIZE[name])
-        shutil.rmtree(bundled / name, ignore_errors=True)
-        shutil.copytree(folder, bundled / name)
         summary = ", ".join(f"{key} {value:.4f}" for key, value in lengths.items())
         print(f"{name:10s} arc lengths: {summary}")
 

@@ -2,7 +2,7 @@
 ``docs/examples/figures/``.
 
 Run from anywhere after ``pip install -e .``: ``python docs/examples/make_figures.py``. Each example is
-synthesised from ``examples/<name>/problem.toml`` and its figures are written as ``<name>_<figure>.png`` (PNG
+synthesised from the bundled ``<name>`` example (``linkwork.data.example(name)``) and its figures are written as ``<name>_<figure>.png`` (PNG
 only, at 80 dpi, to keep each file small). It prints each example's E_max and run time, the numbers quoted in
 the write-ups.
 """
@@ -14,11 +14,11 @@ from pathlib import Path
 
 import matplotlib
 
+from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.synthesis import synthesize
 from linkwork.viz import synthesis_plots as plots
 
-ROOT = Path(__file__).resolve().parents[2]
 OUT = Path(__file__).resolve().parent / "figures"
 NAMES = ("wing", "closed", "fixed-end", "seat")
 DPI = 80
@@ -28,7 +28,7 @@ def main() -> None:
     """Synthesise every example and write its figures."""
     OUT.mkdir(parents=True, exist_ok=True)
     for name in NAMES:
-        problem = load_problem(ROOT / "examples" / name / "problem.toml")
+        problem = load_problem(example(name))
         start = time.perf_counter()
         result = synthesize(problem)
         seconds = time.perf_counter() - start

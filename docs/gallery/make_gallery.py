@@ -18,6 +18,7 @@ matplotlib.use("Agg")
 
 import numpy as np
 
+from linkwork.data import example
 from linkwork.kinematics.tracer import trace
 from linkwork.linkages import hedgepeth_rods
 from linkwork.linkages.guest import guest_frame
@@ -95,7 +96,7 @@ def main() -> None:
     from linkwork.synthesis import synthesize
     from linkwork.viz.synthesis_plots import write_synthesis_figures
 
-    result = synthesize(load_problem(ROOT / "examples" / "seat" / "problem.toml"))
+    result = synthesize(load_problem(example("seat")))
     names = {
         "profiles": "synth_fig03_profiles.png",
         "m_segment": "synth_fig06_m_segment.png",
@@ -107,10 +108,10 @@ def main() -> None:
         for file in write_synthesis_figures(result, tmp):
             if file.suffix == ".png" and file.stem in names:
                 written.append(Path(shutil.copy(file, HERE / names[file.stem])))
-    # Fig. 14: the seat chain mechanized to one degree of freedom (examples/seat/mechanize.toml).
+    # Fig. 14: the seat chain mechanized to one degree of freedom (seat/mechanize.toml).
     from linkwork.outputs.mechanization import mechanize_into
 
-    seat = synthesize(load_problem(ROOT / "examples" / "seat" / "mechanize.toml"))
+    seat = synthesize(load_problem(example("seat", "mechanize.toml")))
     with tempfile.TemporaryDirectory() as tmp:
         mechanize_into(seat, Path(tmp), plots=True)
         written.append(

@@ -259,14 +259,6 @@ def test_run_synthesis_example_writes_inputs_and_outputs(tmp_path: Path) -> None
     assert math.isclose(first["joined"]["e_max"], second["joined"]["e_max"], rel_tol=0, abs_tol=1e-12)
 
 
-def test_bundled_examples_match_the_committed_ones() -> None:
-    for name in data.EXAMPLES:
-        bundled = data.example(name)
-        assert bundled.read_text(encoding="utf-8") == (ROOT / "examples" / name / "problem.toml").read_text(
-            encoding="utf-8"
-        )
-
-
 def test_unknown_example_is_a_spec_error(tmp_path: Path) -> None:
     with pytest.raises(
         SpecError, match=r'unknown example "moon"; expected one of wing, closed, fixed-end, seat'

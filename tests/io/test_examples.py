@@ -12,12 +12,12 @@ from types import ModuleType
 import numpy as np
 import pytest
 
+from linkwork.data import EXAMPLES, example
 from linkwork.io.problem import load_problem
 from linkwork.io.profiles import load_profile
 from linkwork.synthesis import synthesize, target_profiles
 
 ROOT = Path(__file__).resolve().parents[2]
-EXAMPLES = ("wing", "closed", "fixed-end", "seat")
 
 
 def load_script() -> ModuleType:
@@ -87,27 +87,28 @@ def test_naca_outline_is_selig_ordered_and_scaled() -> None:
 
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_example_problem_loads(name: str) -> None:
-    problem = load_problem(ROOT / "examples" / name / "problem.toml")
-    assert problem.count == 3
-    assert len(set(problem.names)) == 3
+    problem = load_problem(example(name))
+    expected = 6 if name == "wing-six" else 3  # the paper's three profiles; wing-six has six
+    assert problem.count == expected
+    assert len(set(problem.names)) == expected
 
 
 def test_wing_arc_lengths_differ_by_at_least_thirty_percent() -> None:
-    problem = load_problem(ROOT / "examples" / "wing" / "problem.toml")
+    problem = load_problem(example("wing"))
     lengths = [arc_length(p) for p in problem.profiles]
     assert lengths == sorted(lengths)
     assert lengths[-1] / lengths[0] >= 1.3
 
 
 def test_fixed_end_arches_share_their_ends() -> None:
-    problem = load_problem(ROOT / "examples" / "fixed-end" / "problem.toml")
+    problem = load_problem(example("fixed-end"))
     assert {Path(p).suffix for p in ("low_arch.svg", "high_arch.dxf")} == {".svg", ".dxf"}
     for profile in problem.profiles:
         np.testing.assert_allclose(profile[[0, -1]], [[0.0, 0.0], [4.0, 0.0]], rtol=0, atol=1e-9)
 
 
 def test_seat_has_the_papers_arc_lengths_and_piece_counts() -> None:
-    problem = load_problem(ROOT / "examples" / "seat" / "problem.toml")
+    problem = load_problem(example("seat"))
     lengths = [arc_length(p) for p in problem.profiles]
     np.testing.assert_allclose(lengths, [44.42, 51.98, 54.39], rtol=0, atol=1e-9)
     pieces = [t.pieces for t in target_profiles(problem)]
@@ -115,22 +116,25 @@ def test_seat_has_the_papers_arc_lengths_and_piece_counts() -> None:
     np.testing.assert_allclose(pieces, [127, 149, 155], rtol=0, atol=1)
 
 
-def test_committed_files_are_what_the_script_writes(tmp_path: Path) -> None:
+def test_the_one_bundled_copy_is_what_the_script_writes(tmp_path: Path) -> None:
     make_examples.main(tmp_path)
     for name in EXAMPLES:
-        committed = sorted(p.name for p in (ROOT / "examples" / name).iterdir())
-        bundled = sorted(p.name for p in (ROOT / "src" / "linkwork" / "data" / "examples" / name).iterdir())
-        fresh = sorted(p.name for p in (tmp_path / "examples" / name).iterdir())
-        assert committed == bundled == fresh
-        for file in committed:
-            ours = ROOT / "examples" / name / file
-            copy = ROOT / "src" / "linkwork" / "data" / "examples" / name / file
-            again = tmp_path / "examples" / name / file
+        bundled_dir = example(name).parent
+        bundled = sorted(p.name for p in bundled_dir.iterdir())
+        fresh = sorted(p.name for p in (tmp_path / "src" / "linkwork" / "data" / "examples" / name).iterdir())
+        assert bundled == fresh
+        for file in bundled:
+            ours = bundled_dir / file
+            again = tmp_path / "src" / "linkwork" / "data" / "examples" / name / file
             if ours.suffix == ".dxf":  # DXF headers carry creation times and GUIDs: compare the curves
-                for other in (copy, again):
-                    np.testing.assert_allclose(load_profile(other), load_profile(ours), rtol=0, atol=1e-12)
+                np.testing.assert_allclose(load_profile(again), load_profile(ours), rtol=0, atol=1e-12)
             else:
-                assert ours.read_bytes() == copy.read_bytes() == again.read_bytes(), f"{name}/{file}"
+                assert ours.read_bytes() == again.read_bytes(), f"{name}/{file}"
+
+
+def test_examples_folder_holds_no_second_copy() -> None:
+    for name in EXAMPLES:
+        assert not (ROOT / "examples" / name).exists(), f"examples/{name} duplicates the bundled data"
 
 
 @pytest.mark.slow
@@ -141,7 +145,7 @@ def test_committed_files_are_what_the_script_writes(tmp_path: Path) -> None:
     [("wing", 0.015), ("closed", 0.11), ("fixed-end", 0.05), ("seat", 0.26)],
 )
 def test_example_synthesises_in_seconds(name: str, e_max_bound: float) -> None:
-    problem = load_problem(ROOT / "examples" / name / "problem.toml")
+    problem = load_problem(example(name))
     start = time.perf_counter()
     result = synthesize(problem)
     seconds = time.perf_counter() - start

@@ -7,7 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-SEAT = Path(__file__).resolve().parents[2] / "examples" / "seat" / "mechanize.toml"
+from linkwork.data import example
+
+SEAT = example("seat", "mechanize.toml")
 
 GROUND_A = np.array([0.0, 0.0])
 GROUND_D = np.array([4.0, 0.0])

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.io.spec import load_spec
 from linkwork.kinematics.closure import closure_residual, jacobian
@@ -218,7 +219,7 @@ def test_two_dof_says_it_was_not_traced(two_dof: tuple) -> None:
     assert found.verification.paths == ()
 
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = example("wing").parents[1]  # the bundled example sets
 
 
 @pytest.fixture(scope="module")

@@ -10,12 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.mechanization import MechanizeOptions, build_chain, mechanize
 from linkwork.synthesis import synthesize
 from linkwork.viz.mechanism_viewer import mechanism_viewer_data, write_mechanism_viewer
 
-WING = Path(__file__).resolve().parents[2] / "examples" / "wing" / "mechanize.toml"
+WING = example("wing", "mechanize.toml")
 
 
 @pytest.fixture(scope="module")

@@ -10,11 +10,12 @@ import typer
 from typer.testing import CliRunner
 
 from linkwork.cli.mechanize import mechanize
+from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.outputs.synthesis import write_synthesis_outputs
 from linkwork.synthesis import synthesize
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = example("wing").parents[1]  # the bundled example sets
 
 
 def _synth_folder(tmp_path: Path) -> Path:

@@ -13,11 +13,12 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
+from linkwork.data import example
 from linkwork.io.spec import load_spec
 from linkwork.kinematics.tracer import trace
 from linkwork.mechanization import MechanizationError, MechanizeOptions, mechanize
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = example("wing").parents[1]  # the bundled example sets
 
 
 @pytest.fixture(scope="module")

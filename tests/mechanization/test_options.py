@@ -8,13 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from linkwork.data import example
 from linkwork.errors import SpecError
 from linkwork.io.problem import load_problem
 from linkwork.mechanization import GroundRegion, MechanizeOptions, options_from_values
 from linkwork.mechanization.options import OPTION_KEYS, parse_region_flag
 from linkwork.outputs.mechanization import resolve_options
 
-WING = Path(__file__).resolve().parents[2] / "examples" / "wing"
+WING = example("wing").parent
 
 
 def _problem(tmp_path: Path, extra: str) -> Path:

@@ -7,10 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
+from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.outputs.problem_copy import copy_problem
 
-WING = Path(__file__).resolve().parents[2] / "examples" / "wing"
+WING = example("wing").parent
 
 
 def test_profiles_outside_the_problem_folder_are_copied_next_to_it(tmp_path: Path) -> None:

@@ -12,8 +12,9 @@ from typer.testing import CliRunner
 
 from linkwork.cli.mechanize import mechanize
 from linkwork.cli.synth import synth
+from linkwork.data import example
 
-WING = Path(__file__).resolve().parents[2] / "examples" / "wing"
+WING = example("wing").parent
 
 
 def _app(command: object) -> typer.Typer:

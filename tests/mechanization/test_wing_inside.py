@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.io.spec import load_spec
 from linkwork.kinematics.tracer import trace
@@ -19,7 +20,7 @@ from linkwork.synthesis import synthesize
 
 from .geometry_checks import joint_positions, triangle_angle
 
-WING = Path(__file__).resolve().parents[2] / "examples" / "wing"
+WING = example("wing").parent
 CHORD = 1.0  # the cruise profile's chord, the shortest of the three
 
 

@@ -28,6 +28,7 @@ import numpy as np
 import pytest
 
 import linkwork as lw
+from linkwork.data import example
 from linkwork.viz.viewer import write_synthesis_viewer, write_trace_viewer
 
 CHROMIUM = "/usr/bin/chromium"
@@ -478,7 +479,7 @@ def test_mechanism_viewer_opens_fixed_with_the_target_profiles(browser: Browser,
     from linkwork.mechanization import MechanizeOptions, mechanize
     from linkwork.viz.mechanism_viewer import write_mechanism_viewer
 
-    wing = Path(__file__).resolve().parents[2] / "examples" / "wing" / "mechanize.toml"
+    wing = example("wing", "mechanize.toml")
     found = mechanize(lw.synthesize(load_problem(wing)), MechanizeOptions(designs=1))
     page = write_mechanism_viewer(found, tmp_path / "mechanism.html")
     browser.open(page)

@@ -30,13 +30,16 @@ def example(name: str = "wing", file: str = "problem.toml") -> Path:
 
 
 def problem_file(spec: str | Path) -> Path:
-    """The problem file that ``spec`` names: an existing file as it is, else a bundled example's problem file by
-    name (``"wing"``), as built-in linkages are found by name; a name that is neither is a :class:`SpecError`."""
+    """The problem file that ``spec`` names: an existing file as it is, else a bundled example by name (``"wing"``
+    for its ``problem.toml``, ``"wing/mechanize.toml"`` for another of its files), as built-in linkages are found
+    by name; a name that is neither is a :class:`SpecError`."""
     path = Path(spec)
     if path.exists():
         return path
     if str(spec) in EXAMPLES:
         return example(str(spec))
+    if len(path.parts) == 2 and path.parts[0] in EXAMPLES and path.suffix == ".toml":
+        return example(path.parts[0], path.parts[1])
     expected = "a problem file (TOML)"
     if not path.suffix and len(path.parts) == 1:  # a bare name: perhaps a misspelt example
         expected += f" or a bundled example ({', '.join(EXAMPLES)})"
