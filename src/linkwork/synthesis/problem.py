@@ -2,14 +2,31 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.errors import SpecError
+from linkwork.io.toml_reader import MAX_NAME_CHARS, show
+
 ProfileKind = Literal["open", "closed", "fixed-end"]
+
+KINDS: tuple[ProfileKind, ...] = ("open", "closed", "fixed-end")
+"""The values of ``kind`` (``type`` in a problem file)."""
+
+MAX_STARTS = 1000
+"""The most initial segment matrices one design vector's search may start from."""
+
+MAX_AUTO_SEGMENTS = 10
+"""The most segments ``q`` of an exhaustive search (``design = "auto"`` tries all ``2**q`` design vectors)."""
+
+MAX_PIECES = 2000
+"""The most pieces ``m_j = ceil(C_j / s_d)`` of a target profile (Eq. 3): ``piece_length`` must be at least
+the longest profile's arc length divided by this."""
 
 
 @dataclass(frozen=True)
@@ -57,7 +74,134 @@ class Problem:
     source: Path | None = None
     mechanize: bool = False
 
+    def __post_init__(self) -> None:
+        """Check every rule of a problem; a broken one is a :class:`SpecError` naming the problem file's key
+        with the same words as the file reader."""
+        for key, message in _broken_rules(self):
+            raise SpecError(message, source=None if self.source is None else str(self.source), key=key)
+
     @property
     def count(self) -> int:
         """``p``, the number of design profiles."""
         return len(self.profiles)
+
+
+def _whole(value: Any, minimum: int, maximum: int | None = None) -> bool:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        return False
+    return bool(minimum <= value and (maximum is None or value <= maximum))
+
+
+def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
+    """``(key, message)`` of the first broken rule of ``problem`` (empty when it is sound); keys and units are
+    those of the problem file (degrees for ``merge_below``), profiles are counted from 0."""
+    p = problem
+    if p.kind not in KINDS:
+        return [("type", f'expected one of "open", "closed", "fixed-end", got {show(p.kind)}')]
+    if len(p.profiles) < 2:
+        return [("profiles", f"lists {len(p.profiles)} profile(s); expected at least 2 profiles")]
+    if not (isinstance(p.piece_length, int | float) and math.isfinite(p.piece_length) and p.piece_length > 0):
+        return [("piece_length", f"expected a positive number, got {show(p.piece_length)}")]
+    if not _whole(p.min_pieces, 2):
+        return [
+            (
+                "min_pieces",
+                "expected a whole number of pieces >= 2 (a C-segment needs an interior point), "
+                f"got {show(p.min_pieces)}",
+            )
+        ]
+    broken = _design_rules(p)
+    if broken:
+        return broken
+    if not _whole(p.starts, 1, MAX_STARTS):
+        return [
+            (
+                "starts",
+                f"expected a whole number of starts, 1 <= starts <= {MAX_STARTS}, got {show(p.starts)}",
+            )
+        ]
+    merge = p.merge_below
+    if not (isinstance(merge, int | float) and 0.0 <= merge < math.pi):
+        shown = f"{math.degrees(merge):g}" if isinstance(merge, int | float) else show(merge)
+        return [("merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {shown}")]
+    if not _whole(p.seed, 0):
+        return [("seed", f"expected a whole number >= 0, got {show(p.seed)}")]
+    return _name_rules(p) or _profile_rules(p)
+
+
+def _design_rules(p: Problem) -> list[tuple[str, str]]:
+    """The design vector and the number of segments."""
+    expected = 'a design vector of M and C letters such as "MCMC", or "auto"'
+    auto = p.design is None or (isinstance(p.design, str) and p.design.strip().lower() == "auto")
+    if auto:
+        if p.segments is None:
+            return [("segments", 'missing; design = "auto" needs the number of segments q, e.g. 4')]
+        if not _whole(p.segments, 1, MAX_AUTO_SEGMENTS):
+            return [
+                (
+                    "segments",
+                    f"expected a whole number of segments, 1 <= segments <= {MAX_AUTO_SEGMENTS} for design "
+                    f'"auto" (an exhaustive search over 2**segments design vectors), got {show(p.segments)}',
+                )
+            ]
+        return []
+    if not isinstance(p.design, str) or not p.design.strip():
+        return [("design", f"expected {expected}, got {show(p.design)}")]
+    design = p.design.strip().upper()
+    wrong = sorted({letter for letter in design if letter not in "MC"})
+    if wrong:
+        letters = show(", ".join(wrong))[1:-1]
+        return [("design", f"expected {expected}, got {show(p.design)} (letters {letters} are not M or C)")]
+    if p.segments is not None and p.segments != len(design):
+        return [
+            (
+                "segments",
+                f'is {show(p.segments)} but design "{design}" has {len(design)} segments; give one or the other',
+            )
+        ]
+    return []
+
+
+def _name_rules(p: Problem) -> list[tuple[str, str]]:
+    """One distinct, non-empty name per profile (or none: numbered names are used)."""
+    if not p.names:
+        return []
+    if not all(isinstance(n, str) and n.strip() for n in p.names):
+        return [("names", f"expected a list of {len(p.profiles)} non-empty names")]
+    if len(p.names) != len(p.profiles):
+        return [
+            (
+                "names",
+                f"lists {len(p.names)} names for {len(p.profiles)} profiles; expected one per profile",
+            )
+        ]
+    for index, name in enumerate(p.names):
+        if len(name) > MAX_NAME_CHARS:
+            return [(f"names[{index}]", f"expected at most {MAX_NAME_CHARS} characters, got {len(name)}")]
+    folded = [name.casefold() for name in p.names]
+    if len(set(folded)) != len(folded):
+        return [("names", "repeats a name (ignoring case); expected a different name for every profile")]
+    return []
+
+
+def _profile_rules(p: Problem) -> list[tuple[str, str]]:
+    """Each profile a finite ``(N, 2)`` polyline, short enough in pieces for :data:`MAX_PIECES`."""
+    length = 0.0
+    for index, profile in enumerate(p.profiles):
+        points = np.asarray(profile)
+        key = f"profiles[{index}]"
+        if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 2:
+            return [(key, f"expected a polyline of shape (N, 2) with N >= 2, got shape {points.shape}")]
+        if not np.all(np.isfinite(points)):
+            return [(key, "has a non-finite coordinate; expected finite numbers")]
+        with np.errstate(over="ignore", invalid="ignore"):
+            length = max(length, float(np.sum(np.hypot(*np.diff(points, axis=0).T))))
+    if not length / float(p.piece_length) <= MAX_PIECES:
+        return [
+            (
+                "piece_length",
+                f"expected at least 1/{MAX_PIECES} of the longest profile's arc length ({length:.6g}), "
+                f"i.e. piece_length >= {length / MAX_PIECES:.6g}, got {show(p.piece_length)}",
+            )
+        ]
+    return []

@@ -6,7 +6,6 @@ compound segments.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -49,22 +48,6 @@ class _Candidate:
     @property
     def rank_key(self) -> tuple[float, float, float]:
         return (self.joined_e_max, float(self.error_matrix.max()), float(self.error_matrix.mean()))
-
-
-def _check_problem(problem: Problem) -> None:
-    src = None if problem.source is None else str(problem.source)
-    if problem.count < 1:
-        raise SpecError("a synthesis problem needs at least one profile", source=src, key="profiles")
-    if problem.kind not in ("open", "closed", "fixed-end"):
-        raise SpecError(
-            f"type must be open, closed or fixed-end, got {problem.kind!r}", source=src, key="type"
-        )
-    if problem.starts < 1:
-        raise SpecError(f"starts must be at least 1, got {problem.starts}", source=src, key="starts")
-    if not (problem.merge_below >= 0.0 and math.isfinite(problem.merge_below)):
-        raise SpecError(f"merge_below must be >= 0, got {problem.merge_below}", source=src, key="merge_below")
-    if problem.design is None and problem.segments is None:
-        raise SpecError("give a design vector or the number of segments", source=src, key="design")
 
 
 def _design_seed(seed: int, design: str) -> list[int]:
@@ -110,7 +93,6 @@ def synthesize(
     if search not in ("paper", "refined"):
         raise SpecError(f"search must be 'paper' or 'refined', got {search!r}", key="search")
     t0 = time.perf_counter()
-    _check_problem(problem)
     targets = target_profiles(problem)
     pieces = [t.pieces for t in targets]
     if problem.design is not None and problem.design.strip().lower() != "auto":
