@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.text import Text
 
 from linkwork.cli.common import friendly_errors
 from linkwork.outputs.staging import console
@@ -29,7 +30,9 @@ def demo(
 
     sections: list[tuple[str, str, Path, list[str]]] = []
 
-    console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)")
+    console.rule(
+        Text("1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)", style="bold")
+    )
     hexagon = lw.load("hedgepeth-rods", n=6)
     inner, outer = deployed_angles(6)
     path = lw.trace(hexagon, until=("A", inner), steps=200)
@@ -50,7 +53,11 @@ def demo(
         )
     )
 
-    console.rule("[bold]2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)")
+    console.rule(
+        Text(
+            "2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)", style="bold"
+        )
+    )
     try:
         frame = lw.load("guest-frame")
     except lw.SpecError:
@@ -72,7 +79,7 @@ def demo(
             )
         )
 
-    console.rule("[bold]3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)")
+    console.rule(Text("3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)", style="bold"))
     try:
         from linkwork.outputs.synthesis import run_synthesis_example
     except ImportError:  # pragma: no cover - synthesis not installed
@@ -93,7 +100,9 @@ def demo(
             )
         )
     if run_synthesis_example is not None:
-        console.rule("[bold]4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)")
+        console.rule(
+            Text("4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)", style="bold")
+        )
         import json
 
         folder = out / "mechanism-wing"

@@ -71,7 +71,7 @@ def synth(
 
     plots = not no_plots
     if plots and not have_matplotlib():
-        console.print("note: matplotlib is not installed (pip install 'linkwork\\[viz]'): no figures drawn")
+        console.print("note: matplotlib is not installed (pip install 'linkwork[viz]'): no figures drawn")
         plots = False
     found = None
     with staged_output(out) as stage:

@@ -11,8 +11,9 @@ from pathlib import Path
 
 from rich.console import Console
 
-console = Console()
-"""The console every summary is printed on (standard output)."""
+console = Console(markup=False)
+"""The console every summary is printed on (standard output). Markup is off: names, files and notes a user wrote
+are printed as text (``[/]`` in a joint name is two brackets and a slash); styled words are :class:`rich.text.Text`."""
 
 
 @contextlib.contextmanager

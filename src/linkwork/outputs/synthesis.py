@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from rich.text import Text
 
 from linkwork.data import example
 from linkwork.errors import SpecError
@@ -155,7 +156,8 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
     problem = result.problem
     searched = "given" if problem.design else f"best of every design vector of {problem.segments} segments"
     console.print(
-        f"[bold]design[/] {result.design} ({searched}); {problem.kind} profiles, piece length "
+        Text("design", style="bold"),
+        f"{result.design} ({searched}); {problem.kind} profiles, piece length "
         f"{problem.piece_length:g}, at least {problem.min_pieces} pieces per segment; "
         f"{result.stats.starts} starts, {result.stats.seconds:.2f} s",
         highlight=False,
