@@ -235,7 +235,7 @@ def bad_toml(tmp_path: Path) -> str:
 
 BAD_INPUT = {
     "unknown linkage": (lambda t: ["trace", "no-such-linkage"], "no-such-linkage"),
-    "unknown --set key": (lambda t: ["trace", "hedgepeth", "--set", "m=6"], "'m'"),
+    "unknown --set key": (lambda t: ["trace", "hedgepeth", "--set", "m=6"], '"m"'),
     "odd n": (lambda t: ["trace", "hedgepeth", "--set", "n=5"], "even"),
     "--until without =": (lambda t: ["trace", "hedgepeth", "--until", "A87"], "JOINT=VALUE"),
     "--until unknown joint": (lambda t: ["trace", "hedgepeth", "--until", "Z=30"], "'Z'"),
