@@ -10,7 +10,7 @@ import typer
 from rich.text import Text
 
 from linkwork.cli.common import friendly_errors
-from linkwork.outputs.staging import console
+from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 
 @friendly_errors
@@ -20,7 +20,18 @@ def demo(
 ) -> None:
     """Deploy Hedgepeth's hexagon from the bundle to the flat hexagon (Figs. 12-13), follow Guest's frame
     through its bifurcations (Figs. 15-16), synthesise and mechanize a morphing wing; write everything with an
-    index.html into --out."""
+    index.html into --out.
+
+    Everything is written into a staging folder and moved into --out at the end: a demo interrupted (Ctrl-C,
+    SIGTERM) or failing leaves --out as it was, its previous complete result or nothing."""
+    check_output_folder(out)
+    with staged_output(out) as stage:
+        _build_demo(stage, no_plots)
+    console.print(f"\nopen {out / 'index.html'} to see every result")
+
+
+def _build_demo(out: Path, no_plots: bool) -> None:
+    """Run the four parts of the demo and write them, with index.html, into ``out`` (the staging folder)."""
     import numpy as np
 
     import linkwork as lw
@@ -122,7 +133,6 @@ def demo(
         )
         sections.append(("Mechanized wing (one degree of freedom)", text, folder, figs_m))
     _write_index(out, sections)
-    console.print(f"\nopen {out / 'index.html'} to see every result")
 
 
 #: What each section's interactive viewer lets a reader do.

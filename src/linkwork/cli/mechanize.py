@@ -17,7 +17,7 @@ import typer
 
 from linkwork.cli.common import friendly_errors
 from linkwork.errors import SpecError
-from linkwork.outputs.staging import console, staged_output
+from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 
 def _region(text: str | None) -> tuple[float, float, float, float] | None:
@@ -69,6 +69,7 @@ def mechanize(
     mechanism.toml (for `linkwork trace`), mechanization.json, figures and an animation."""
     from linkwork.mechanization import MechanizeOptions
 
+    check_output_folder(out or folder)
     options = MechanizeOptions(
         dof=dof,
         drive=drive,

@@ -15,7 +15,7 @@ import typer
 
 from linkwork.cli.common import friendly_errors
 from linkwork.errors import SpecError
-from linkwork.outputs.staging import console, have_matplotlib, staged_output
+from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
 
 
 @friendly_errors
@@ -51,6 +51,7 @@ def synth(
     from linkwork.outputs.synthesis import print_synthesis_summary, write_synthesis_outputs
     from linkwork.synthesis import synthesize
 
+    check_output_folder(out, ["chain.json", "target_profiles.csv", "outline.svg", "outline.dxf"])
     if search not in ("paper", "refined"):
         raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")
     spec = load_problem(problem)

@@ -16,7 +16,7 @@ from linkwork.cli.common import (
     parse_assignments,
 )
 from linkwork.io.toml_reader import show
-from linkwork.outputs.staging import console
+from linkwork.outputs.staging import check_output_folder, console
 
 MAX_STEP_DEG = 90.0
 """The largest ``--max-step`` (degrees)."""
@@ -103,6 +103,7 @@ def trace(
     from linkwork.io.spec import resolve_spec
     from linkwork.kinematics.tracer import trace as run_trace
 
+    check_output_folder(out, ["path.csv", "report.json"])
     check_range("--max-step", max_step, 0.0, MAX_STEP_DEG, "a number of degrees", open_low=True)
     check_range("--max-steps", max_steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
     if steps is not None:

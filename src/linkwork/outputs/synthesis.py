@@ -14,7 +14,7 @@ from rich.text import Text
 
 from linkwork.data import example
 from linkwork.errors import SpecError
-from linkwork.outputs.staging import console, have_matplotlib
+from linkwork.outputs.staging import console, have_matplotlib, staged_output
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -74,14 +74,13 @@ def run_synthesis_example(
     problem_file = example(name, file)
     problem = load_problem(problem_file)
     result = synthesize(problem)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copytree(problem_file.parent, out_dir / "problem", dirs_exist_ok=True)
-    write_synthesis_outputs(result, out_dir, plots=plots and have_matplotlib())
-    if problem.mechanize:
-        from linkwork.outputs.mechanization import mechanize_into
+    with staged_output(Path(out_dir)) as stage:
+        shutil.copytree(problem_file.parent, stage / "problem")
+        write_synthesis_outputs(result, stage, plots=plots and have_matplotlib())
+        if problem.mechanize:
+            from linkwork.outputs.mechanization import mechanize_into
 
-        mechanize_into(result, out_dir, plots=plots and have_matplotlib())
+            mechanize_into(result, stage, plots=plots and have_matplotlib())
     return result
 
 
