@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +27,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
+from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
+from linkwork.io.toml_reader import escape_line
 
 if TYPE_CHECKING:
     from linkwork.synthesis.result import JoinedProfile, SynthesisResult
@@ -35,6 +38,15 @@ FLATTEN_TOLERANCE = 1e-4
 
 COINCIDENT = 1e-9
 """Two consecutive points closer than this fraction of the curve's size count as one repeated point."""
+
+MAX_COORDINATE = 1e12
+"""The largest coordinate (absolute value) of a profile point accepted."""
+
+MAX_FLATTENED_POINTS = 200_000
+"""The most points curved geometry (arcs, bulges, Bézier curves, splines) may be flattened into."""
+
+MAX_BULGE = 1e6
+"""The largest DXF bulge (tan of a quarter of the arc's included angle) accepted."""
 
 _MAX_DEPTH = 24  # recursion limit of the adaptive flattening: 2**24 pieces per curve segment at most
 
@@ -201,6 +213,12 @@ def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points
         raise SpecError(
             f"point {bad[0] + 1} is {_fmt_point(pts[bad[0]])}; expected finite numbers", source=where
         )
+    huge = np.flatnonzero((np.abs(pts) > MAX_COORDINATE).any(axis=1))
+    if len(huge):
+        raise SpecError(
+            f"point {huge[0] + 1} is {_fmt_point(pts[huge[0]])}; expected coordinates within +-{MAX_COORDINATE:g}",
+            source=where,
+        )
     step = np.hypot(*np.diff(pts, axis=0).T)
     repeated = np.flatnonzero(step <= COINCIDENT * _size(pts))
     if len(repeated):
@@ -269,9 +287,16 @@ def _arc_points(
     if radius <= tolerance:
         count = 1
     else:
-        # sagitta r (1 - cos(dphi / 2)) <= tolerance
-        dphi = 2.0 * math.acos(max(-1.0, 1.0 - tolerance / radius))
-        count = max(1, math.ceil(abs(sweep) / dphi))
+        # sagitta r (1 - cos(dphi / 2)) <= tolerance, i.e. dphi = 4 asin(sqrt(tolerance / (2 r))) (no
+        # cancellation for a huge radius)
+        dphi = 4.0 * math.asin(min(1.0, math.sqrt(tolerance / (2.0 * radius))))
+        wanted = abs(sweep) / dphi if dphi > 0.0 else math.inf
+        if not wanted <= MAX_FLATTENED_POINTS:
+            raise SpecError(
+                f"an arc of radius {radius:.6g} would need {wanted:.3g} points; expected at most "
+                f"{MAX_FLATTENED_POINTS} (a smaller arc or a larger tolerance)"
+            )
+        count = max(1, math.ceil(wanted))
     angles = start + sweep * np.arange(1, count + 1) / count
     return [(center[0] + radius * math.cos(a), center[1] + radius * math.sin(a)) for a in angles]
 
@@ -458,7 +483,16 @@ def _svg_document(body: Iterable[str], extents: Sequence[Points], pixels: float 
 
 
 def _xml_escape(text: str) -> str:
-    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
+    """``text`` as XML character data or attribute value: markup characters escaped, characters XML 1.0 does
+    not allow (control characters but tab, line feed and carriage return) replaced by U+FFFD."""
+    text = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]", "\ufffd", text)
+    return (
+        text.replace("&", "&amp;")
+        .replace("<", "&lt;")
+        .replace(">", "&gt;")
+        .replace('"', "&quot;")
+        .replace("'", "&apos;")
+    )
 
 
 # ---------------------------------------------------------------------------------------------------- DXF
@@ -490,10 +524,7 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     entity = entities[0]
     kind = entity.dxftype()
     if kind == "SPLINE":
-        spline = entity.construction_tool()
-        control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
-        absolute = tolerance * _size(control)
-        return np.array([(v.x, v.y) for v in spline.flattening(absolute, segments=8)], dtype=float)
+        return _spline_points(entity, tolerance, path)
     if kind == "LWPOLYLINE":
         vertices = [(float(x), float(y), float(bulge)) for x, y, bulge in entity.get_points("xyb")]
         closed = bool(entity.closed)
@@ -510,6 +541,33 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     return _bulge_polyline(vertices, closed, tolerance)
 
 
+def _spline_points(entity: Any, tolerance: float, path: Path) -> Points:
+    """A DXF SPLINE flattened by ezdxf to ``tolerance`` times the size of its control points."""
+    count = len(entity.control_points)
+    order = int(entity.dxf.get("degree", 3)) + 1
+    if count < max(2, order) and len(entity.fit_points) < 2:
+        raise SpecError(
+            f"the SPLINE has {count} control points for degree {order - 1}; expected at least {max(2, order)}",
+            source=str(path),
+        )
+    spline = entity.construction_tool()
+    control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
+    if not np.all(np.isfinite(control)) or np.abs(control).max() > MAX_COORDINATE:
+        raise SpecError(
+            f"the SPLINE has a control point that is not finite or beyond +-{MAX_COORDINATE:g}",
+            source=str(path),
+        )
+    absolute = tolerance * _size(control)
+    points = []
+    for v in spline.flattening(absolute, segments=8):
+        points.append((v.x, v.y))
+        if len(points) > MAX_FLATTENED_POINTS:
+            raise SpecError(
+                f"the SPLINE flattens into more than {MAX_FLATTENED_POINTS} points", source=str(path)
+            )
+    return np.array(points, dtype=float)
+
+
 def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, tolerance: float) -> Points:
     """Flatten polyline vertices ``(x, y, bulge)`` whose bulge turns the piece after a vertex into an arc."""
     from ezdxf.math import bulge_to_arc
@@ -519,8 +577,13 @@ def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, to
     absolute = tolerance * _size(np.array([v[:2] for v in vertices], dtype=float))
     chain = [*vertices, vertices[0]] if closed else vertices
     points = [chain[0][:2]]
-    for (x0, y0, bulge), (x1, y1, _) in itertools.pairwise(chain):
-        if bulge == 0.0 or (x0, y0) == (x1, y1):
+    for number, ((x0, y0, bulge), (x1, y1, _)) in enumerate(itertools.pairwise(chain), start=1):
+        if not (math.isfinite(bulge) and abs(bulge) <= MAX_BULGE):
+            raise SpecError(
+                f"vertex {number}: bulge {bulge!r}; expected a finite bulge within +-{MAX_BULGE:g}"
+            )
+        # An arc whose sagitta (|bulge| * chord / 2) is within the tolerance is its chord.
+        if abs(bulge) * math.hypot(x1 - x0, y1 - y0) / 2.0 <= absolute or (x0, y0) == (x1, y1):
             points.append((x1, y1))
             continue
         center, _start, _end, radius = bulge_to_arc((x0, y0), (x1, y1), bulge)
@@ -529,6 +592,10 @@ def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, to
         arc = _arc_points((center.x, center.y), radius, begin, sweep, absolute)
         arc[-1] = (x1, y1)  # land exactly on the next vertex
         points += arc
+        if len(points) > MAX_FLATTENED_POINTS:
+            raise SpecError(
+                f"the bulges flatten into more than {MAX_FLATTENED_POINTS} points; expected fewer"
+            )
     return np.array(points, dtype=float)
 
 
@@ -596,8 +663,9 @@ def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
     radius = 0.006 * _size(np.vstack([t.points for t in result.targets]))
     document = ezdxf.new("R2010")
     space = document.modelspace()
+    layers = _dxf_layer_names([t.name or f"profile {j + 1}" for j, t in enumerate(result.targets)])
     for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
-        name = _dxf_layer_name(target.name or f"profile {j + 1}")
+        name = layers[j]
         colour = j % 6 + 1  # AutoCAD colour index 1..6
         for suffix in ("target", "chain", "joints"):
             document.layers.add(f"{name}-{suffix}", color=8 if suffix == "target" else colour)
@@ -624,8 +692,26 @@ def _svg_d(points: Points) -> str:
 
 
 def _dxf_layer_name(name: str) -> str:
-    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) become underscores."""
-    return "".join("_" if ch in _DXF_FORBIDDEN else ch for ch in name) or "profile"
+    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) and control characters become
+    underscores, leading and trailing spaces go."""
+    cleaned = "".join("_" if ch in _DXF_FORBIDDEN or ord(ch) < 32 or ord(ch) == 127 else ch for ch in name)
+    return cleaned.strip()[:200] or "profile"
+
+
+def _dxf_layer_names(names: Sequence[str]) -> list[str]:
+    """One distinct layer name per profile: DXF layer names ignore case, and :func:`_dxf_layer_name` can map two
+    names onto one, so a repeat gets ``-2``, ``-3``, ... appended."""
+    out: list[str] = []
+    taken: set[str] = set()
+    for name in names:
+        base = candidate = _dxf_layer_name(name)
+        number = 1
+        while candidate.casefold() in taken:
+            number += 1
+            candidate = f"{base}-{number}"
+        taken.add(candidate.casefold())
+        out.append(candidate)
+    return out
 
 
 _DXF_FORBIDDEN = frozenset('<>/\\":;?*|=`')
@@ -720,7 +806,23 @@ def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> P
     path = Path(path)
     fmt = _format_for(path)
     _check_readable(path)
-    return check_profile(fmt.read(path, tolerance), source=path)
+    if path.stat().st_size > MAX_PROFILE_BYTES:
+        raise SpecError(
+            f"is {path.stat().st_size} bytes, larger than the limit of {MAX_PROFILE_BYTES}; expected a profile",
+            source=str(path),
+        )
+    try:
+        points = fmt.read(path, tolerance)
+    except SpecError as exc:
+        if exc.source is None:
+            raise SpecError(str(exc), source=str(path), key=exc.key) from None
+        raise
+    except Exception as exc:  # a hostile file can make a third-party parser fail in many ways
+        raise SpecError(
+            f"could not be read as a {fmt.name} curve ({type(exc).__name__}: {escape_line(str(exc))[:200]})",
+            source=str(path),
+        ) from None
+    return check_profile(points, source=path)
 
 
 def save_profile(path: str | Path, points: ArrayLike) -> None:

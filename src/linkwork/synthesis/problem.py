@@ -178,9 +178,15 @@ def _name_rules(p: Problem) -> list[tuple[str, str]]:
     for index, name in enumerate(p.names):
         if len(name) > MAX_NAME_CHARS:
             return [(f"names[{index}]", f"expected at most {MAX_NAME_CHARS} characters, got {len(name)}")]
-    folded = [name.casefold() for name in p.names]
-    if len(set(folded)) != len(folded):
-        return [("names", "repeats a name (ignoring case); expected a different name for every profile")]
+        if any(ord(ch) < 32 or ord(ch) == 127 or ch in "\u2028\u2029" for ch in name):
+            return [
+                (
+                    f"names[{index}]",
+                    f"expected a name without line breaks or control characters, got {show(name)}",
+                )
+            ]
+    if len(set(p.names)) != len(p.names):
+        return [("names", "repeats a name; expected a different name for every profile")]
     return []
 
 
