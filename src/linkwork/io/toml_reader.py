@@ -23,10 +23,13 @@ from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
 
-__all__ = ["MAX_FILE_BYTES", "MAX_NAME_CHARS", "TomlReader", "closest", "key_path", "read_toml", "show"]
+__all__ = ["MAX_FILE_BYTES", "MAX_MAGNITUDE", "MAX_NAME_CHARS", "TomlReader", "closest", "key_path", "read_toml", "show"]
 
 MAX_FILE_BYTES = 16 * 1024 * 1024
 """The largest input file read (16 MiB); a larger one is refused with a message."""
+
+MAX_MAGNITUDE = 1e12
+"""The largest absolute value of a number in a file (a length, a coordinate, an angle)."""
 
 MAX_NAME_CHARS = 100
 """The longest name (of a joint, profile or linkage) accepted, in characters."""
@@ -266,6 +269,8 @@ class TomlReader:
             number = math.inf
         if not math.isfinite(number):
             raise self.error(key, f"expected a finite number, got {show(value)}")
+        if abs(number) > MAX_MAGNITUDE:
+            raise self.error(key, f"expected a number within +-{MAX_MAGNITUDE:g}, got {show(value)}")
         return number
 
     def vector(
@@ -296,9 +301,11 @@ class TomlReader:
         out = np.array([self.scalar(item, key_path(full, i)) for i, item in enumerate(value)])
         if nonzero:
             scale = float(np.max(np.abs(out)))
-            # Normalise before the norm so that a huge but finite direction does not overflow to inf.
-            if not scale > 0.0 or not np.isfinite(np.linalg.norm(out / scale)):
+            if not scale > 0.0:
                 raise self.error(full, f"expected a non-zero direction vector, got {show(value)}")
+            # Only the direction counts: scaled to a largest component of 1, its norm can neither overflow
+            # (a direction of 1e12s) nor underflow (one of 1e-300s).
+            return out / scale
         return out
 
     def string_list(
