@@ -23,7 +23,16 @@ from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
 
-__all__ = ["MAX_FILE_BYTES", "MAX_MAGNITUDE", "MAX_NAME_CHARS", "TomlReader", "closest", "key_path", "read_toml", "show"]
+__all__ = [
+    "MAX_FILE_BYTES",
+    "MAX_MAGNITUDE",
+    "MAX_NAME_CHARS",
+    "TomlReader",
+    "closest",
+    "key_path",
+    "read_toml",
+    "show",
+]
 
 MAX_FILE_BYTES = 16 * 1024 * 1024
 """The largest input file read (16 MiB); a larger one is refused with a message."""
