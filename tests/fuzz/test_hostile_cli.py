@@ -303,3 +303,25 @@ def test_mechanize_on_a_broken_chain_json(home: Path, content: bytes) -> None:
     run = run_cli(["mechanize", str(folder), "--no-plots"], out=folder, home=home)
     assert run.code == 2
     assert "chain.json" in run.stderr
+
+
+def test_mathtext_in_names_is_drawn_as_written(home: Path) -> None:
+    """matplotlib read "$x^$" in a joint or profile name as broken mathtext: a traceback instead of figures."""
+    file = home / "dollar.toml"
+    file.write_text(spec_text(name="$\\frac{$", joint="$x^$"), encoding="utf-8")
+    out = home / "trace-out"
+    run = run_cli(["trace", str(file), "--out", str(out), "--max-steps", "30"], out=out, home=home)
+    assert run.code == 0, run
+    assert (out / "angles.png").is_file() and (out / "sequence.png").is_file()
+    t = np.linspace(0.0, 1.0, 40)
+    save_profile(home / "a.csv", np.column_stack([t, 0.2 * t**2]))
+    save_profile(home / "b.csv", np.column_stack([1.2 * t, 0.3 * t**2]))
+    (home / "problem.toml").write_text(
+        'profiles = ["a.csv", "b.csv"]\npiece_length = 0.1\ndesign = "MC"\nstarts = 1\n'
+        'names = ["$\\\\frac{$", "$x^$"]\n',
+        encoding="utf-8",
+    )
+    out = home / "synth-out"
+    run = run_cli(["synth", "problem.toml", "--out", str(out)], out=out, home=home)
+    assert run.code == 0, run
+    assert (out / "profiles.png").is_file()

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.mechanization.chain import apply
+from linkwork.viz.labels import plain
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -116,7 +117,9 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
     for j, (ax, state) in enumerate(zip(axes, check.states, strict=True)):
         _draw(ax, found, mech, state.values, j, target=True)
         value = f"{math.degrees(state.drive_value):.2f} deg" if revolute else f"{state.drive_value:.4g}"
-        ax.set_title(f"profile {j + 1}: {design.drive} = {value}\nE_max = {state.e_max:.3g}", fontsize=9)
+        ax.set_title(
+            f"profile {j + 1}: {plain(str(design.drive))} = {value}\nE_max = {state.e_max:.3g}", fontsize=9
+        )
         ax.set_aspect("equal")
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
@@ -125,7 +128,7 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
         if j == 0:
             ax.set_ylabel("y")
             ax.legend(fontsize=7, loc="best")
-    fig.suptitle(f"{design.name}: DOF {check.dof}, drive {design.drive}", fontsize=10)
+    fig.suptitle(f"{plain(design.name)}: DOF {check.dof}, drive {plain(str(design.drive))}", fontsize=10)
     return fig
 
 

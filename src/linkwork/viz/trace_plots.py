@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from linkwork.kinematics.trace_result import Trace
+from linkwork.viz.labels import plain
 
 
 def _unwrap_branch(path: Trace, mask: np.ndarray) -> np.ndarray:
@@ -40,14 +41,14 @@ def plot_angles(path: Trace, file: Path) -> Path:
                 color=colors[j % len(colors)],
                 lw=2.2 - 0.3 * (j % len(styles)) if br.id == 0 else 0.8,
                 alpha=1.0 if br.id == 0 else 0.45,
-                label=f"θ{name}" if br.id == 0 else None,
+                label=f"θ{plain(name)}" if br.id == 0 else None,
             )
     for b in path.bifurcations:
         a = np.degrees(b.angles)
         ax.plot(np.full(len(a) - 1, a[d]), np.delete(a, d), "ko", ms=4)
-    ax.set_xlabel(f"θ{path.drive} (deg)")
+    ax.set_xlabel(f"θ{plain(str(path.drive))} (deg)")
     ax.set_ylabel("hinge angle (deg)")
-    title = f"{mech.name}: hinge angles"
+    title = f"{plain(mech.name)}: hinge angles"
     if len(path.branches) > 1:
         title += f" ({len(path.branches)} branches, {len(path.bifurcations)} bifurcation points ●)"
     ax.set_title(title, fontsize=10)
@@ -82,7 +83,7 @@ def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
     axes[0].set_ylim(0, None)
     for i in range(s.shape[1]):
         axes[1].semilogy(steps, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
-    axes[1].set_xlabel(f"step (θ{path.drive} from {x[0]:.4g}° to {x[-1]:.4g}°)")
+    axes[1].set_xlabel(f"step (θ{plain(str(path.drive))} from {x[0]:.4g}° to {x[-1]:.4g}°)")
     axes[1].set_ylim(1e-17, None)
     for ax in axes:
         ax.set_ylabel("singular value")
@@ -92,7 +93,7 @@ def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
             axes[0].axvline(b.step, color="k", lw=0.8, ls="--")
             axes[1].axvline(b.step, color="k", lw=0.8, ls="--")
     axes[1].legend(fontsize=8, ncol=2)
-    fig.suptitle(f"{mech.name}: singular values of the Jacobian along branch {branch}", fontsize=10)
+    fig.suptitle(f"{plain(mech.name)}: singular values of the Jacobian along branch {branch}", fontsize=10)
     fig.savefig(file, dpi=120)
     fig.savefig(Path(file).with_suffix(".svg"))
     plt.close(fig)
