@@ -325,3 +325,37 @@ def test_mathtext_in_names_is_drawn_as_written(home: Path) -> None:
     run = run_cli(["synth", "problem.toml", "--out", str(out)], out=out, home=home)
     assert run.code == 0, run
     assert (out / "profiles.png").is_file()
+
+
+@pytest.fixture
+def two_profile_chain(home: Path) -> Path:
+    """A `linkwork synth` output folder of a two-profile problem (its problem file beside it)."""
+    t = np.linspace(0.0, 1.0, 40)
+    save_profile(home / "a.csv", np.column_stack([t, 0.2 * t**2]))
+    save_profile(home / "b.csv", np.column_stack([1.2 * t, 0.3 * t**2]))
+    (home / "problem.toml").write_text(
+        'profiles = ["a.csv", "b.csv"]\npiece_length = 0.1\ndesign = "MC"\nstarts = 1\n', encoding="utf-8"
+    )
+    assert run_cli(["synth", "problem.toml", "--out", "chain", "--no-plots"], home=None).code == 0
+    return home / "chain"
+
+
+@pytest.mark.parametrize(
+    ("flags", "code", "fragment"),
+    [
+        (["--ground-region", "nan,0,1,2"], 2, "(finite numbers)"),
+        (["--min-transmission", "nan"], 2, "0 <= --min-transmission <= 90"),
+        (["--dof", "1000000"], 2, "1 <= --dof <= 20"),
+        (["--dof", "-1"], 2, "1 <= --dof <= 20"),
+        ([], 3, "needs at least three profiles, got 2"),  # was a ValueError traceback from the guidance
+    ],
+)
+def test_mechanize_flags_and_a_two_profile_chain(
+    home: Path, two_profile_chain: Path, flags: list[str], code: int, fragment: str
+) -> None:
+    out = home / "mech"
+    args = ["mechanize", str(two_profile_chain), "--problem", "problem.toml", "--no-plots", "--out", str(out)]
+    run = run_cli([*args, *flags], out=out, home=home)
+    assert run.code == code, run
+    assert fragment in run.stderr
+    assert not out.exists()

@@ -15,8 +15,9 @@ from typing import Annotated
 
 import typer
 
-from linkwork.cli.common import friendly_errors
+from linkwork.cli.common import check_range, friendly_errors
 from linkwork.errors import SpecError
+from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 
@@ -27,9 +28,15 @@ def _region(text: str | None) -> tuple[float, float, float, float] | None:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
         values = ()
-    if len(values) != 4 or values[0] >= values[2] or values[1] >= values[3]:
+    if (
+        len(values) != 4
+        or not all(math.isfinite(v) for v in values)
+        or values[0] >= values[2]
+        or values[1] >= values[3]
+    ):
         raise SpecError(
-            f"--ground-region {text!r}: expected XMIN,YMIN,XMAX,YMAX with XMIN < XMAX and YMIN < YMAX"
+            f"--ground-region {show(text)}: expected XMIN,YMIN,XMAX,YMAX (finite numbers) with XMIN < XMAX and "
+            "YMIN < YMAX"
         )
     return values
 
@@ -70,6 +77,8 @@ def mechanize(
     from linkwork.mechanization import MechanizeOptions
 
     check_output_folder(out or folder)
+    check_range("--dof", dof, 1, 20, "a whole number of degrees of freedom")
+    check_range("--min-transmission", min_transmission, 0.0, 90.0, "an angle in degrees", open_low=False)
     options = MechanizeOptions(
         dof=dof,
         drive=drive,

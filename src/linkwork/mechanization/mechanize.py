@@ -138,8 +138,11 @@ def mechanize(
         chain = build_chain(result)
         source = result.problem.source
         label = name or (f"{source.parent.name} mechanized" if source is not None else "mechanized chain")
-    if chain.count < 2:
-        raise MechanizationError("mechanize: needs at least two profiles to move between")
+    if chain.count < 3:
+        raise MechanizationError(
+            f"mechanize: needs at least three profiles, got {chain.count}: rigid-body guidance places each pivot "
+            "through three or more positions of a body (Sec. 7)"
+        )
     rejected: list[str] = []
     attempts = 0
     modes = ("ground", "any") if options.anchors == "auto" else (options.anchors,)
