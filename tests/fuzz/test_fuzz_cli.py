@@ -7,8 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from fuzzkit import FUZZ, HOSTILE_TEXT, run_cli
-from hypothesis import given
+from fuzzkit import EXAMPLES, FUZZ, HOSTILE_TEXT, run_cli
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from linkwork.io.spec import _import_builtins
@@ -54,3 +54,38 @@ def test_trace_with_generated_flags(home: Path, flags: list[tuple[str, str]]) ->
     for flag, value in flags:
         args += [flag, value]
     run_cli([*args, *budget] if "--max-steps" not in dict(flags) else args, out=out, home=home)
+
+
+SYNTH_EXAMPLES = max(3, EXAMPLES // 2)  # a synthesis takes about a second
+
+
+@settings(parent=FUZZ, max_examples=SYNTH_EXAMPLES)
+@given(names=st.lists(st.sampled_from(HOSTILE_TEXT), min_size=2, max_size=2),
+       design=st.sampled_from(['"MC"', '"auto"\nsegments = 2', '"CM"', '"mx"', "3"]),
+       extra=st.sampled_from(["", "merge_below = 179.9", "merge_below = nan", "seed = 4294967296", "starts = 0"]),
+       html=st.booleans())  # fmt: skip
+def test_synth_with_hostile_names_and_settings(
+    home: Path, names: list[str], design: str, extra: str, html: bool
+) -> None:
+    import json
+
+    import numpy as np
+
+    from linkwork.io.profiles import save_profile
+
+    folder = home / "problem"
+    folder.mkdir(exist_ok=True)
+    t = np.linspace(0.0, 1.0, 40)
+    save_profile(folder / "a.csv", np.column_stack([t, 0.2 * t**2]))
+    save_profile(folder / "b.csv", np.column_stack([1.3 * t, 0.3 * t**2]))
+    text = (
+        f'profiles = ["a.csv", "b.csv"]\npiece_length = 0.1\nstarts = 1\ndesign = {design}\n'
+        f"names = {json.dumps(names)}\n{extra}\n"
+    )
+    (folder / "problem.toml").write_text(text, encoding="utf-8")
+    out = home / "out"
+    args = ["synth", str(folder / "problem.toml"), "--out", str(out), "--no-plots"]
+    run = run_cli([*args, "--html"] if html else args, out=out, home=home)
+    if run.code == 0:
+        for name in names:
+            assert " ".join(name.split())[:20] in " ".join(run.stdout.split()) or len(name) > 100
