@@ -359,3 +359,14 @@ def test_mechanize_flags_and_a_two_profile_chain(
     assert run.code == code, run
     assert fragment in run.stderr
     assert not out.exists()
+
+
+def test_an_until_target_never_reached_is_exit_3_with_the_trace_kept(home: Path) -> None:
+    """--until A=1e300 exited 0 although the drive never got there; now exit 3, and what was traced is written."""
+    out = home / "out"
+    run = run_cli(
+        ["trace", "bennett", "--until", "A=1e300", "--steps", "10", "--no-plots", "--out", str(out)]
+    )
+    assert run.code == 3
+    assert "--until A=1e+300: not reached; branch 0 ended at A = 60 deg" in run.stderr
+    assert (out / "path.csv").is_file() and (out / "report.json").is_file()

@@ -15,6 +15,7 @@ from linkwork.cli.common import (
     friendly_errors,
     parse_assignments,
 )
+from linkwork.errors import RequestNotMetError
 from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console
 
@@ -165,3 +166,12 @@ def trace(
     print_trace_summary(path)
     written = ["path.csv", "report.json", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
+    if target is not None and not any(br.end_reason.startswith("reached target") for br in path.branches):
+        first = path.branches[0]
+        j = mech.index(target[0])
+        last = path.angles[path.of_branch(first.id)][-1, j]
+        shown = f"{np.degrees(last):.6g} deg" if mech.joint_types[j] == "R" else f"{last:.6g}"
+        raise RequestNotMetError(
+            f"--until {target[0]}={target[1]:g}: not reached; branch {first.id} ended at {target[0]} = {shown} "
+            f"({first.end_reason}); what was traced is in {out}/"
+        )
