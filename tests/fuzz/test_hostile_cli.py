@@ -271,20 +271,19 @@ def test_dxf_splines_with_too_few_control_points(home: Path, count: int) -> None
         '<path transform="scale(1e308)" d="M 0 0 L 10 10 L 20 0"/>',
         '<path d="M 0 0 A 1e300 1e300 0 0 1 1 1"/>',
         '<path d="M 0 0 C 1e200 1e200 -1e200 1e200 1 0"/>',
+        '<path d="M 1e300 0 Q 0 1e300 -1e300 0"/>',
     ],
 )
 def test_svg_with_huge_coordinates_or_transforms(home: Path, svg: str) -> None:
+    """OverflowError tracebacks (Bezier curves of 1e200s), or curves of 1e308 accepted; now one line."""
     from linkwork.errors import SpecError
     from linkwork.io.profiles import load_profile
 
     file = home / "huge.svg"
     file.write_text(f'<svg xmlns="http://www.w3.org/2000/svg">{svg}</svg>', encoding="utf-8")
-    try:
-        points = load_profile(file)
-    except SpecError as exc:
-        assert "\n" not in str(exc) and str(exc).startswith(str(file))
-    else:
-        assert np.all(np.isfinite(points)) and np.abs(points).max() <= 1e12
+    with pytest.raises(SpecError) as info:
+        load_profile(file)
+    assert "\n" not in str(info.value) and str(info.value).startswith(str(file))
 
 
 # ------------------------------------------------------------------------------------------- mechanize
