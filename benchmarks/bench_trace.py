@@ -182,8 +182,8 @@ def profile_hexagon(calls: int = 20, loops: int = 20000) -> dict[str, float]:
 
     from numba import njit
 
-    from linkwork.kinematics.bifurcation import Workspace
     from linkwork.kinematics.march import evaluate
+    from linkwork.kinematics.workspace import Workspace
 
     run = linkwork_paper_mode(6, couple=False)
     run()

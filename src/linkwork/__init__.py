@@ -4,7 +4,8 @@
   motion, find its bifurcation points and follow every branch.
 * Synthesise shape-changing planar mechanisms (Shamsudin et al. 2013): :func:`synthesize`.
 
-Radians inside the API; degrees in files, flags and printed tables.
+Radians everywhere in the Python API (built-in parameters of :func:`load` too); degrees in files, flags and
+printed tables.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from linkwork.kinematics.tracer import trace
 
 if TYPE_CHECKING:
     from linkwork.synthesis.problem import Problem
+    from linkwork.synthesis.result import SynthesisResult
 
 __version__ = "0.1.0"
 
@@ -54,24 +56,56 @@ def __getattr__(name: str) -> Any:
 
 
 def load(spec: str | pathlib.Path, **params: Any) -> Mechanism:
-    """A mechanism from a built-in name with its parameters (angles in DEGREES, as on the command line:
-    ``load("bennett", alpha1=45)``) or from a TOML spec file (``load("my.toml")``)."""
+    """A mechanism from a built-in name with its parameters, or from a TOML spec file (``load("my.toml")``).
+
+    Parameters are in API units like everything in the Python API: angles in RADIANS
+    (``load("bennett", alpha1=np.radians(45))``); only files, ``--set`` flags and printed tables use degrees.
+    ``linkwork linkages`` lists every built-in's parameters.
+    """
     from linkwork.io.spec import resolve_spec
 
-    return resolve_spec(spec, params).mechanism
+    return resolve_spec(spec, _file_units(spec, params)).mechanism
 
 
-def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> Any:
+def _file_units(spec: str | pathlib.Path, params: dict[str, Any]) -> dict[str, Any]:
+    """Built-in parameters converted from API units (radians) to the file units ``resolve_spec`` reads."""
+    if not params or isinstance(spec, pathlib.Path) or pathlib.Path(spec).suffix.lower() == ".toml":
+        return params
+    import math
+
+    from linkwork.io.spec import _import_builtins
+    from linkwork.linkages.registry import REGISTRY, get
+
+    _import_builtins()
+    if str(spec).replace("_", "-").lower() not in REGISTRY:
+        return params  # a file name without .toml, or an unknown name: resolve_spec says which
+    entry = get(str(spec))
+    out = dict(params)
+    for key, value in params.items():
+        param = entry.params.get(key)
+        if (
+            param is not None
+            and param.unit == "deg"
+            and isinstance(value, int | float)
+            and not isinstance(value, bool)
+        ):
+            out[key] = math.degrees(value)
+    return out
+
+
+def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> SynthesisResult:
     """Synthesise a chain of rigid links that approximates every design profile of ``problem``.
 
-    ``problem`` is a :class:`linkwork.synthesis.problem.Problem` or the path of a problem TOML file.
+    ``problem`` is a :class:`linkwork.synthesis.problem.Problem`, the path of a problem TOML file, or the name of
+    a bundled example (``"wing"``, see :data:`linkwork.data.EXAMPLES`).
     """
     from linkwork.synthesis.problem import Problem as _Problem
 
     if not isinstance(problem, _Problem):
+        from linkwork.data import problem_file
         from linkwork.io.problem import load_problem
 
-        problem = load_problem(pathlib.Path(problem))
+        problem = load_problem(problem_file(problem))
     from linkwork.synthesis import synthesize as _synthesize
 
     return _synthesize(problem, **kwargs)

@@ -1,5 +1,5 @@
-"""``linkwork trace``, ``linkages`` and ``show``: the contract files (DESIGN.md, "Contract: commands and
-outputs"), the paper's deployment of the six-rod Hedgepeth hoop, and bad input as one line with exit code 2.
+"""``linkwork trace``, ``linkages`` and ``show``: the contract files (docs/architecture.md, "Contracts":
+commands and outputs), the paper's deployment of the six-rod Hedgepeth hoop, and bad input as one line with exit code 2.
 
 References come from the paper: the deployed angle of the n = 6 hoop, theta_A = 87.0067 deg (Eq. 10), the
 symmetry A = C = E, B = D = F along its whole path (Sec. 5), rank 5 and mobility 1, no bifurcation, and the
@@ -138,11 +138,13 @@ def test_report_lists_the_single_branch_that_reached_its_target(adaptive: Path) 
     assert branch["end_reason"] == "reached target"
 
 
-def test_max_condition_is_the_largest_ratio_of_the_csv_singular_values(paper: Path) -> None:
+def test_max_condition_raw_is_the_largest_ratio_of_the_csv_singular_values(paper: Path) -> None:
     report = json.loads((paper / "report.json").read_text())
     _, col = read_csv(paper / "path.csv")
     ratio = col["sigma_1"] / col["sigma_5"]  # rank 5: sigma_5 is the smallest non-zero one
-    assert report["max_condition"] == pytest.approx(ratio.max(), rel=1e-12)
+    assert report["max_condition_raw"] == pytest.approx(ratio.max(), rel=1e-12)
+    # max_condition is the same ratio on the normalised Jacobian (frame and unit free): finite, >= 1.
+    assert 1.0 <= report["max_condition"] < 1e3
 
 
 # ------------------------------------------------------------------------------------------------- figures
@@ -247,6 +249,11 @@ BAD_INPUT = {
     "missing spec file": (lambda t: ["trace", str(t / "missing.toml")], "not found"),
     "TOML syntax error": (lambda t: ["trace", bad_toml(t)], "line 2"),
     "--steps without --until": (lambda t: ["trace", "hedgepeth", "--steps", "10"], "until"),
+    "--limit without a colon": (lambda t: ["trace", "hedgepeth", "--limit", "A=10"], "JOINT=LO:HI"),
+    "--limit empty range": (lambda t: ["trace", "hedgepeth", "--limit", "A=10:5"], "LO < HI"),
+    "--limit unknown joint": (lambda t: ["trace", "hedgepeth", "--limit", "Z=0:10"], "'Z'"),
+    "--limit excluding the start": (lambda t: ["trace", "hedgepeth", "--limit", "A=10:20"], "outside"),
+    "--closure-tol not positive": (lambda t: ["trace", "hedgepeth", "--closure-tol", "0"], "--closure-tol"),
 }
 
 
@@ -317,3 +324,101 @@ def test_help_lists_every_command() -> None:
     assert result.exit_code == 0
     for command in ("trace", "linkages", "show", "synth", "demo"):
         assert re.search(rf"^\W*{command}\b", ANSI.sub("", result.stdout), re.MULTILINE), command
+
+
+# ------------------------------------------------------------------- requests that cannot be met, limits (issue 9)
+
+FOUR_BAR = str(Path(__file__).resolve().parents[2] / "examples" / "specs" / "four-bar.toml")
+
+
+def rocker_range_deg() -> tuple[float, float]:
+    """Range of the four-bar's rocker joint D from its start, by the law of cosines in triangle A-C-D at the two
+    positions where crank (sqrt 2) and coupler (|BC|) are collinear (|AC| = |BC| -/+ sqrt 2)."""
+    ground, rocker, coupler = 4.0, float(np.hypot(0.5, 3.0)), float(np.hypot(2.5, 2.0))
+
+    def at_d(ac: float) -> float:
+        return float(np.degrees(np.arccos((ground**2 + rocker**2 - ac**2) / (2 * ground * rocker))))
+
+    start = at_d(float(np.hypot(3.5, 3.0)))
+    return at_d(coupler - np.sqrt(2.0)) - start, at_d(coupler + np.sqrt(2.0)) - start
+
+
+def test_unreachable_target_exits_3_with_one_line_and_writes_the_path(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", FOUR_BAR, "--until", "D=-95", "--no-plots", "--out", str(out))
+    assert result.exit_code == 3
+    lo, hi = rocker_range_deg()
+    assert_one_error_line(
+        result.stderr, f"D never reaches -95.00 deg on this path: its range is [{lo:.2f}, {hi:.2f}] deg"
+    )
+    report = json.loads((out / "report.json").read_text())
+    assert report["target_reached"] is False and report["unmet"].startswith("D never reaches")
+    branch = report["branches"][0]
+    assert branch["end_reason"] == "closed path" and branch["mobility"] == 1
+    np.testing.assert_allclose(branch["range"]["D"], [lo, hi], atol=1e-7)  # the folds of the drive count
+    assert branch["range"]["A"] == pytest.approx([45.0, 405.0], abs=1e-9)  # the crank turned once
+    _, col = read_csv(out / "path.csv")
+    assert len(col["D"]) == branch["steps"] + 1
+
+
+def test_limit_ends_the_branch_on_the_limit_and_is_reported(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", FOUR_BAR, "--limit", "D=-5:30", "--no-plots", "--out", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["branches"][0]["end_reason"] == "limit D"
+    assert report["branches"][0]["range"]["D"][0] == pytest.approx(-5.0, abs=1e-9)
+    assert report["target_reached"] is None
+
+
+def test_report_states_the_closure_tolerance_and_the_largest_misfit(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", FOUR_BAR, "--closure-tol", "1e-9", "--no-plots", "--out", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["closure_tol"] == 1e-9
+    assert report["max_misfit"] == pytest.approx(report["max_residual"]) and report["max_misfit"] <= 1e-9
+
+
+def test_trace_help_documents_the_exit_codes_and_new_flags() -> None:
+    result = invoke("trace", "--help")
+    text = ANSI.sub("", result.stdout)
+    assert result.exit_code == 0
+    for fragment in (
+        "Exit codes",
+        "0 done as asked",
+        "2 bad input",
+        "3 the request",
+        "--limit",
+        "--closure-tol",
+    ):
+        assert fragment in " ".join(text.split()), fragment
+
+
+def rounded_bennett(tmp_path: Path) -> Path:
+    """examples/specs/bennett-hinge-lines.toml with every number rounded to 6 decimals: a rigid loop, strictly."""
+    text = (
+        Path(__file__).resolve().parents[2] / "examples" / "specs" / "bennett-hinge-lines.toml"
+    ).read_text()
+    rounded = re.sub(r"-?\d+\.\d{7,}", lambda m: f"{float(m.group()):.6f}", text)
+    file = tmp_path / "bennett-rounded.toml"
+    file.write_text(rounded)
+    return file
+
+
+def test_rounded_hinge_lines_are_refused_then_traced_within_the_closure_tolerance(tmp_path: Path) -> None:
+    spec = str(rounded_bennett(tmp_path))
+    refused = invoke("trace", spec, "--no-plots", "--out", str(tmp_path / "strict"))
+    assert refused.exit_code == 2
+    assert_one_error_line(refused.stderr, "--closure-tol")
+    out = tmp_path / "out"
+    result = invoke("trace", spec, "--closure-tol", "1e-5", "--no-plots", "--out", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["branches"][0]["end_reason"] == "closed path"
+    assert report["closure_tol"] == 1e-5 and 1e-9 < report["max_misfit"] <= 1e-5
+    # Bennett's closed form (alpha 45/75 deg): tan(A/2) tan(B/2) = k, to the order of the rounding
+    _, col = read_csv(out / "path.csv")
+    a, b = np.radians(col["A"]) / 2, np.radians(col["B"]) / 2
+    k = np.sin(np.radians(60.0)) / np.sin(np.radians(15.0))
+    assert np.max(np.abs(np.sin(a) * np.sin(b) - k * np.cos(a) * np.cos(b))) < 1e-4

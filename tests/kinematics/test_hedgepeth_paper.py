@@ -117,7 +117,7 @@ def test_hexagon_stays_threefold_symmetric_without_assuming_it() -> None:
 
 
 def test_large_hoops_need_and_get_the_paper_symmetry() -> None:
-    # n >= 8: mobility n - 5 at the bundle without symmetry (DESIGN.md); the n/2-fold coupling leaves one.
+    # n >= 8: mobility n - 5 at the bundle without symmetry (docs/linkages.md); the n/2-fold coupling leaves one.
     free = hedgepeth(8, couple=False)
     from linkwork.kinematics.closure import jacobian
     from linkwork.kinematics.rank import numerical_rank

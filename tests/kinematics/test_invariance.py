@@ -1,6 +1,6 @@
 """A traced path belongs to the linkage, not to how it is written down; the derivatives are what they claim.
 
-Invariances (DESIGN.md, "Testing"): the same Bennett linkage (from DH parameters) and the same Hedgepeth hoop
+Invariances (docs/architecture.md): the same Bennett linkage (from DH parameters) and the same Hedgepeth hoop
 (n = 6, the paper's Eqs. 7-12) traced after
 
 * relabelling the loop's first joint (the loop product becomes a conjugate ``g^-1 P g``),

@@ -88,7 +88,7 @@ def test_two_loop_watt_six_bar_has_mobility_one_and_stays_closed() -> None:
     # Link lengths are preserved: distance O1-A and A-B computed by moving the points with the body poses.
     from linkwork.kinematics.closure import body_poses
 
-    poses = body_poses(mech, path.angles[-1])
+    poses = body_poses(mech, angles=path.angles[-1])
 
     def moved(body: str, name: str) -> np.ndarray:
         return (poses[body] @ np.array([*P[name], 0.0, 1.0]))[:2]

@@ -40,7 +40,7 @@ def picture_frame(n: int) -> list[np.ndarray]:
 
 def traced_frames(n: int, angles: np.ndarray) -> list[np.ndarray]:
     mech = hedgepeth_rods(n)
-    poses = body_poses(mech, mech.q_from_angles(angles))
+    poses = body_poses(mech, angles=angles)
     return [poses[f"link{i}"] @ rod_frame(n, i) for i in range(n)]
 
 

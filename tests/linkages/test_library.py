@@ -50,7 +50,7 @@ def shift(x: float, z: float) -> np.ndarray:
 
 
 def dh_product(thetas: Sequence[float], links: Sequence[tuple[float, float, float]]) -> np.ndarray:
-    """``prod Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` for links ``(d, a, alpha)`` (DESIGN.md convention)."""
+    """``prod Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` for links ``(d, a, alpha)`` (the spec file convention, docs/spec-format.md)."""
     g = np.eye(4)
     for t, (d, a, al) in zip(thetas, links, strict=True):
         g = g @ rz(t) @ shift(0.0, d) @ shift(a, 0.0) @ rx(al)
@@ -333,7 +333,7 @@ def test_goldberg_links_come_from_two_bennett_loops() -> None:
 def test_sarrus_top_plate_translates_along_the_common_perpendicular() -> None:
     mech = sarrus_module.sarrus()
     for q in step_along(mech, steps=10, size=0.05):
-        poses = body_poses(mech, q)
+        poses = body_poses(mech, q=q)
         relative = np.linalg.inv(poses["link2"]) @ poses["link5"]  # top plate seen from the bottom plate
         assert np.max(np.abs(relative[:3, :3] - np.eye(3))) < 1e-12
         assert np.max(np.abs(relative[:2, 3])) < 1e-12

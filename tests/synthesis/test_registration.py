@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from linkwork.geometry.fit import register
 from linkwork.synthesis.frames import rotation, to_local_frame
-from linkwork.synthesis.registration import register
 
 # Umeyama (1991), Sec. IV: x = (0,0), (1,0), (0,2) mapped onto y = (0,0), (-1,0), (0,2) (here in the order of
 # the brief: reference (0,2), (0,0), (-1,0); sensed (0,2), (0,0), (1,0)).

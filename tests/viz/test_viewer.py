@@ -94,7 +94,7 @@ def test_poses_are_the_cores_body_poses(guest_path: lw.Trace, guest_page: Path) 
     poses = unpack(data["poses"])
     mech = guest_path.mechanism
     for i in (0, 500, len(guest_path.branch) - 1):
-        ref = body_poses(mech, mech.q_from_angles(guest_path.angles[i]))
+        ref = body_poses(mech, angles=guest_path.angles[i])
         for b, name in enumerate(mech.bodies):
             np.testing.assert_allclose(poses[i, b, :9].reshape(3, 3), ref[name][:3, :3], rtol=0, atol=F32)
             np.testing.assert_allclose(poses[i, b, 9:], ref[name][:3, 3], rtol=0, atol=F32)

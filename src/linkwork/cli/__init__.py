@@ -6,14 +6,14 @@ stays fast.
 
 from __future__ import annotations
 
+import logging
 import sys
 from collections.abc import Sequence
-from typing import Any
+from typing import Annotated, Any
 
 import typer
-from typer.core import TyperGroup
 
-from linkwork.cli import demo, linkages, mechanize, synth, trace
+from linkwork.cli import demo, help, linkages, mechanize, robustness, sweep, synth, trace
 from linkwork.cli.common import fail
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -21,8 +21,14 @@ try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
 except ImportError:  # pragma: no cover - older typer uses click itself
     from click import exceptions as click_exceptions  # type: ignore[no-redef]
 
+EXIT_CODES = (
+    "Exit codes: 0 done as asked; 2 bad input (one line on stderr names the file, key or flag and what was "
+    "expected); 3 the request could not be met (target not reached, no design or mechanism passes): one line "
+    "says why, and everything computed so far is written."
+)
 
-class OneLineErrors(TyperGroup):
+
+class OneLineErrors(help.Group):
     """The command group, with click's usage errors (an unknown flag, a value of the wrong type) printed as the
     one ``error:`` line and exit code 2 that every other bad input gets, instead of click's framed usage box."""
 
@@ -52,19 +58,60 @@ class OneLineErrors(TyperGroup):
 
 
 app = typer.Typer(
-    cls=OneLineErrors,
     name="linkwork",
     help="Kinematics of shape-changing mechanisms: trace closed-loop linkages, synthesise shape-changing chains.",
+    epilog=EXIT_CODES,
+    cls=OneLineErrors,
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-app.command("trace")(trace.trace)
-app.command("linkages")(linkages.linkages)
-app.command("show")(linkages.show)
-app.command("synth")(synth.synth)
-app.command("mechanize")(mechanize.mechanize)
-app.command("demo")(demo.demo)
+app.command("trace", cls=help.Command)(trace.trace)
+app.command("linkages", cls=help.Command)(linkages.linkages)
+app.command("show", cls=help.Command)(linkages.show)
+app.command("synth", cls=help.Command)(synth.synth)
+app.command("mechanize", cls=help.Command)(mechanize.mechanize)
+app.command("demo", cls=help.Command)(demo.demo)
+app.command("robustness", cls=help.Command)(robustness.robustness)
+app.command("sweep", cls=help.Command)(sweep.sweep)
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from linkwork import __version__
+
+        typer.echo(f"linkwork {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_print_version, is_eager=True, help="Print linkwork's version and exit."
+        ),
+    ] = False,
+) -> None:
+    """Kinematics of shape-changing mechanisms: trace closed-loop linkages, synthesise shape-changing chains."""
+    _announce_kernels()
+
+
+def _announce_kernels() -> None:
+    """Print the kernel announcements (``compiling kernels, first run only``) on stderr, once."""
+    log = logging.getLogger("linkwork.jit")
+    if not any(isinstance(h, _StderrNote) for h in log.handlers):
+        log.addHandler(_StderrNote())
+        log.setLevel(logging.INFO)
+
+
+class _StderrNote(logging.Handler):
+    """A logging handler that prints a record as one ``note:`` line on stderr."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        from linkwork.cli.common import err_console
+
+        err_console.print(f"note: {record.getMessage()}", highlight=False, soft_wrap=True)
 
 
 def main() -> None:

@@ -15,7 +15,7 @@ from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 @friendly_errors
 def demo(
-    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("linkwork-demo"),
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("linkwork-demo"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
 ) -> None:
     """Deploy Hedgepeth's hexagon from the bundle to the flat hexagon (Figs. 12-13), follow Guest's frame

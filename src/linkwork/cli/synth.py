@@ -24,7 +24,7 @@ def synth(
         Path,
         typer.Argument(
             help="Problem file (TOML): type, profiles, piece_length, min_pieces, design, starts, merge_below "
-            "(degrees), seed. See docs/synthesis.md.",
+            "(degrees), seed; or a bundled example by name (wing, closed, fixed-end, seat). See docs/synthesis.md.",
             show_default=False,
         ),
     ],
@@ -54,7 +54,9 @@ def synth(
     check_output_folder(out, ["chain.json", "target_profiles.csv", "outline.svg", "outline.dxf"])
     if search not in ("paper", "refined"):
         raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")
-    spec = load_problem(problem)
+    from linkwork.data import problem_file
+
+    spec = load_problem(problem_file(problem))
     with Progress(
         TextColumn("[bold]synthesising[/]"),
         BarColumn(),

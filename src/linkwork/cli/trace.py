@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.text import Text
@@ -25,6 +25,13 @@ MAX_STEP_DEG = 90.0
 MAX_TRACE_STEPS = 1_000_000
 """The largest step budget ``--max-steps`` (and ``--steps``): a bound on time and memory."""
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from linkwork.io.spec import LoadedSpec
+    from linkwork.kinematics.mechanism import Mechanism
+    from linkwork.kinematics.trace_result import Trace
+
 
 def _parse_until(text: str | None) -> tuple[str, float] | None:
     if text is None:
@@ -37,6 +44,30 @@ def _parse_until(text: str | None) -> tuple[str, float] | None:
     if not sep or not name.strip() or not math.isfinite(value):
         raise fail(f"--until {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
     return name.strip(), value
+
+
+def _parse_limits(items: list[str] | None) -> dict[str, tuple[float, float]]:
+    """``--limit J=LO:HI`` items as ``{joint: (lo, hi)}`` in file units (degrees, or lengths)."""
+    out: dict[str, tuple[float, float]] = {}
+    for item in items or []:
+        name, sep, span = item.partition("=")
+        lo_text, colon, hi_text = span.partition(":")
+        try:
+            lo, hi = float(lo_text), float(hi_text)
+        except ValueError:
+            lo = hi = float("nan")
+        if (
+            not sep
+            or not colon
+            or not name.strip()
+            or not (math.isfinite(lo) and math.isfinite(hi))
+            or lo >= hi
+        ):
+            raise fail(
+                f"--limit {item!r}: expected JOINT=LO:HI with LO < HI (degrees, or lengths), e.g. D=-140:-100"
+            )
+        out[name.strip()] = (lo, hi)
+    return out
 
 
 def _parse_couple(items: list[str] | None) -> list[list[str]]:
@@ -82,7 +113,22 @@ def trace(
     branches: Annotated[
         bool, typer.Option("--branches", help="Follow every branch at every bifurcation.")
     ] = False,
-    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out"),
+    limit: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="Joint limit JOINT=LO:HI (degrees, or lengths for a prismatic joint); a branch passing it ends "
+            "with the reason 'limit JOINT'. Repeatable.",
+            show_default=False,
+        ),
+    ] = None,
+    closure_tol: Annotated[
+        float,
+        typer.Option(
+            help="Accept a least-squares closure within this misfit (play in the hinges), for a loop whose "
+            "link parameters are slightly inconsistent; report.json states it and the largest misfit met.",
+        ),
+    ] = 1e-12,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
     animate: Annotated[
         bool,
@@ -98,10 +144,14 @@ def trace(
         ),
     ] = False,
 ) -> None:
-    """Trace a closed-loop linkage: path.csv, report.json and figures in --out."""
+    """Trace a closed-loop linkage: path.csv, report.json and figures in --out.
+
+    Exit codes: 0 done as asked; 2 bad input (one line saying which file, key or flag and what was expected);
+    3 the request could not be met (the --until target is never reached on the path: its range is printed),
+    after path.csv, report.json and the figures of what was traced are written.
+    """
     import numpy as np
 
-    from linkwork.io.spec import resolve_spec
     from linkwork.kinematics.tracer import trace as run_trace
 
     check_output_folder(out, ["path.csv", "report.json"])
@@ -111,10 +161,14 @@ def trace(
         check_range("--steps", steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
     params = parse_assignments(set_, "--set")
     target = _parse_until(until)
-    loaded = resolve_spec(spec, params)
+    limits_file = _parse_limits(limit)
+    if not (math.isfinite(closure_tol) and closure_tol > 0):
+        raise fail(f"--closure-tol {closure_tol}: expected a positive number")
+    loaded = _load(spec, params, closure_tol)
     mech = loaded.mechanism
     if couple or fixed:
         mech = mech.with_couplings(_parse_couple(couple), fixed or [])
+    limits = _limits_in_api_units(mech, limits_file)
     until_rad = None
     if target is not None:
         j = mech.index(target[0])
@@ -132,9 +186,49 @@ def trace(
             f"start corrected onto the loop: residual {loaded.assembly.residual_before:.2e} -> "
             f"{loaded.assembly.residual_after:.2e}, joints moved by up to {worst:.3g} deg"
         )
+    path = _run_with_progress(
+        run_trace, mech, total=steps if steps is not None else max_steps, drive=drive, until=until_rad,
+        steps=steps, max_step=float(np.radians(max_step)), max_steps=max_steps, branches=branches, limits=limits,
+        closure_tol=closure_tol,
+    )  # fmt: skip
+    from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
+
+    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
+    print_trace_summary(path)
+    written = ["path.csv", "report.json", *[f.name for f in figures]]
+    console.print(f"wrote {', '.join(written)} to {out}/")
+    if "unmet" in path.stats:
+        raise RequestNotMetError(str(path.stats["unmet"]))
+
+
+def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:
+    """The spec, assembled accepting a closure misfit within ``closure_tol`` (play in the hinges)."""
+    from linkwork.io.spec import resolve_spec
+
+    return resolve_spec(spec, params, closure_tol=closure_tol)
+
+
+def _limits_in_api_units(
+    mech: Mechanism, limits_file: dict[str, tuple[float, float]]
+) -> dict[str, tuple[float, float]]:
+    """``--limit`` values (degrees, or lengths) in the API's units (radians), each checked against the start."""
+    import numpy as np
+
+    limits = {}
+    for name, (lo, hi) in limits_file.items():
+        j = mech.index(name)
+        scale = np.radians(1.0) if mech.joint_types[j] == "R" else 1.0
+        start = float(mech.offsets[j] / scale)
+        if not lo <= start <= hi:
+            raise fail(f"--limit {name}={lo:g}:{hi:g}: the start value {start:.6g} of {name} is outside it")
+        limits[name] = (float(lo * scale), float(hi * scale))
+    return limits
+
+
+def _run_with_progress(run: Callable[..., Trace], mech: Mechanism, total: int, **options: Any) -> Trace:
+    """``run(mech, **options, progress=...)`` with a progress bar on a terminal (none otherwise)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    total = steps if steps is not None else max_steps
     with Progress(
         TextColumn("tracing"),
         BarColumn(),
@@ -150,28 +244,4 @@ def trace(
         def report(done: float, what: str) -> None:
             progress.update(task, advance=done, description=what)
 
-        path = run_trace(
-            mech,
-            drive=drive,
-            until=until_rad,
-            steps=steps,
-            max_step=float(np.radians(max_step)),
-            max_steps=max_steps,
-            branches=branches,
-            progress=report,
-        )
-    from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
-
-    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
-    print_trace_summary(path)
-    written = ["path.csv", "report.json", *[f.name for f in figures]]
-    console.print(f"wrote {', '.join(written)} to {out}/")
-    if target is not None and not any(br.end_reason.startswith("reached target") for br in path.branches):
-        first = path.branches[0]
-        j = mech.index(target[0])
-        last = path.angles[path.of_branch(first.id)][-1, j]
-        shown = f"{np.degrees(last):.6g} deg" if mech.joint_types[j] == "R" else f"{last:.6g}"
-        raise RequestNotMetError(
-            f"--until {target[0]}={target[1]:g}: not reached; branch {first.id} ended at {target[0]} = {shown} "
-            f"({first.end_reason}); what was traced is in {out}/"
-        )
+        return run(mech, **options, progress=report)

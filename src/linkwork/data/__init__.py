@@ -27,3 +27,17 @@ def example(name: str = "wing", file: str = "problem.toml") -> Path:
     if not path.is_file():
         raise SpecError(f"the bundled example is missing ({path}); reinstall linkwork", key="example")
     return path
+
+
+def problem_file(spec: str | Path) -> Path:
+    """The problem file that ``spec`` names: an existing file as it is, else a bundled example's problem file by
+    name (``"wing"``), as built-in linkages are found by name; a name that is neither is a :class:`SpecError`."""
+    path = Path(spec)
+    if path.exists():
+        return path
+    if str(spec) in EXAMPLES:
+        return example(str(spec))
+    expected = "a problem file (TOML)"
+    if not path.suffix and len(path.parts) == 1:  # a bare name: perhaps a misspelt example
+        expected += f" or a bundled example ({', '.join(EXAMPLES)})"
+    raise SpecError(f"{spec}: file not found; expected {expected}")

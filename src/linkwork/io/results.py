@@ -1,7 +1,7 @@
 """Result files of a trace: ``path.csv`` (one row per traced point) and ``report.json`` (the summary).
 
 Angles are written in degrees (prismatic joints in length units); the column and key names are a contract
-(DESIGN.md, "Contract: commands and outputs").
+(docs/architecture.md, "Contracts").
 """
 
 from __future__ import annotations
@@ -56,6 +56,20 @@ def write_path_csv(path: Trace, file: Path) -> None:
             writer.writerow([f"{v:.17g}" if isinstance(v, float) else v for v in row])
 
 
+def branch_range(path: Trace, branch: int) -> dict[str, list[float]]:
+    """``{joint: [min, max]}`` over one branch, in file units (degrees, or lengths for prismatic joints); the
+    located folds of the drive count, so the drive's range is exact to ``Tolerances.locate``."""
+    on_branch = [
+        path.angles[path.branch == branch],
+        *[f.angles[None, :] for f in path.folds if f.branch == branch],
+    ]
+    values = _display(path, np.concatenate(on_branch))
+    return {
+        name: [float(values[:, j].min()), float(values[:, j].max())]
+        for j, name in enumerate(path.mechanism.joint_names)
+    }
+
+
 def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
     """The content of ``report.json``."""
     mech = path.mechanism
@@ -86,7 +100,12 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         },
         "points": len(path.branch),
         "max_residual": float(path.residual.max()),
+        "closure_tol": float(path.stats.get("closure_tol", 1e-12)),
+        "max_misfit": float(path.stats.get("max_misfit", path.residual.max())),
+        "target_reached": ("unmet" not in path.stats) if path.stats.get("has_target") else None,
+        "unmet": path.stats.get("unmet"),
         "max_condition": path.max_condition,
+        "max_condition_raw": path.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
         "bifurcations": [
             {
@@ -100,8 +119,20 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
                 "method": b.method,
                 "residual": b.residual,
                 "accuracy": b.bracket,
+                "kind": b.kind,
+                "dimension": b.dimension,
             }
             for b in path.bifurcations
+        ],
+        "folds": [
+            {
+                "branch": f.branch,
+                "step": f.step,
+                "drive": path.drive,
+                "value": float(_display(path, f.angles)[mech.index(path.drive)]),
+                "angles": dict(zip(names, map(float, _display(path, f.angles)), strict=True)),
+            }
+            for f in path.folds
         ],
         "branches": [
             {
@@ -111,6 +142,8 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
                 "direction": br.direction,
                 "steps": br.steps,
                 "end_reason": br.end_reason,
+                "mobility": br.mobility,
+                "range": branch_range(path, br.id),
                 "start": dict(
                     zip(names, map(float, _display(path, path.angles[path.branch == br.id][0])), strict=True)
                 ),
@@ -126,6 +159,8 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         out["assembly"] = {
             "residual_before": float(assembly.residual_before),
             "residual_after": float(assembly.residual_after),
+            "misfit": float(getattr(assembly, "misfit", assembly.residual_after)),
+            "closure_tol": float(getattr(assembly, "closure_tol", 1e-12)),
             "correction_deg": dict(zip(names, map(float, np.degrees(assembly.correction)), strict=True)),
         }
     return out

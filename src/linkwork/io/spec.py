@@ -10,7 +10,7 @@ file, the key path and what was expected, for example
 Two forms (see ``docs/spec-format.md`` for every key):
 
 * ``[loop]``: one closed loop of revolute joints in loop order, in the ``dh``, ``hinge-lines`` or ``rods``
-  convention (DESIGN.md, "Contract: linkage spec file");
+  convention (docs/spec-format.md; docs/architecture.md, "Contracts");
 * ``[mechanism]``: joints between named bodies, each a revolute (``R``) or prismatic (``P``) joint on a
   line in the start configuration; the loops are a cycle basis of the body graph, ``planar = true`` keeps
   the three planar closure equations per loop.
@@ -52,6 +52,7 @@ from linkwork.geometry.names import default_joint_name
 from linkwork.io.toml_reader import MAX_NAME_CHARS, TomlReader, closest, key_path, read_toml, show
 from linkwork.kinematics.chains import Assembly, from_dh, from_rods
 from linkwork.kinematics.mechanism import Array, Mechanism
+from linkwork.kinematics.normalization import near_mobility
 
 __all__ = ["CONVENTIONS", "LoadedSpec", "dump_spec", "load_spec", "resolve_spec"]
 
@@ -133,13 +134,16 @@ class LoadedSpec:
 
 # ----------------------------------------------------------------------------------------------------------
 # reading
-def load_spec(path: str | Path) -> LoadedSpec:
+def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     """Read a linkage spec file (TOML) into an assembled mechanism.
 
     Parameters
     ----------
     path
         The spec file.
+    closure_tol
+        The largest least-squares closure misfit accepted when a ``dh`` or ``rods`` loop is assembled (play in
+        the hinges); it is recorded in :attr:`LoadedSpec.assembly`.
 
     Returns
     -------
@@ -154,8 +158,9 @@ def load_spec(path: str | Path) -> LoadedSpec:
         duplicate joint names, an unknown joint in ``couple``/``fixed``, both or neither of ``[loop]`` and
         ``[mechanism]``, a joint connecting a body to itself, or bodies not connected to the rest.
     AssemblyError
-        The start configuration of a ``dh`` or ``rods`` loop cannot be closed; the message starts with the
-        file.
+        The start configuration of a ``dh`` or ``rods`` loop cannot be closed, or its link parameters close no
+        loop within ``closure_tol`` (misfit, smallest singular value and joints named); the message starts with
+        the file.
     """
     path = Path(path)
     source = str(path)
@@ -178,7 +183,7 @@ def load_spec(path: str | Path) -> LoadedSpec:
     meta = {"source": source}
     try:
         if has_loop:
-            mech, assembly, couplings = _read_loop(reader, table["loop"], name, meta)
+            mech, assembly, couplings = _read_loop(reader, table["loop"], name, meta, closure_tol)
         else:
             mech, couplings = _read_mechanism(reader, table["mechanism"], name, meta)
             assembly = None
@@ -187,10 +192,29 @@ def load_spec(path: str | Path) -> LoadedSpec:
     couple, fixed = couplings
     if couple or fixed:
         mech = mech.with_couplings(couple, fixed)
+    if assembly is None:
+        _check_not_near_mobile(mech, source, closure_tol)
     return LoadedSpec(mechanism=mech, assembly=assembly, source=path)
 
 
-def resolve_spec(spec: str | Path, params: Mapping[str, Any] | None = None) -> LoadedSpec:
+def _check_not_near_mobile(mech: Mechanism, source: str, closure_tol: float) -> None:
+    """Hinge lines a rounding away from a mobile linkage: one line with the numbers, unless within tolerance."""
+    near = near_mobility(mech)
+    if near is None or near.misfit <= closure_tol:
+        return
+    raise AssemblyError(
+        f"{source}: {mech.name}: the joint lines are rigid by a hair, not mobile: smallest singular value "
+        f"{near.relative:.3g} of the largest (normalised Jacobian), a closure misfit of {near.misfit:.3g} per "
+        f"radian of the near-motion of joints {', '.join(near.joints)} > closure tolerance {closure_tol:.3g}; "
+        "an over-constrained linkage typed with rounded coordinates? Give them to full precision, or accept the "
+        "misfit as play in the hinges with a closure tolerance above it (closure_tol / --closure-tol)",
+        residual=near.misfit,
+    )
+
+
+def resolve_spec(
+    spec: str | Path, params: Mapping[str, Any] | None = None, *, closure_tol: float = 1e-12
+) -> LoadedSpec:
     """A spec file or a built-in linkage by name, as the CLI's ``SPEC [--set KEY=VALUE ...]`` takes it.
 
     Parameters
@@ -200,6 +224,8 @@ def resolve_spec(spec: str | Path, params: Mapping[str, Any] | None = None) -> L
         :func:`load_spec`; anything else is the name of a built-in linkage (``linkwork linkages`` lists them).
     params
         Parameters of a built-in in file units (degrees for angles); must be empty for a file.
+    closure_tol
+        For a file: the largest least-squares closure misfit accepted at assembly (see :func:`load_spec`).
 
     Returns
     -------
@@ -222,7 +248,7 @@ def resolve_spec(spec: str | Path, params: Mapping[str, Any] | None = None) -> L
                 source=str(path),
                 key="--set",
             )
-        return load_spec(path)
+        return load_spec(path, closure_tol=closure_tol)
     from linkwork.linkages.registry import get
 
     _import_builtins()
@@ -333,7 +359,7 @@ Couplings = tuple[list[list[str]], list[str]]
 
 
 def _read_loop(
-    reader: _Reader, value: Any, name: str, meta: Mapping[str, Any]
+    reader: _Reader, value: Any, name: str, meta: Mapping[str, Any], closure_tol: float = 1e-12
 ) -> tuple[Mechanism, Assembly | None, Couplings]:
     """The ``[loop]`` table: one closed loop of revolute joints in one of :data:`CONVENTIONS`."""
     section = reader.table(value, "loop", LOOP_KEYS)
@@ -362,7 +388,7 @@ def _read_loop(
             }
             for i, joint in enumerate(joints)
         ]
-        mech, assembly = from_dh(name, params, joint_names=names, meta=info)
+        mech, assembly = from_dh(name, params, joint_names=names, meta=info, closure_tol=closure_tol)
     elif convention == "rods":
         rods, thetas = [], []
         for i, joint in enumerate(joints):
@@ -382,7 +408,7 @@ def _read_loop(
                 }
             )
             thetas.append(reader.number(joint, "theta", here, default=0.0, angle=True))
-        mech, assembly = from_rods(name, rods, thetas, joint_names=names, meta=info)
+        mech, assembly = from_rods(name, rods, thetas, joint_names=names, meta=info, closure_tol=closure_tol)
     else:
         twists, offsets = [], []
         for i, joint in enumerate(joints):

@@ -14,64 +14,30 @@ P. Kumar, S. Pellegrino, "Computation of kinematic paths and bifurcation points"
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.kinematics.closure import hessian, reduce
-from linkwork.kinematics.march import evaluate, tangent_and_test
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank
+from linkwork.kinematics.workspace import Workspace
 
 Array = NDArray[np.float64]
 
+__all__ = [
+    "Workspace",
+    "branch_tangents",
+    "correct_on_plane",
+    "hermite",
+    "locate",
+    "locate_minimum",
+    "polish",
+]
 
-@dataclass
-class Workspace:
-    """The flattened mechanism and scratch arrays the compiled kernels need."""
 
-    twists: Array
-    loop_joint: NDArray[np.int64]
-    loop_sign: NDArray[np.int64]
-    loop_ptr: NDArray[np.int64]
-    rows: NDArray[np.int64]
-    groups: NDArray[np.int64]
-    q: Array
-    res: Array
-    jac: Array
-
-    @classmethod
-    def of(cls, mech: Mechanism) -> Workspace:
-        """Scratch space for ``mech``."""
-        lj, ls, lp = mech.loop_arrays()
-        return cls(
-            twists=mech.twists,
-            loop_joint=lj,
-            loop_sign=ls,
-            loop_ptr=lp,
-            rows=np.array(mech.rows, dtype=np.int64),
-            groups=mech.groups,
-            q=np.empty(mech.n_joints),
-            res=np.empty(mech.n_equations),
-            jac=np.empty((mech.n_equations, mech.n_unknowns)),
-        )
-
-    def evaluate(self, u: Array) -> tuple[float, Array, Array]:
-        """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
-        r = evaluate(
-            self.twists,
-            self.loop_joint,
-            self.loop_sign,
-            self.loop_ptr,
-            self.rows,
-            self.groups,
-            np.ascontiguousarray(u, dtype=float),
-            self.q,
-            self.res,
-            self.jac,
-        )
-        return float(r), self.res.copy(), self.jac.copy()
+def _accept(tol: Tolerances) -> float:
+    """Largest residual a stalled correction is accepted with (see :func:`linkwork.kinematics.march.correct`)."""
+    return max(tol.closure, tol.roundoff * tol.exact)
 
 
 def correct_on_plane(
@@ -88,14 +54,32 @@ def correct_on_plane(
     prev = np.inf
     for _ in range(max_iter):
         r, res, jac = ws.evaluate(u)
-        if r < tol.closure or (r < 100 * tol.closure and r > 0.5 * prev):
+        if r < tol.exact or (r < _accept(tol) and r > 0.5 * prev):
             return u, r, True
         prev = r
         A = jac @ V
         U, s, Wt = np.linalg.svd(A, full_matrices=False)
         keep = s > tol.truncate * s[0]
         u = u - V @ (Wt[keep].T @ ((U[:, keep].T @ res) / s[keep]))
-    return u, r, r < 100 * tol.closure
+    return u, r, r < _accept(tol)
+
+
+def hermite(x: float, lo: tuple[float, Array, Array], hi: tuple[float, Array, Array], axis: Array) -> Array:
+    """The cubic Hermite curve through two path points with their tangents, at parameter ``x``.
+
+    ``lo`` and ``hi`` are ``(h, u, t)``: the parameter ``h = axis . (u - u_ref)`` of each point, the point and
+    its tangent; each tangent is scaled so that ``axis . (du/dh) = 1``.
+    """
+    (h0, u0, t0), (h1, u1, t1) = lo, hi
+    d = h1 - h0
+    s = (x - h0) / d
+    m0, m1 = t0 / (axis @ t0), t1 / (axis @ t1)
+    return (
+        (2 * s**3 - 3 * s**2 + 1) * u0
+        + (s**3 - 2 * s**2 + s) * d * m0
+        + (-2 * s**3 + 3 * s**2) * u1
+        + (s**3 - s**2) * d * m1
+    )
 
 
 def locate(
@@ -120,20 +104,8 @@ def locate(
     def evaluate_at(u: Array) -> tuple[float, Array]:
         _, _, jac = ws.evaluate(u)
         t = np.empty_like(t_a)
-        value = tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
+        value = ws.kernels.tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
         return float(value), t
-
-    def hermite(x: float, lo: tuple[float, Array, Array], hi: tuple[float, Array, Array]) -> Array:
-        (h0, u0, t0), (h1, u1, t1) = lo, hi
-        d = h1 - h0
-        s = (x - h0) / d
-        m0, m1 = t0 / (t_a @ t0), t1 / (t_a @ t1)
-        return (
-            (2 * s**3 - 3 * s**2 + 1) * u0
-            + (s**3 - 2 * s**2 + s) * d * m0
-            + (-2 * s**3 + 3 * s**2) * u1
-            + (s**3 - s**2) * d * m1
-        )
 
     f_lo, _ = evaluate_at(u_a)
     f_hi, t_b2 = evaluate_at(u_b)
@@ -147,7 +119,7 @@ def locate(
         x = hi[0] - f_hi * (hi[0] - lo[0]) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * (lo[0] + hi[0])
         if not (min(lo[0], hi[0]) < x < max(lo[0], hi[0])):
             x = 0.5 * (lo[0] + hi[0])
-        u_x, _, _ = correct_on_plane(ws, hermite(x, lo, hi), t_a, tol)
+        u_x, _, _ = correct_on_plane(ws, hermite(x, lo, hi, t_a), t_a, tol)
         f_x, t_x = evaluate_at(u_x)
         best = u_x
         if f_x == 0.0:
@@ -316,17 +288,9 @@ def locate_minimum(
     interpolant and corrected in their hyperplane). Catches rank drops where the test function keeps its sign.
     Returns the point and the ratio there."""
     h_b = float(t_a @ (u_b - u_a))
-    m_a, m_b = t_a / (t_a @ t_a), t_b / (t_a @ t_b)
 
     def point(x: float) -> Array:
-        s = x / h_b
-        guess = (
-            (2 * s**3 - 3 * s**2 + 1) * u_a
-            + (s**3 - 2 * s**2 + s) * h_b * m_a
-            + (-2 * s**3 + 3 * s**2) * u_b
-            + (s**3 - s**2) * h_b * m_b
-        )
-        return correct_on_plane(ws, guess, t_a, tol)[0]
+        return correct_on_plane(ws, hermite(x, (0.0, u_a, t_a), (h_b, u_b, t_b), t_a), t_a, tol)[0]
 
     def ratio(x: float) -> tuple[float, Array]:
         u = point(x)

@@ -95,9 +95,19 @@ def reduce(mech: Mechanism, matrix: Array) -> Array:
     return np.einsum("eij,ia,jb->eab", matrix, C, C)
 
 
-def body_poses(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
-    """Displacement of every body from the reference (4x4), along a spanning tree from the first body."""
-    q = np.asarray(q, dtype=float)
+def body_poses(
+    mech: Mechanism, *, q: ArrayLike | None = None, angles: ArrayLike | None = None
+) -> dict[str, Array]:
+    """Displacement of every body from the reference (4x4), along a spanning tree from the first body (the
+    ground, when there is one).
+
+    Give exactly one of ``angles``, the joint values users read (a row of ``Trace.angles``, ``offsets + q``), or
+    ``q``, the displacements from the reference. Both are keyword-only: a bare array would leave it to the
+    caller to remember the reference offsets, and forgetting them is silently wrong.
+    """
+    if (q is None) == (angles is None):
+        raise TypeError("body_poses takes exactly one of angles= (joint values) or q= (displacements)")
+    q = np.asarray(q, dtype=float) if angles is None else mech.q_from_angles(angles)
     if not mech.bodies:
         return {}
     root = "ground" if "ground" in mech.bodies else mech.bodies[0]
@@ -118,7 +128,7 @@ def body_poses(mech: Mechanism, q: ArrayLike) -> dict[str, Array]:
 
 def spatial_twists(mech: Mechanism, q: ArrayLike, poses: dict[str, Array] | None = None) -> Array:
     """Joint twists ``(n, 6)`` in the base frame at displacement ``q`` (each carried by its body's pose)."""
-    poses = body_poses(mech, q) if poses is None else poses
+    poses = body_poses(mech, q=q) if poses is None else poses
     return np.array(
         [adjoint(poses[a]) @ mech.twists[j] for j, (a, _b) in enumerate(mech.joint_bodies)]
     ).reshape(mech.n_joints, 6)

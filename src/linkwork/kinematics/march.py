@@ -17,7 +17,8 @@ from numba import njit
 
 from linkwork.kinematics.kernels import closure_jacobian, expand
 
-BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING = 0, 1, 2, 3, 4, 5, 6
+BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING, NO_PROGRESS = 0, 1, 2, 3, 4, 5, 6, 7
+TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
 STOP_REASONS = {
     BUDGET: "step budget",
     TARGET: "reached target",
@@ -26,6 +27,7 @@ STOP_REASONS = {
     SIGN_CHANGE: "bifurcation",
     LIMIT: "joint limit",
     TURNING: "drive turning point",
+    NO_PROGRESS: "no progress",
 }
 
 
@@ -39,23 +41,27 @@ def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, j
 
 @njit(cache=True)
 def correct(
-    twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, truncate, max_iter, q, res, jac
-):
+    twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, exact, roundoff, truncate, max_iter, q,
+    res, jac,
+):  # fmt: skip
     """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
 
     ``held`` is the unknown kept fixed (-1: none, minimum-norm correction over all unknowns). Returns
-    ``(converged, iterations, residual)``. Accepts a residual that stalls below ``100 tol`` (round-off floor of
-    very long loops) and reports it.
+    ``(converged, iterations, residual)``. Converged: a residual below ``exact``, or one that stalls (falls by
+    less than half in an iteration) below ``max(tol, roundoff * exact)``: the least-squares closure of a loop
+    whose parameters are off by up to ``tol`` (``Tolerances.closure``), or the round-off floor of a very long
+    loop.
     """
     m = u.shape[0]
     prev = np.inf
+    accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
         r = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
         if not np.isfinite(r):
             return False, it, r
-        if r < tol:
+        if r < exact:
             return True, it, r
-        if r < 100.0 * tol and r > 0.5 * prev:
+        if r < accept and r > 0.5 * prev:
             return True, it, r
         if it == max_iter or (it >= 2 and r > prev):
             return False, it, r
@@ -179,14 +185,81 @@ def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
 
 @njit(cache=True)
 def wrapped_distance(a, b, periodic):
-    """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to (-pi, pi]."""
+    """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to [-pi, pi)."""
     d = 0.0
     for i in range(a.shape[0]):
         diff = a[i] - b[i]
         if periodic[i]:
-            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
+            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # compiled copy of linkwork.geometry.angles.wrap
         d += diff * diff
     return np.sqrt(d)
+
+
+@njit(cache=True)
+def step_geometry(u, t, u_try, t_new):
+    """``(turn, dist, ahead)`` of a corrected step: the cosine between the tangents, the step's length and how far
+    it went along the old tangent."""
+    turn = 0.0
+    dist = 0.0
+    ahead = 0.0
+    for a in range(u.shape[0]):
+        du = u_try[a] - u[a]
+        turn += t_new[a] * t[a]
+        dist += du * du
+        ahead += t[a] * du
+    return turn, np.sqrt(dist), ahead
+
+
+@njit(cache=True)
+def snap_home(u, u_home, periodic, out):
+    """``out``: the start ``u_home`` written in the continuous angles of ``u`` (revolute unknowns differ from it
+    by whole turns), the last row of a closed path."""
+    for a in range(u.shape[0]):
+        diff = u_home[a] - u[a]
+        if periodic[a]:
+            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # compiled copy of linkwork.geometry.angles.wrap
+        out[a] = u[a] + diff
+
+
+@njit(cache=True)
+def predict(u, t, h, paper, drive, target, has_target, first, u_try):
+    """The predictor (Sec. 4.1): ``u_try = u + step t``; returns ``(step, landing, held)``.
+
+    Paper mode: ``step`` moves the drive by exactly ``h`` (on the first step ``t`` is turned, in place, to
+    point that way), the corrector holds the drive (``held``); ``held == TURNED`` means the drive has turned
+    back.
+    Adaptive mode: ``step = h`` along the tangent. Either way a step that would pass the target is shortened to
+    land on it (``landing``; the drive then held at the target).
+    """
+    m = u.shape[0]
+    landing = False
+    held = -1
+    if paper:
+        if abs(t[drive]) < 1e-9:
+            return 0.0, False, TURNED
+        step = h / t[drive]
+        if step < 0.0:
+            if not first:
+                return 0.0, False, TURNED
+            for a in range(m):  # first step: orient the tangent along the drive direction
+                t[a] = -t[a]
+            step = h / t[drive]
+        if has_target and abs(u[drive] + h - target) < 1e-9 * max(1.0, abs(target)):
+            landing = True
+        held = drive
+    else:
+        step = h
+        if has_target and abs(t[drive]) > 1e-12:
+            to_go = (target - u[drive]) / t[drive]
+            if 0.0 <= to_go <= h:
+                step = to_go
+                landing = True
+                held = drive
+    for a in range(m):
+        u_try[a] = u[a] + step * t[a]
+    if landing:
+        u_try[drive] = target
+    return step, landing, held
 
 
 @njit(cache=True)
@@ -210,8 +283,13 @@ def march(
     target,
     has_target,
     tol,
+    exact,
+    roundoff,
     truncate,
     max_iter,
+    advance,
+    stall_steps,
+    stall_length,
     max_steps,
     r_path,
     periodic,
@@ -229,6 +307,11 @@ def march(
     """March from ``(u0, t0)`` for at most ``max_steps`` steps; row 0 of the outputs is the start.
 
     ``u_home`` is where the path began (for closed-path detection across several calls).
+
+    An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h`` along
+    the tangent (the corrector pulled it back); an adaptive march stops with ``NO_PROGRESS`` when its last
+    ``stall_steps`` steps together advanced less than ``stall_length * hmax`` (a paper-mode step always moves the
+    drive by its fixed amount).
 
     ``paper``: fixed steps of ``h0`` in the drive unknown (signed: negative steps move the drive down), corrector
     with the drive held (the paper's mode);
@@ -259,68 +342,26 @@ def march(
     s_total = 0.0
     basis_try = basis.copy()
     far = wrapped_distance(u0, u_home, periodic)
+    recent = np.zeros(max(stall_steps, 1))  # lengths of the last stall_steps steps (a ring)
     count = 1
     while count <= max_steps:
-        landing = False
-        held = -1
         # ---- predictor (Sec. 4.1)
-        if paper:
-            if abs(t[drive]) < 1e-9:
-                return count, TURNING, h
-            step = h / t[drive]
-            if step < 0.0:
-                if count > 1:  # the drive has turned back: equal drive steps cannot go on
-                    return count, TURNING, h
-                for a in range(m):  # first step: orient the tangent along the drive direction
-                    t[a] = -t[a]
-                step = h / t[drive]
-            if has_target and abs(u[drive] + h - target) < 1e-9 * max(1.0, abs(target)):
-                landing = True
-            for a in range(m):
-                u_try[a] = u[a] + step * t[a]
-            if landing:
-                u_try[drive] = target
-            held = drive
-        else:
-            step = h
-            if has_target and abs(t[drive]) > 1e-12:
-                to_go = (target - u[drive]) / t[drive]
-                if 0.0 <= to_go <= h:
-                    step = to_go
-                    landing = True
-            for a in range(m):
-                u_try[a] = u[a] + step * t[a]
-            if landing:
-                u_try[drive] = target
-                held = drive
+        step, landing, held = predict(u, t, h, paper, drive, target, has_target, count == 1, u_try)
+        if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
+            return count, TURNING, h
         # ---- corrector (Sec. 4.2, Eq. (28))
         ok, iters, r = correct(
-            twists,
-            loop_joint,
-            loop_sign,
-            loop_ptr,
-            rows,
-            groups,
-            u_try,
-            held,
-            tol,
-            truncate,
-            max_iter,
-            q,
-            res,
-            jac,
-        )
+            twists, loop_joint, loop_sign, loop_ptr, rows, groups, u_try, held, tol, exact, roundoff, truncate,
+            max_iter, q, res, jac,
+        )  # fmt: skip
+        turn, dist, tau_new = 1.0, 0.0, 0.0
         if ok:
             basis_try[:, :] = basis
             tau_new = tangent_and_test(jac, t, basis_try, r_path, t_new, sig)
-            turn = 0.0
-            for a in range(m):
-                turn += t_new[a] * t[a]
-            dist = 0.0
-            for a in range(m):
-                dist += (u_try[a] - u[a]) ** 2
-            dist = np.sqrt(dist)
-            if not paper and not landing and (turn < cos_turn or dist > 2.0 * step + 1e-300) and h > hmin:
+            turn, dist, ahead = step_geometry(u, t, u_try, t_new)
+            jumped = dist > 2.0 * step + 1e-300
+            pulled_back = ahead < advance * step
+            if not paper and not landing and (turn < cos_turn or jumped or pulled_back) and h > hmin:
                 ok = False
         if not ok:
             if paper:
@@ -341,7 +382,10 @@ def march(
         out_res[count] = r
         out_tau[count] = tau_new
         out_s[count] = s_total
+        recent[count % recent.shape[0]] = dist
         count += 1
+        if not paper and count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
+            return count, NO_PROGRESS, h
         if landing:
             return count, TARGET, h
         for a in range(m):
@@ -351,14 +395,9 @@ def march(
             return count, SIGN_CHANGE, h
         if check_closed:
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
-            if d > far:
-                far = d
+            far = max(far, d)
             if far > 4.0 * hmax and d < 1.5 * abs(h):
-                for a in range(m):
-                    diff = u_home[a] - u[a]
-                    if periodic[a]:
-                        diff = (diff + np.pi) % (2.0 * np.pi) - np.pi
-                    out_u[count - 1, a] = u[a] + diff
+                snap_home(u, u_home, periodic, out_u[count - 1])
                 out_sigma[count - 1, :] = out_sigma[0, :]
                 out_res[count - 1] = out_res[0]
                 out_tau[count - 1] = out_tau[0]

@@ -79,18 +79,19 @@ class Mechanism:
     meta: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        """Check the shapes and keep private, read-only copies of the arrays (a frozen value in full)."""
         n = len(self.joint_names)
-        twists = np.ascontiguousarray(self.twists, dtype=float)
+        twists = _frozen(self.twists, float)
         if twists.shape != (n, 6):
             raise ValueError(f"Expected twists of shape ({n}, 6), got {twists.shape}")
         object.__setattr__(self, "twists", twists)
-        object.__setattr__(self, "offsets", np.asarray(self.offsets, dtype=float).reshape(n))
+        object.__setattr__(self, "offsets", _frozen(np.asarray(self.offsets, dtype=float).reshape(n), float))
         groups = np.asarray(self.groups, dtype=np.int64)
         if groups.size == 0:
             groups = np.arange(n, dtype=np.int64)
         if groups.shape != (n,):
             raise ValueError(f"Expected groups of shape ({n},), got {groups.shape}")
-        object.__setattr__(self, "groups", groups)
+        object.__setattr__(self, "groups", _frozen(groups, np.int64))
         if len(set(self.joint_names)) != n:
             raise SpecError(f"joint names must be unique, got {list(self.joint_names)}")
 
@@ -217,7 +218,7 @@ class Mechanism:
         from linkwork.kinematics.closure import body_poses, spatial_twists
 
         q = np.asarray(q, dtype=float)
-        poses = body_poses(self, q)
+        poses = body_poses(self, q=q)
         twists = spatial_twists(self, q, poses)
         return replace(self, twists=twists, offsets=self.offsets + q)
 
@@ -295,6 +296,13 @@ class Mechanism:
             joint_bodies=pairs,
             meta=dict(meta or {}),
         )
+
+
+def _frozen(values: ArrayLike, dtype: type) -> Any:
+    """A contiguous copy of ``values`` that cannot be written to, so that no caller's array aliases a field."""
+    out: np.ndarray = np.array(values, dtype=dtype, order="C", copy=True)
+    out.flags.writeable = False
+    return out
 
 
 def cycle_basis(pairs: Sequence[tuple[str, str]], ground: str = "ground") -> tuple[list[Loop], list[str]]:

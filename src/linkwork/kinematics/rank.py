@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -10,12 +10,23 @@ from numpy.typing import ArrayLike
 
 @dataclass(frozen=True)
 class Tolerances:
-    """Every tolerance of the kinematic core in one documented place.
+    """Every tolerance and threshold of the kinematic core in one documented place.
 
     Attributes
     ----------
     closure
         A configuration is on the loop when the closure residual's 2-norm is below this (Eq. (28) iterations).
+        Raised above ``exact`` (``--closure-tol``, play in the hinges), the corrector accepts a least-squares
+        closure: Gauss-Newton iterated until its step stops reducing the residual, with a residual below this.
+    exact
+        A residual below this is closed whatever ``closure`` says (the round-off level of one loop).
+    roundoff
+        A residual that stalls (falls by less than half in an iteration) below ``roundoff * max(closure, exact)``
+        is accepted: the round-off floor of very long loops.
+    max_iter
+        Corrector iterations before it gives up (it also gives up when the residual grows after the second).
+    start_slack
+        The start must close to ``start_slack * closure``; a larger residual asks for assembly first.
     floor
         Singular values below ``floor * sigma_1`` are zero whatever the gap.
     loose
@@ -25,15 +36,67 @@ class Tolerances:
     truncate
         The corrector's pseudo-inverse keeps singular values above ``truncate * sigma_1`` (Eq. (28)).
     locate
-        Bifurcation points are located to this distance in the unknowns.
+        Bifurcation points and folds are located to this distance in the unknowns.
+    local_min
+        A local minimum of ``sigma_r / sigma_1`` below this (without a sign change of the test function) is
+        refined by golden section as a possible bifurcation point.
+    same_branch
+        At a bifurcation, a branch tangent whose ``|cos|`` with the incoming tangent exceeds this is the incoming
+        branch itself (not queued as a new branch).
+    same_point
+        Two located points closer than ``same_point * max(1, |u|)`` (angles modulo a full turn) are the same.
+    polish_gap
+        A simple bifurcation point is replaced by the intersection of its two fitted branches when they pass
+        within this of each other.
+    advance
+        An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h``
+        along the tangent: the corrector pulled it back (no progress).
+    stall_steps, stall_length
+        A branch whose last ``stall_steps`` accepted steps together advanced less than
+        ``stall_length * max_step`` in arclength has stalled: it ends with the reason ``no progress``.
+    component_points
+        A branch on which the mobility is 2 or more at this many consecutive points lies on a
+        higher-dimensional component of the configuration space: it ends there, reported once as such.
     """
 
     closure: float = 1e-12
+    exact: float = 1e-12
+    roundoff: float = 100.0
+    max_iter: int = 25
+    start_slack: float = 1e3
     floor: float = 1e-10
     loose: float = 1e-5
     min_gap: float = 1e3
     truncate: float = 1e-10
     locate: float = 1e-10
+    local_min: float = 1e-2
+    same_branch: float = 0.99
+    same_point: float = 1e-6
+    polish_gap: float = 1e-8
+    advance: float = 0.5
+    stall_steps: int = 25
+    stall_length: float = 1e-3
+    component_points: int = 3
+
+    def with_closure(self, closure: float) -> Tolerances:
+        """These tolerances accepting a least-squares closure within ``closure`` (``--closure-tol``).
+
+        Singular values at the scale of an accepted misfit carry no information, so ``floor`` (and ``loose``)
+        and the corrector's ``truncate`` are raised to at least ``closure``: a loop whose parameters are off by
+        that much is read as the mobile loop it was meant to be, and Gauss-Newton does not chase the misfit
+        along the direction it would have been mobile in. A tolerance below ``exact`` tightens ``exact`` too.
+        """
+        if not closure > 0.0:
+            raise ValueError(f"closure tolerance {closure!r}: expected a positive number")
+        floor = max(self.floor, closure)
+        return replace(
+            self,
+            closure=closure,
+            exact=min(self.exact, closure),
+            floor=floor,
+            loose=max(self.loose, 10.0 * floor),
+            truncate=max(self.truncate, floor),
+        )
 
 
 DEFAULT = Tolerances()

@@ -8,12 +8,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.normalization import condition_ratios
 
 Array = NDArray[np.float64]
 
@@ -23,7 +25,11 @@ class Bifurcation:
     """A located bifurcation point.
 
     ``angles`` are the joint values (radians) there, ``tangents`` the branch tangents as unit vectors over the
-    joints (one per line through the point), ``sigma`` the Jacobian's singular values.
+    joints (one per line through the point) and ``tangents_u`` the same over the unknowns, ``sigma`` the
+    Jacobian's singular values. ``kind`` is ``"bifurcation"`` (an isolated point with two or more branch
+    tangents), ``"fold"`` (a rank drop with fewer than two real branch tangents: the path touches the singular
+    set and no other branch leaves it) or ``"component"`` (where the path meets a higher-dimensional component of
+    the configuration space: ``dimension`` is its dimension, the mobility on it; no branch is switched to there).
     """
 
     id: int
@@ -37,11 +43,31 @@ class Bifurcation:
     method: str
     residual: float
     bracket: float
+    tangents_u: Array = field(default_factory=lambda: np.zeros((0, 0)))
+    kind: str = "bifurcation"
+    dimension: int = 0
+
+
+@dataclass(frozen=True)
+class Fold:
+    """A fold (limit point) of the drive on a branch: the drive stops and turns back there.
+
+    ``value`` is the drive's extreme value (radians, or length for a prismatic drive), ``angles`` every joint
+    there, ``step`` the step of the branch just before it.
+    """
+
+    branch: int
+    step: int
+    value: float
+    angles: Array
 
 
 @dataclass(frozen=True)
 class Branch:
-    """One traced branch: where it starts (parent branch and bifurcation, or the start), direction, end."""
+    """One traced branch: where it starts (parent branch and bifurcation, or the start), direction, end.
+
+    ``mobility`` is the mobility (unknowns minus rank) that holds along the branch away from its ends.
+    """
 
     id: int
     parent: int | None
@@ -49,6 +75,7 @@ class Branch:
     direction: int
     steps: int
     end_reason: str
+    mobility: int = 1
 
 
 @dataclass(frozen=True)
@@ -86,6 +113,7 @@ class Trace:
     bifurcations: tuple[Bifurcation, ...]
     branches: tuple[Branch, ...]
     stats: Mapping[str, Any] = field(default_factory=dict)
+    folds: tuple[Fold, ...] = ()
 
     @property
     def mobility(self) -> NDArray[np.int64]:
@@ -94,14 +122,32 @@ class Trace:
 
     @property
     def max_condition(self) -> float:
-        """Largest ratio of largest to smallest non-zero singular value along the path (Sec. 5)."""
-        ratios = [
-            s[0] / s[r - 1] for s, r in zip(self.sigma, self.rank, strict=True) if r > 0 and s[r - 1] > 0
-        ]
-        return float(max(ratios)) if ratios else float("nan")
+        """Largest robustness ratio along the path (Sec. 5), on the normalised Jacobian.
+
+        The ratio of the largest to the smallest non-zero singular value of the closure Jacobian with moments
+        about the linkage's own centre and lengths in its own scale
+        (:mod:`linkwork.kinematics.normalization`): unchanged when the linkage is moved, turned, scaled or
+        relabelled. :attr:`max_condition_raw` is the same ratio of the raw singular values in :attr:`sigma`.
+        """
+        ratios = self.condition()
+        return float(np.nanmax(ratios)) if np.any(np.isfinite(ratios)) else float("nan")
 
     def condition(self) -> Array:
-        """``(N,)`` ratio of the largest to the smallest non-zero singular value at every point."""
+        """``(N,)`` robustness ratio at every point, on the normalised Jacobian (see :attr:`max_condition`)."""
+        return self._normalized_condition.copy()
+
+    @cached_property
+    def _normalized_condition(self) -> Array:
+        return condition_ratios(self.mechanism, self.angles, self.rank)
+
+    @property
+    def max_condition_raw(self) -> float:
+        """Largest ratio of the raw singular values (:attr:`sigma`, base frame and file units) along the path."""
+        ratios = self.condition_raw()
+        return float(np.nanmax(ratios)) if np.any(np.isfinite(ratios)) else float("nan")
+
+    def condition_raw(self) -> Array:
+        """``(N,)`` ratio of the largest to the smallest non-zero raw singular value at every point."""
         out = np.full(len(self.rank), np.nan)
         for i, (s, r) in enumerate(zip(self.sigma, self.rank, strict=True)):
             if r > 0 and s[r - 1] > 0:
@@ -111,3 +157,76 @@ class Trace:
     def of_branch(self, branch: int) -> NDArray[np.bool_]:
         """Boolean mask of the points of one branch."""
         return self.branch == branch
+
+    # ---------------------------------------------------------------------------------------- notebook use
+    def positions(self) -> Array:
+        """``(N, n, 3)`` world coordinates of every joint at every point, in ``mechanism.joint_names`` order.
+
+        A joint's point is a fixed point on its axis (see :mod:`linkwork.kinematics.positions`), placed by the
+        pose of its body; the reference offsets are taken care of.
+        """
+        from linkwork.kinematics.positions import joint_positions
+
+        return joint_positions(self.mechanism, self.angles, self.poses())
+
+    def poses(self) -> dict[str, Array]:
+        """``{body: (N, 4, 4)}`` the world pose of every body at every point (displacement from the reference
+        configuration, the first body or the ground held still)."""
+        from linkwork.kinematics.positions import poses_along
+
+        return poses_along(self.mechanism, self.angles)
+
+    def plot(self, kind: str = "angles", *, branch: int = 0) -> Any:
+        """A matplotlib ``Figure``: ``kind="angles"`` (every hinge angle against the drive, all branches) or
+        ``"singular_values"`` (the Jacobian's singular values along ``branch``). Needs ``linkwork[viz]``."""
+        from linkwork.viz import trace_plots
+
+        if kind == "angles":
+            return trace_plots.angles_figure(self)
+        if kind == "singular_values":
+            return trace_plots.singular_values_figure(self, branch)
+        raise ValueError(f"Expected kind 'angles' or 'singular_values', got {kind!r}")
+
+    def __repr__(self) -> str:
+        """A few lines a notebook user can read: size, joints, branches, the range of the drive, accuracy."""
+        return "\n".join(_summary_lines(self))
+
+    def _repr_html_(self) -> str:
+        """The interactive viewer (the same page ``linkwork trace --html`` writes), inline in Jupyter."""
+        from linkwork.viz.inline import trace_html
+
+        return trace_html(self)
+
+
+def _names(names: tuple[str, ...], most: int = 12) -> str:
+    """Joint names, shortened in the middle when there are many."""
+    if len(names) <= most:
+        return ", ".join(names)
+    return ", ".join(names[: most - 2]) + f", ... , {names[-1]}"
+
+
+def _summary_lines(trace: Trace) -> list[str]:
+    mech = trace.mechanism
+    n_points = len(trace.angles)
+    d = mech.index(trace.drive)
+    unit, scale = ("deg", 180.0 / np.pi) if mech.joint_types[d] == "R" else ("", 1.0)
+    drive = trace.angles[:, d] * scale if n_points else np.zeros(1)
+    mobility = trace.mobility
+    lines = [
+        f"Trace of {mech.name!r}: {n_points} points, {len(trace.branches)} branch(es), "
+        f"{len(trace.bifurcations)} bifurcation point(s)",
+        f"  joints ({mech.n_joints}): {_names(mech.joint_names)}; drive {trace.drive} "
+        f"from {drive[0]:.6g} to {drive[-1]:.6g} {unit}".rstrip(),
+    ]
+    if n_points:
+        lines.append(
+            f"  mobility {int(mobility.min())}..{int(mobility.max())}; max closure residual "
+            f"{float(np.max(trace.residual)):.2e}; max condition {trace.max_condition:.4g}"
+        )
+    for br in trace.branches[:4]:
+        origin = "start" if br.parent is None else f"bifurcation {br.bifurcation} on branch {br.parent}"
+        lines.append(f"  branch {br.id}: {br.steps} steps from {origin}, ended: {br.end_reason}")
+    if len(trace.branches) > 4:
+        lines.append(f"  ... {len(trace.branches) - 4} more branches (trace.branches)")
+    lines.append("  .angles (N, n) rad, .positions() (N, n, 3), .poses(), .plot(), .sigma, .bifurcations")
+    return lines

@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import LinkworkError
 from linkwork.geometry.angles import wrap
+from linkwork.geometry.se2 import apply, pose_matrix, pose_of, relative
 from linkwork.synthesis.result import JoinedProfile, SynthesisResult
 from linkwork.synthesis.segment_fit import segment_starts
 
@@ -35,37 +36,6 @@ Array = NDArray[np.float64]
 
 #: Two bodies welded by a merged joint, or a joint's two bodies, must agree to this (relative to the size).
 CONSISTENCY = 1e-8
-
-
-def pose_matrix(pose: ArrayLike) -> Array:
-    """``3 x 3`` homogeneous matrix of a planar pose ``(x, y, angle)``."""
-    x, y, a = np.asarray(pose, dtype=float)
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, x], [s, c, y], [0.0, 0.0, 1.0]])
-
-
-def pose_of(matrix: ArrayLike) -> Array:
-    """``(x, y, angle)`` of a ``3 x 3`` (or the planar part of a ``4 x 4``) homogeneous matrix."""
-    m = np.asarray(matrix, dtype=float)
-    t = m[:2, -1]
-    return np.array([t[0], t[1], math.atan2(m[1, 0], m[0, 0])])
-
-
-def apply(pose: ArrayLike, points: ArrayLike) -> Array:
-    """Points ``(n, 2)`` (or ``(2,)``) moved by the displacement ``pose``."""
-    x, y, a = np.asarray(pose, dtype=float)
-    pts = np.asarray(points, dtype=float)
-    c, s = math.cos(a), math.sin(a)
-    rot = np.array([[c, -s], [s, c]])
-    return pts @ rot.T + np.array([x, y])
-
-
-def relative(before: ArrayLike, after: ArrayLike) -> Array:
-    """``(p, 3)`` displacements of ``after`` seen from ``before``: ``g_before^-1 g_after`` per profile."""
-    b, a = np.asarray(before, dtype=float), np.asarray(after, dtype=float)
-    return np.array(
-        [pose_of(np.linalg.inv(pose_matrix(u)) @ pose_matrix(v)) for u, v in zip(b, a, strict=True)]
-    )
 
 
 @dataclass(frozen=True)

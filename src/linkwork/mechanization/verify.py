@@ -95,7 +95,7 @@ def loaded_mechanism(design: Design) -> Mechanism:
 
 def chain_displacements(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
     """``(x, y, angle)`` displacement of every body of the mechanism at joint displacements ``values``."""
-    poses = body_poses(mech, values)
+    poses = body_poses(mech, q=values)
     return {name: pose_of(g[np.ix_([0, 1, 3], [0, 1, 3])]) for name, g in poses.items()}
 
 
@@ -210,7 +210,7 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
     for j in range(1, chain.count):
         path = trace(mech, drive=drive, until=(drive, float(v[j])), max_step=max_step, max_steps=max_steps)
         paths.append(path)
-        max_cond = max(max_cond, path.max_condition)
+        max_cond = max(max_cond, path.max_condition_raw)  # raw, like the untraced check above
         where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
         end = path.branches[0].end_reason
         if path.bifurcations:

@@ -73,12 +73,20 @@ def print_trace_summary(path: Trace) -> None:
     table.add_column("branch", justify="right")
     table.add_column("from")
     table.add_column("steps", justify="right")
+    table.add_column("mob.", justify="right")
     table.add_column("end")
     table.add_column("joints at the end (deg)", overflow="fold")
     for br in path.branches:
         mask = path.of_branch(br.id)
         origin = "start" if br.parent is None else f"bif {br.bifurcation} on {br.parent}"
-        table.add_row(str(br.id), origin, str(br.steps), br.end_reason, angles_text(path.angles[mask][-1]))
+        table.add_row(
+            str(br.id),
+            origin,
+            str(br.steps),
+            str(br.mobility),
+            br.end_reason,
+            angles_text(path.angles[mask][-1]),
+        )
     console.print(table)
     mob = rep["mobility_along_path"]
     console.print(
@@ -87,6 +95,16 @@ def print_trace_summary(path: Trace) -> None:
         f"{rep['max_residual']:.2e}; max condition (sigma_1 / smallest non-zero) {rep['max_condition']:.4g}; "
         f"{rep['points']} points in {rep['seconds']:.3f} s"
     )
+    if rep["closure_tol"] > 1e-12:
+        console.print(
+            f"closure accepted within {rep['closure_tol']:.2e} (--closure-tol); largest misfit met "
+            f"{rep['max_misfit']:.2e}"
+        )
+    for fold in rep["folds"]:
+        console.print(
+            f"fold of the drive on branch {fold['branch']} (after step {fold['step']}): "
+            f"{fold['drive']} turns back at {fold['value']:.4f}"
+        )
     if path.bifurcations:
         bt = Table(title="bifurcation points", title_justify="left")
         bt.add_column("id", justify="right")
@@ -98,8 +116,10 @@ def print_trace_summary(path: Trace) -> None:
         bt.add_column("joints (deg)", overflow="fold")
         for b in path.bifurcations:
             zero = b.sigma[b.rank] / b.sigma[0] if b.rank < len(b.sigma) else 0.0
+            what = f"{len(b.tangents)} ({b.method})"
+            if b.kind == "component":
+                what = f"none: meets a {b.dimension}-dimensional component"
             bt.add_row(
-                str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}",
-                f"{len(b.tangents)} ({b.method})", angles_text(b.angles),
+                str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}", what, angles_text(b.angles),
             )  # fmt: skip
         console.print(bt)

@@ -115,3 +115,15 @@ def arc_errors(
         lo = offsets[j] + starts[j]
         out[j] = _aligned_error(arc[: pieces[j] + 1], points[lo : lo + pieces[j] + 1])
     return out
+
+
+def warm_up() -> None:
+    """Compile these kernels into numba's cache (run by the background compile of a first run, see
+    :mod:`linkwork.kinematics.jit`), with the argument types the search uses."""
+    from linkwork.synthesis.error_kernels import ProfileTables
+
+    t = np.linspace(0.0, 1.0, 9)
+    curve = np.column_stack([t, 0.1 * np.sin(3.0 * t)])
+    tables = ProfileTables([curve, 1.1 * curve], compiled=True)
+    tables.mean_errors([0, 1], 4)
+    tables.arc_errors([0, 1], [4, 5])

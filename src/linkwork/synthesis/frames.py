@@ -1,18 +1,16 @@
-"""Planar rotations and the local frame of a segment (first point at the origin, chord along ``+x``)."""
+"""The local frame of a segment (first point at the origin, chord along ``+x``); planar rotations are
+:func:`linkwork.geometry.se2.rotation`."""
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from linkwork.geometry.se2 import rotation
+
 Array = NDArray[np.float64]
 
-
-def rotation(angle: ArrayLike) -> Array:
-    """Rotation matrices ``(..., 2, 2)`` of angles ``(...)`` (radians, counter-clockwise), Eq. (13)."""
-    angle = np.asarray(angle, dtype=float)
-    c, s = np.cos(angle), np.sin(angle)
-    return np.stack([np.stack([c, -s], axis=-1), np.stack([s, c], axis=-1)], axis=-2)
+__all__ = ["chord_angle", "rotation", "to_local_frame"]
 
 
 def chord_angle(points: ArrayLike) -> Array:

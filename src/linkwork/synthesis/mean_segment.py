@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from linkwork.synthesis.registration import register
+from linkwork.geometry.fit import register
 
 Array = NDArray[np.float64]
 

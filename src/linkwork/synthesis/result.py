@@ -371,6 +371,48 @@ class SynthesisResult:
             "search": self.stats.to_dict(),
         }
 
+    # ---------------------------------------------------------------------------------------- notebook use
+    def plot(self, kind: str = "chain") -> Any:
+        """A matplotlib ``Figure``: ``kind="chain"`` (the chain before and after joining, Fig. 8),
+        ``"profiles"`` (design and target profiles, Fig. 3), ``"errors"`` (every segment's error on every
+        profile, Eq. 21) or ``"compound"`` (merged joints, Fig. 10). Needs ``linkwork[viz]``."""
+        from linkwork.viz import synthesis_plots
+
+        kinds = {
+            "chain": synthesis_plots.plot_chain,
+            "profiles": synthesis_plots.plot_profiles,
+            "errors": synthesis_plots.plot_errors,
+            "compound": synthesis_plots.plot_compound,
+        }
+        if kind not in kinds:
+            raise ValueError(f"Expected kind one of {', '.join(kinds)}, got {kind!r}")
+        return kinds[kind](self)
+
+    def __repr__(self) -> str:
+        """A few lines a notebook user can read: profiles, design, errors, compound joints."""
+        names = ", ".join(f"{t.name or j + 1} ({t.pieces} pieces)" for j, t in enumerate(self.targets))
+        lines = [
+            f"SynthesisResult ({self.problem.kind}): {len(self.targets)} profiles: {names}",
+            f"  design {self.design} ({len(self.segments)} segments), piece length {self.problem.piece_length:.6g}",
+            f"  E_max {self.e_max:.4g} / E_mean {self.e_mean:.4g} after segmentation; "
+            f"E_max {self.joined_e_max:.4g} after joining",
+        ]
+        if self.compound is not None:
+            merged = ", ".join(str(i + 1) for i in self.compound.merged) or "none"
+            lines.append(f"  compound: joints merged {merged}; E_max {self.compound.e_max:.4g}")
+        lines.append(
+            f"  search: {len(self.stats.designs)} design(s) ranked, {self.stats.evaluations} evaluations "
+            f"in {self.stats.seconds:.3g} s"
+        )
+        lines.append("  .plot('chain'|'profiles'|'errors'|'compound'), .joined, .segments, .to_dict()")
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        """The interactive viewer (the same page ``linkwork synth --html`` writes), inline in Jupyter."""
+        from linkwork.viz.inline import synthesis_html
+
+        return synthesis_html(self)
+
 
 def target_profile_rows(targets: Sequence[TargetProfile]) -> list[tuple[str, int, float, float]]:
     """Rows ``(profile, index, x, y)`` of every target point, index 0-based along each profile."""

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import LinkworkError
+from linkwork.geometry.fit import kabsch
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
 from linkwork.viz.labels import plain, subscript
@@ -144,7 +145,7 @@ def follow(clouds: Array, reference: Array | None = None) -> Array:
             T = np.eye(4)
             T[:3, 3] = -cloud.mean(axis=0)
         else:
-            T = _fit(cloud, prev)
+            T = kabsch(cloud, prev)
         out[k] = T
         prev = cloud @ T[:3, :3].T + T[:3, 3]
     return out
@@ -163,18 +164,6 @@ def leveling(clouds: Array, moves: Array) -> Array:
     level = np.eye(4)
     level[:3, :3] = R  # rows: principal directions -> x, y, z
     return level
-
-
-def _fit(src: Array, dst: Array) -> Array:
-    """The proper rigid transform taking ``src`` onto ``dst`` in least squares (Kabsch), 4x4."""
-    cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    U, _, Vt = np.linalg.svd((src - cs).T @ (dst - cd))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = cd - R @ cs
-    return T
 
 
 def bounds(frames: Sequence[Sequence[Mesh]]) -> tuple[Array, Array]:

@@ -32,6 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from linkwork.geometry.fit import kabsch
 from linkwork.kinematics.closure import body_poses
 from linkwork.kinematics.mechanism import Mechanism
 
@@ -120,7 +121,7 @@ def posed_meshes(mech: Mechanism, angles: ArrayLike, *, pins: bool = True) -> li
     """Every body's mesh (``mech.bodies`` order), then the pins (joint order), at the joint values ``angles``.
 
     ``angles`` are the reported joint values in radians (a row of ``Path.angles``); bodies are placed by
-    ``body_poses(mech, mech.q_from_angles(angles))``, a pin by the pose of the body after its joint.
+    ``body_poses(mech, angles=angles)``, a pin by the pose of the body after its joint.
     """
     bodies, pin_meshes = _drawing(mech)
     return place(mech, bodies, pin_meshes if pins else [], angles)
@@ -131,7 +132,7 @@ def place(mech: Mechanism, bodies: Mapping[str, Mesh], pins: list[Mesh], angles:
 
     Use it to pose many frames without rebuilding the meshes.
     """
-    poses = body_poses(mech, mech.q_from_angles(angles))
+    poses = body_poses(mech, angles=angles)
     out = [mesh.transformed(poses[name]) for name, mesh in bodies.items()]
     by_joint = {name: j for j, name in enumerate(mech.joint_names)}
     for pin in pins:
@@ -417,7 +418,7 @@ def _to_reference(
         dst = _line_pair_points(ref_points[a], ref_dirs[a], ref_points[b], ref_dirs[b])
         if src is None or dst is None:
             return None
-        T = _kabsch(src, dst)
+        T = kabsch(src, dst)
         moved = src @ T[:3, :3].T + T[:3, 3]
         if np.max(np.abs(moved - dst)) > 1e-7 * max(scale, 1.0):
             return None
@@ -435,19 +436,6 @@ def _line_pair_points(p1: Array, d1: Array, p2: Array, d2: Array) -> Array | Non
         return None
     f1, f2 = common_normal(p1, d1, p2, d2)
     return np.array([f1, f1 + d1, f2, f2 + d2])
-
-
-def _kabsch(src: Array, dst: Array) -> Array:
-    """The 4x4 proper rigid transform minimising ``sum |T src - dst|^2``."""
-    cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    H = (src - cs).T @ (dst - cd)
-    U, _, Vt = np.linalg.svd(H)
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = cd - R @ cs
-    return T
 
 
 def _rod_frames(mech: Mechanism) -> list[Array]:

@@ -163,7 +163,7 @@ def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
     ValueError
         If segment ``index`` is not an M-segment.
     """
-    from linkwork.synthesis.registration import register
+    from linkwork.geometry.fit import register
 
     segment = result.segments[index]
     if segment.kind != "M":
@@ -311,6 +311,40 @@ def plot_compound(result: SynthesisResult) -> Figure:
     )
     for ax in axes:
         _legend(ax)
+    return figure
+
+
+def plot_errors(result: SynthesisResult) -> Figure:
+    """The error of every segment on every profile (Eq. 21: the largest point-to-point distance), after
+    segmentation (pale, left) and after joining (solid, right), with E_max of the joined chain (Eq. 22) dashed."""
+    from matplotlib.figure import Figure
+
+    q, p = result.joined_error_matrix.shape
+    figure = Figure(figsize=(8.0, 4.2), dpi=DPI, layout="constrained")
+    ax = figure.subplots()
+    width = 0.8 / p
+    x = np.arange(q)
+    for j in range(p):
+        centre = x - 0.4 + (j + 0.5) * width
+        ax.bar(centre - width / 4, result.error_matrix[:, j], width / 2, color=_colour(j), alpha=0.35)
+        ax.bar(
+            centre + width / 4,
+            result.joined_error_matrix[:, j],
+            width / 2,
+            color=_colour(j),
+            label=_name(result, j),
+        )
+    ax.axhline(result.joined_e_max, color="black", linestyle="--", linewidth=0.9)
+    ax.set_xticks(x, [f"{e + 1} {kind}" for e, kind in enumerate(result.design)])
+    ax.set_xlabel("segment (M: rigid, C: constant curvature)")
+    ax.set_ylabel("error E (profile length units)")
+    ax.set_title(
+        f"segment errors, pale: segmented (E_max = {result.e_max:.3g}); "
+        f"solid: joined (E_max = {result.joined_e_max:.3g}, dashed)",
+        fontsize="medium",
+    )
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(fontsize="small")
     return figure
 
 

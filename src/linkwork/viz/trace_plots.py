@@ -1,31 +1,48 @@
 """Figures of a traced path: hinge angles against the drive angle (like the paper's Figs. 9, 10, 12) and the
-Jacobian's singular values along the path (like Fig. 15). matplotlib is imported inside the functions."""
+Jacobian's singular values along the path (like Fig. 15). matplotlib is imported inside the functions, and only
+its object-oriented API is used: :func:`angles_figure` and :func:`singular_values_figure` return a
+``matplotlib.figure.Figure`` (what ``Trace.plot()`` shows in a notebook), :func:`plot_angles` and
+:func:`plot_singular_values` write it as PNG and SVG."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from linkwork.kinematics.trace_result import Trace
 from linkwork.viz.labels import plain
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 
 def _unwrap_branch(path: Trace, mask: np.ndarray) -> np.ndarray:
     return np.degrees(path.angles[mask])
 
 
+def _save(fig: Figure, file: Path) -> Path:
+    fig.savefig(file, dpi=120)
+    fig.savefig(Path(file).with_suffix(".svg"))
+    return Path(file)
+
+
 def plot_angles(path: Trace, file: Path) -> Path:
+    """Write :func:`angles_figure` to ``file`` (PNG) and next to it as SVG; returns ``file``."""
+    return _save(angles_figure(path), file)
+
+
+def angles_figure(path: Trace) -> Figure:
     """Every hinge angle against the drive angle, one colour per joint, one line style per branch."""
     import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     mech = path.mechanism
     d = mech.index(path.drive)
-    fig, ax = plt.subplots(figsize=(7.5, 5.0), layout="constrained")
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(7.5, 5.0), layout="constrained")
+    ax = fig.subplots()
+    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     styles = ["-", "--", ":", "-."]
     for br in path.branches:
         mask = path.of_branch(br.id)
@@ -54,25 +71,25 @@ def plot_angles(path: Trace, file: Path) -> Path:
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(ncol=2, fontsize=8)
-    fig.savefig(file, dpi=120)
-    fig.savefig(Path(file).with_suffix(".svg"))
-    plt.close(fig)
-    return Path(file)
+    return fig
 
 
 def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
-    """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
-    import matplotlib
+    """Write :func:`singular_values_figure` to ``file`` (PNG) and next to it as SVG; returns ``file``."""
+    return _save(singular_values_figure(path, branch), file)
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
+    """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
+    from matplotlib.figure import Figure
 
     mech = path.mechanism
     d = mech.index(path.drive)
     mask = path.of_branch(branch)
     x = np.degrees(path.angles[mask, d])
     s = path.sigma[mask]
-    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), layout="constrained")
+    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
+    axes = fig.subplots(1, 2)
     steps = path.step[mask]
     rank = int(path.stats.get("start_rank", s.shape[1]))
     # Left: the non-zero singular values on a linear scale against the step (as the paper's Fig. 15);
@@ -94,10 +111,7 @@ def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
             axes[1].axvline(b.step, color="k", lw=0.8, ls="--")
     axes[1].legend(fontsize=8, ncol=2)
     fig.suptitle(f"{plain(mech.name)}: singular values of the Jacobian along branch {branch}", fontsize=10)
-    fig.savefig(file, dpi=120)
-    fig.savefig(Path(file).with_suffix(".svg"))
-    plt.close(fig)
-    return Path(file)
+    return fig
 
 
 def write_trace_figures(path: Trace, out: Path) -> list[Path]:

@@ -173,7 +173,7 @@ def _pose_rows(mech: Mechanism, angles: NDArray[np.float64]) -> NDArray[np.float
     """``(N, b, 12)``: for each point and body, the rows of its rotation then its translation."""
     out = np.empty((len(angles), len(mech.bodies), 12))
     for i, a in enumerate(angles):
-        poses = body_poses(mech, mech.q_from_angles(a))
+        poses = body_poses(mech, angles=a)
         for b, name in enumerate(mech.bodies):
             T = poses[name]
             out[i, b, :9] = T[:3, :3].ravel()
@@ -438,9 +438,13 @@ def write_trace_viewer(
     -------
     The path of the file written.
     """
+    return _write(file, trace_viewer_page(path, title=title, max_points=max_points))
+
+
+def trace_viewer_page(path: Trace, *, title: str | None = None, max_points: int = MAX_POINTS) -> str:
+    """The HTML text of :func:`write_trace_viewer`'s page (for an inline view in a notebook)."""
     data = trace_viewer_data(path, title=title, max_points=max_points)
-    page = _page("trace.html", data["title"], data, ["common.js", "scene.js", "trace.js"])
-    return _write(file, page)
+    return _page("trace.html", data["title"], data, ["common.js", "scene.js", "trace.js"])
 
 
 # ----------------------------------------------------------------------------------------------- synthesis viewer
@@ -532,6 +536,10 @@ def write_synthesis_viewer(result: SynthesisResult, file: str | Path, *, title: 
     -------
     The path of the file written.
     """
+    return _write(file, synthesis_viewer_page(result, title=title))
+
+
+def synthesis_viewer_page(result: SynthesisResult, *, title: str | None = None) -> str:
+    """The HTML text of :func:`write_synthesis_viewer`'s page (for an inline view in a notebook)."""
     data = synthesis_viewer_data(result, title=title)
-    page = _page("synthesis.html", data["title"], data, ["common.js", "synthesis.js"])
-    return _write(file, page)
+    return _page("synthesis.html", data["title"], data, ["common.js", "synthesis.js"])

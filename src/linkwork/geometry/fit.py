@@ -1,11 +1,13 @@
-"""Least-squares planar registration of corresponding point sets: rotation and translation, optionally scale.
+"""Least-squares rigid fits of corresponding point sets: the one home of Kabsch (3-D) and Umeyama (planar).
 
-The closed form of Umeyama (1991) specialised to the plane: for centred point sets ``x`` (source) and ``y``
-(target) the best rotation angle is ``atan2(sum x ^ y, sum x . y)`` (``^`` the planar cross product), which is
-always a proper rotation, so no reflection can occur. Works over leading batch axes.
+:func:`kabsch` is the proper rigid motion (no reflection) that best maps 3-D points onto 3-D points (used to steady
+drawings and to place solids); :func:`register` is the planar closed form of Umeyama (1991): for centred point sets
+``x`` (source) and ``y`` (target) the best rotation angle is ``atan2(sum x ^ y, sum x . y)`` (``^`` the planar cross
+product), always a proper rotation, optionally with a uniform scale. Both work over leading batch axes where noted.
 
 References
 ----------
+W. Kabsch, A solution for the best rotation to relate two sets of vectors, Acta Cryst. A32 (1976) 922-923.
 S. Umeyama, Least-squares estimation of transformation parameters between two point patterns,
 IEEE Trans. Pattern Anal. Mach. Intell. 13 (4) (1991) 376-380.
 K. S. Arun, T. S. Huang, S. D. Blostein, Least-squares fitting of two 3-D point sets, IEEE Trans. PAMI
@@ -19,9 +21,28 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from linkwork.synthesis.frames import rotation
+from linkwork.geometry.se2 import rotation
 
 Array = NDArray[np.float64]
+
+
+def kabsch(source: ArrayLike, target: ArrayLike) -> Array:
+    """The ``4 x 4`` proper rigid transform ``T`` minimising ``sum_i |T source_i - target_i|^2`` (points ``(n, 3)``).
+
+    The sign correction ``D = diag(1, 1, det(V U^T))`` keeps the rotation proper (Kabsch 1976; Arun et al. 1987).
+    """
+    src = np.asarray(source, dtype=float)
+    dst = np.asarray(target, dtype=float)
+    if src.shape != dst.shape or src.ndim != 2 or src.shape[1] != 3:
+        raise ValueError(f"Expected two point sets of equal shape (n, 3), got {src.shape} and {dst.shape}")
+    cs, cd = src.mean(axis=0), dst.mean(axis=0)
+    U, _, Vt = np.linalg.svd((src - cs).T @ (dst - cd))
+    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
+    R = Vt.T @ D @ U.T
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = cd - R @ cs
+    return T
 
 
 @dataclass(frozen=True)

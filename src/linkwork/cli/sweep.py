@@ -1,0 +1,68 @@
+"""``linkwork sweep``: a parameter study of a linkage family or a synthesis problem, one row per grid point."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.text import Text
+
+from linkwork.cli.common import fail, friendly_errors
+from linkwork.outputs.staging import console
+
+
+@friendly_errors
+def sweep(
+    study_file: Annotated[
+        Path, typer.Argument(help="The study file (TOML): a linkage or problem and a [grid].")
+    ],
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(help="Local worker processes (default: one per core; 0 runs in this process)."),
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
+) -> None:
+    """Run every grid point of a study: sweep.parquet, sweep.csv and plots in --out."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from linkwork.errors import RequestNotMetError
+    from linkwork.outputs.sweep import print_sweep_summary, write_sweep_outputs
+    from linkwork.studies.study_file import load_study
+    from linkwork.studies.sweep import run_sweep
+
+    if workers is not None and workers < 0:
+        raise fail(f"--workers {workers}: expected 0 or more")
+    study = load_study(study_file)
+    total = len(study.points())
+    console.print(Text(study.name, style="bold"), f"{study.kind} study of {total} grid point(s)", sep=": ")
+    with Progress(
+        TextColumn("grid points"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    ) as bar:
+        task = bar.add_task("", total=total)
+        results = run_sweep(
+            study,
+            scheduler=scheduler,
+            workers=workers,
+            progress=lambda done, _total: bar.update(task, completed=done),
+        )
+    figures = write_sweep_outputs(study, results, out, plots=not no_plots)
+    rows = [row for row, _ in results]
+    print_sweep_summary(study, rows)
+    console.print(f"wrote {', '.join(['sweep.parquet', 'sweep.csv', *[f.name for f in figures]])} to {out}/")
+    failed = sum(1 for row in rows if row.get("error"))
+    if failed == len(rows):
+        raise RequestNotMetError(f"every grid point failed; the first said: {rows[0]['error']}")

@@ -1,0 +1,143 @@
+"""What a located singular point is: a bifurcation point with its branch tangents, or where the path meets a
+higher-dimensional component of the configuration space; and where the drive folds back.
+
+A point where the Jacobian's rank drops is a bifurcation point when the solution set near it is a finite set of
+curves (two or more branch tangents, Kumar & Pellegrino 2000). When the solution set near it has dimension two or
+more (e.g. the Sarrus linkage folded flat, where two hinge lines coincide), it is not a point of a branch graph but
+an entry into a component of that dimension: reported once, with no branch switching along it.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.bifurcation import branch_tangents, correct_on_plane, hermite, polish
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.rank import Tolerances, numerical_rank
+from linkwork.kinematics.trace_result import Bifurcation
+from linkwork.kinematics.workspace import Workspace
+
+if TYPE_CHECKING:
+    from linkwork.kinematics.marcher import MarchSettings
+
+Array = NDArray[np.float64]
+
+#: Directions sampled in the null space to tell an isolated point from a higher-dimensional component.
+COMPONENT_SAMPLES = 12
+#: Distance (in the unknowns) of those samples from the point.
+COMPONENT_RADIUS = 1e-3
+
+
+def component_dimension(ws: Workspace, u: Array, tol: Tolerances) -> int:
+    """Dimension of the configuration space near ``u`` when it is 2 or more, else 0.
+
+    Points at distance :data:`COMPONENT_RADIUS` along directions of the Jacobian's null space are corrected onto
+    the loop; when (nearly) every direction leads to a configuration, and the mobility there is 2 or more, ``u``
+    lies on a component of that dimension. Near an isolated bifurcation point the corrected points lie on its
+    branches, where the mobility is one.
+    """
+    _, _, jac = ws.evaluate(u)
+    _, s, Vt = np.linalg.svd(jac)
+    m = jac.shape[1]
+    nullity = m - numerical_rank(s, tol)
+    if nullity < 2:
+        return 0
+    N = Vt[m - nullity :].T
+    rng = np.random.default_rng(0)
+    mobilities = []
+    for a in rng.normal(size=(COMPONENT_SAMPLES, nullity)):
+        direction = N @ (a / np.linalg.norm(a))
+        v, _r, ok = correct_on_plane(ws, u + COMPONENT_RADIUS * direction, direction, tol)
+        if not ok or np.linalg.norm(v - u) > 3.0 * COMPONENT_RADIUS:
+            continue
+        _, _, jv = ws.evaluate(v)
+        mobilities.append(m - numerical_rank(np.linalg.svd(jv, compute_uv=False), tol))
+    if len(mobilities) < 0.75 * COMPONENT_SAMPLES:
+        return 0
+    dim = int(np.median(mobilities))
+    return dim if dim >= 2 else 0
+
+
+def classify_point(
+    mech: Mechanism,
+    ws: Workspace,
+    ident: int,
+    branch: int,
+    step: int,
+    u: Array,
+    width: float,
+    cfg: MarchSettings,
+) -> Bifurcation:
+    """Classify a located point: rank, singular values, branch tangents (over the joints and the unknowns), or
+    the dimension of the component it lies on.
+
+    ``kind``: ``"component"`` (the configuration space has dimension 2 or more there), ``"bifurcation"`` (two or
+    more branch tangents), or ``"fold"`` (fewer than two real branch tangents: the path only touches the singular
+    set there and no other branch leaves it)."""
+    tol = cfg.tol
+    dim = component_dimension(ws, u, tol)
+    if dim >= 2:
+        _, _, jac = ws.evaluate(u)
+        sigma = np.asarray(np.linalg.svd(jac, compute_uv=False), dtype=float)
+        tangents_u = np.zeros((0, len(u)))
+        method, rank = "component", numerical_rank(sigma, tol)
+    else:
+        tangents_u, method, rank, sigma = branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
+        if len(tangents_u) == 2:
+            polished, gap = polish(ws, u, tangents_u, tol)
+            if np.isfinite(gap) and gap < tol.polish_gap:
+                u, width = polished, gap
+                tangents_u, method, rank, sigma = branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
+    res_norm, _, _ = ws.evaluate(u)
+    C = mech.coupling_matrix()
+    over_joints = np.array([C @ t / np.linalg.norm(C @ t) for t in tangents_u]).reshape(
+        len(tangents_u), mech.n_joints
+    )
+    return Bifurcation(
+        id=ident,
+        branch=branch,
+        step=step,
+        u=u.copy(),
+        angles=mech.angles_from_q(mech.q_from_u(u)),
+        rank=rank,
+        sigma=sigma,
+        tangents=over_joints,
+        method=method,
+        residual=res_norm,
+        bracket=width,
+        tangents_u=tangents_u,
+        kind="component" if dim >= 2 else ("bifurcation" if len(tangents_u) >= 2 else "fold"),
+        dimension=dim,
+    )
+
+
+def locate_fold(
+    ws: Workspace, u_a: Array, t_a: Array, u_b: Array, t_b: Array, drive: int, tol: Tolerances
+) -> Array:
+    """The fold of the drive between path points ``a`` and ``b``: where the tangent's drive component vanishes.
+
+    Bisection on ``h = t_a . (u - u_a)``; each trial point is predicted by the cubic Hermite curve through the two
+    points and corrected in the hyperplane of its ``h`` (as :func:`linkwork.kinematics.bifurcation.locate`).
+    """
+    sign_a = np.sign(t_a[drive])
+    lo, hi = (0.0, u_a, t_a), (float(t_a @ (u_b - u_a)), u_b, t_b)
+    best = u_a
+    for _ in range(100):
+        if abs(hi[0] - lo[0]) < tol.locate:
+            break
+        x = 0.5 * (lo[0] + hi[0])
+        u_x, _, ok = correct_on_plane(ws, hermite(x, lo, hi, t_a), t_a, tol)
+        if not ok:
+            break
+        _, _, jac = ws.evaluate(u_x)
+        t_x = np.linalg.svd(jac)[2][-1]
+        t_x = t_x if t_x @ t_a > 0 else -t_x
+        best = u_x
+        if np.sign(t_x[drive]) == sign_a:
+            lo = (x, u_x, t_x)
+        else:
+            hi = (x, u_x, t_x)
+    return best

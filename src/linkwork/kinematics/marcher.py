@@ -1,0 +1,460 @@
+"""The branch marcher: follows one branch after another with the compiled march and collects what it meets.
+
+:class:`BranchMarcher` owns the growing result of a trace (points, located bifurcation points, folds of the
+drive, branches) and the shared step budget. :meth:`BranchMarcher.run_branch` marches one branch to its end in
+named steps: march a chunk (:meth:`~BranchMarcher.march_chunk`), cut it where it enters a higher-dimensional
+component, record it, scan it for rank drops without a sign change and for folds of the drive, then handle the
+stop code. :meth:`BranchMarcher.follow_queue` traces every branch queued at a bifurcation point (Sec. 6 of
+Gan & Pellegrino 2006; branch switching after Kumar & Pellegrino 2000).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.geometry.angles import wrap
+from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
+from linkwork.kinematics.classify import classify_point, locate_fold
+from linkwork.kinematics.march import (
+    CLOSED,
+    FAILED,
+    LIMIT,
+    NO_PROGRESS,
+    SIGN_CHANGE,
+    STOP_REASONS,
+)
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
+from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold
+from linkwork.kinematics.workspace import Workspace
+
+Array = NDArray[np.float64]
+Progress = Callable[[float, str], None]
+
+
+@dataclass(frozen=True)
+class MarchSettings:
+    """What every march of one trace shares: the drive, the step control, the path's rank, limits, tolerances.
+
+    ``target`` is the drive's target in the unknowns (``None``: none); ``lo``/``hi`` are the limits in the
+    unknowns (``-inf``/``inf`` where none); ``periodic`` marks the revolute unknowns (compared modulo a turn).
+    """
+
+    drive: int
+    target: float | None
+    min_step: float
+    max_step: float
+    cos_turn: float
+    r_path: int
+    n_sigma: int
+    periodic: NDArray[np.bool_]
+    lo: Array
+    hi: Array
+    tol: Tolerances
+
+
+@dataclass
+class Chunk:
+    """The rows one call of the compiled march wrote (row 0 is its start), its stop code and last step."""
+
+    u: Array
+    t: Array
+    sigma: Array
+    res: Array
+    tau: Array
+    s: Array
+    count: int
+    code: int
+    h: float
+
+
+@dataclass
+class Rows:
+    """Growing per-point storage, one block of rows per compiled march call."""
+
+    u: list[Array] = field(default_factory=list)
+    sigma: list[Array] = field(default_factory=list)
+    res: list[Array] = field(default_factory=list)
+    tau: list[Array] = field(default_factory=list)
+    s: list[Array] = field(default_factory=list)
+    branch: list[NDArray[np.int64]] = field(default_factory=list)
+    step: list[NDArray[np.int64]] = field(default_factory=list)
+
+    def add_point(self, u: Array, sigma: Array, res: float, branch: int) -> None:
+        """Append one point (a bifurcation point opening a branch: arclength 0, step 0, test 0)."""
+        self.u.append(u[None, :].copy())
+        self.sigma.append(sigma[None, :].copy())
+        self.res.append(np.array([res]))
+        self.tau.append(np.zeros(1))
+        self.s.append(np.zeros(1))
+        self.branch.append(np.array([branch], dtype=np.int64))
+        self.step.append(np.zeros(1, dtype=np.int64))
+
+
+@dataclass
+class QueuedBranch:
+    """A branch to trace from a bifurcation point: its parent branch, the point and the direction to leave in."""
+
+    parent: int
+    bifurcation: int
+    u: Array
+    tangent: Array
+    direction: int
+
+
+class BranchMarcher:
+    """Traces branches and collects their points, bifurcation points, folds and the branch graph."""
+
+    def __init__(
+        self,
+        mech: Mechanism,
+        settings: MarchSettings,
+        max_steps: int,
+        *,
+        switch_branches: bool,
+        progress: Progress | None = None,
+    ) -> None:
+        self.mech = mech
+        self.ws = Workspace.of(mech)
+        self.cfg = settings
+        self.budget = max_steps
+        self.switch_branches = switch_branches
+        self.progress = progress
+        self.rows = Rows()
+        self.found: list[Bifurcation] = []
+        self.folds: list[Fold] = []
+        self.branches: list[Branch] = []
+        self.queue: list[QueuedBranch] = []
+        self.max_misfit = 0.0
+        self.spurious = 0
+
+    # ---- one compiled call
+    def march_chunk(
+        self,
+        u: Array,
+        t: Array,
+        u_home: Array,
+        basis: Array,
+        paper: bool,
+        h0: float,
+        n: int,
+        check_closed: bool,
+    ) -> Chunk:
+        """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place)."""
+        cfg, tol, m = self.cfg, self.cfg.tol, len(u)
+        out = Chunk(
+            u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
+            res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty(n + 1), count=0, code=0, h=h0,
+        )  # fmt: skip
+        ws = self.ws
+        out.count, out.code, out.h = ws.kernels.march(
+            twists=ws.twists, loop_joint=ws.loop_joint, loop_sign=ws.loop_sign, loop_ptr=ws.loop_ptr,
+            rows=ws.rows, groups=ws.groups, u0=u, t0=t, u_home=u_home, basis=basis, paper=paper,
+            drive=cfg.drive, h0=h0, hmin=cfg.min_step, hmax=cfg.max_step, cos_turn=cfg.cos_turn,
+            target=0.0 if cfg.target is None else cfg.target, has_target=cfg.target is not None,
+            tol=tol.closure, exact=tol.exact, roundoff=tol.roundoff, truncate=tol.truncate,
+            max_iter=tol.max_iter, advance=tol.advance, stall_steps=tol.stall_steps,
+            stall_length=tol.stall_length, max_steps=n, r_path=cfg.r_path, periodic=cfg.periodic,
+            lo=cfg.lo, hi=cfg.hi, detect=True, check_closed=check_closed,
+            out_u=out.u, out_t=out.t, out_sigma=out.sigma, out_res=out.res, out_tau=out.tau, out_s=out.s,
+        )  # fmt: skip
+        return out
+
+    # ---- one branch
+    def run_branch(
+        self,
+        branch_id: int,
+        u0: Array,
+        t0: Array,
+        basis: Array,
+        *,
+        paper: bool,
+        h0: float,
+        stop_at_known: bool,
+        step_offset: int = 0,
+        check_closed: bool = True,
+    ) -> tuple[int, str]:
+        """March one branch to its end, locating bifurcations and folds on the way; returns (steps, end reason).
+
+        ``step_offset``: step number of ``u0`` in its branch (1 when the branch opens at a bifurcation point).
+        """
+        u, t, u_home = u0.copy(), t0.copy(), u0.copy()
+        n_steps, first = 0, True
+        while True:
+            n = max(min(self.budget, 100 if self.progress else self.budget), 0)
+            if n <= 0 and not first:
+                return n_steps, STOP_REASONS[0]
+            basis_prev = basis.copy()
+            chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
+            limit_reason = self._land_on_limit(chunk) if chunk.code == LIMIT else None
+            component = self._component_entry(chunk)
+            if component is not None:
+                chunk.count = component + 1
+            self._record(chunk, branch_id, first, n_steps)
+            base = n_steps + step_offset
+            n_steps += chunk.count - 1
+            self.budget -= chunk.count - 1
+            self._scan_rank_minima(chunk, branch_id, base)
+            self._scan_folds(chunk, branch_id, base)
+            first = False
+            if self.progress:
+                self.progress(chunk.count - 1, f"branch {branch_id}")
+            if component is not None:
+                return n_steps, self._enter_component(chunk, branch_id, base + component)
+            if chunk.code == SIGN_CHANGE:
+                known = self._on_sign_change(chunk, basis_prev, branch_id, n_steps + step_offset)
+                if known is not None and stop_at_known:
+                    self._end_on_known(chunk, known)
+                    return n_steps, f"reached bifurcation {known}"
+            elif chunk.code == CLOSED and self._turns_towards_target(chunk, u_home):
+                # A full turn of the drive: the target is further round.
+                u_home = chunk.u[chunk.count - 1].copy()
+            elif chunk.code != 0 or self.budget <= 0:
+                return n_steps, limit_reason or self._end_reason(chunk, paper)
+            if self.budget <= 0:
+                return n_steps, STOP_REASONS[0]
+            u, t, h0 = chunk.u[chunk.count - 1].copy(), chunk.t[chunk.count - 1].copy(), chunk.h
+
+    def _land_on_limit(self, chunk: Chunk) -> str:
+        """Replace the chunk's last row (past a limit) by the point of the step where the joint is at its limit.
+
+        From the row before it, the predictor goes along the tangent to the limit's value and the corrector
+        holds that unknown there (as when landing on a target), so a branch ends exactly on the limit. Returns
+        the end reason, ``limit <joint>``.
+        """
+        cfg, c = self.cfg, chunk.count
+        u_a, t_a, u_b = chunk.u[c - 2], chunk.t[c - 2], chunk.u[c - 1]
+        over = np.flatnonzero((u_b < cfg.lo) | (u_b > cfg.hi))
+        reason = "limit " + ", ".join(self.mech.joint_names[self.mech.group_members()[g][0]] for g in over)
+        g = int(over[0])
+        bound = cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g]
+        if abs(t_a[g]) < 1e-12:
+            return reason
+        guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
+        guess[g] = bound
+        tol, ws = cfg.tol, self.ws
+        ok, _, r = ws.kernels.correct(
+            *ws.kernel_arrays(), guess, g, tol.closure, tol.exact, tol.roundoff, tol.truncate, tol.max_iter,
+            ws.q, ws.res, ws.jac,
+        )  # fmt: skip
+        if not ok:
+            return reason
+        _, _, jac = ws.evaluate(guess)
+        chunk.u[c - 1] = guess
+        chunk.sigma[c - 1] = np.linalg.svd(jac, compute_uv=False)[: cfg.n_sigma]
+        chunk.res[c - 1] = r
+        chunk.s[c - 1] = chunk.s[c - 2] + float(np.linalg.norm(guess - u_a))
+        return reason
+
+    def _turns_towards_target(self, chunk: Chunk, u_home: Array) -> bool:
+        """Whether a closed path turned the (revolute) drive by whole turns towards a target still ahead."""
+        cfg, d = self.cfg, self.cfg.drive
+        if cfg.target is None or not cfg.periodic[d]:
+            return False
+        now = chunk.u[chunk.count - 1, d]
+        turned = now - u_home[d]
+        return abs(turned) > np.pi and (cfg.target - now) * turned > 0.0
+
+    def _end_reason(self, chunk: Chunk, paper: bool) -> str:
+        """The end reason a user reads for a chunk's stop code."""
+        if chunk.code == FAILED:
+            if paper:
+                return "corrector failed at a fixed drive step (the drive cannot take that value here)"
+            return f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
+        if chunk.code == NO_PROGRESS:
+            return (
+                f"no progress ({self.cfg.tol.stall_steps} steps advanced less than "
+                f"{self.cfg.tol.stall_length:g} of the largest step)"
+            )
+        return STOP_REASONS[chunk.code]
+
+    def _record(self, chunk: Chunk, branch_id: int, first: bool, n_steps: int) -> None:
+        """Append a chunk's rows (all of them for the branch's first chunk, else without its start row)."""
+        rows, count = self.rows, chunk.count
+        s_base = rows.s[-1][-1] if (not first and rows.s) else 0.0
+        begin = 0 if first else 1
+        rows.u.append(chunk.u[begin:count])
+        rows.sigma.append(chunk.sigma[begin:count])
+        rows.res.append(chunk.res[begin:count])
+        rows.tau.append(chunk.tau[begin:count])
+        rows.s.append(s_base + chunk.s[begin:count])
+        rows.branch.append(np.full(count - begin, branch_id, dtype=np.int64))
+        rows.step.append(n_steps + np.arange(begin, count) - begin + (0 if first else 1))
+        if count > begin:
+            self.max_misfit = max(self.max_misfit, float(np.max(chunk.res[begin:count])))
+
+    # ---- what a chunk meets
+    def _component_entry(self, chunk: Chunk) -> int | None:
+        """Index of the first of ``component_points`` consecutive points of mobility >= 2, if any."""
+        need = self.cfg.tol.component_points
+        if chunk.count < need:
+            return None
+        mobility = len(chunk.u[0]) - numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)
+        run = 0
+        for k, mob in enumerate(mobility):
+            run = run + 1 if mob >= 2 else 0
+            if run >= need and k + 1 - need > 0:
+                return k + 1 - need
+        return None
+
+    def _enter_component(self, chunk: Chunk, branch_id: int, step: int) -> str:
+        """Record where the branch meets a higher-dimensional component (once) and the end reason."""
+        u = chunk.u[chunk.count - 1]
+        known = self._match(u)
+        if known is None:
+            bif = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u, 0.0, self.cfg)
+            if bif.kind != "component":  # the mobility along the branch says so, whatever the samples found
+                dim = self.mech.n_unknowns - numerical_rank(chunk.sigma[chunk.count - 1], self.cfg.tol)
+                empty = np.zeros((0, len(u)))
+                bif = replace(bif, kind="component", dimension=dim, tangents=empty, tangents_u=empty)
+            self.found.append(bif)
+            known = bif.id
+        dim = self.found[known].dimension
+        return f"entered a {dim}-dimensional component (mobility {dim}) at point {known}"
+
+    def _scan_rank_minima(self, chunk: Chunk, branch_id: int, base: int) -> None:
+        """Rank drops where the test function keeps its sign: local minima of ``sigma_r / sigma_1``."""
+        r_path, tol, count = self.cfg.r_path, self.cfg.tol, chunk.count
+        if r_path < 1 or count < 3:
+            return
+        ratio = chunk.sigma[:count, r_path - 1] / chunk.sigma[:count, 0]
+        tau = chunk.tau
+        for k in range(1, count - 1):
+            if not (ratio[k] <= ratio[k - 1] and ratio[k] < ratio[k + 1] and ratio[k] < tol.local_min):
+                continue
+            if tau[k - 1] * tau[k] < 0.0 or tau[k] * tau[k + 1] < 0.0:
+                continue  # a sign change: located by the test function
+            u_min, r_min = locate_minimum(
+                self.ws, chunk.u[k - 1], chunk.t[k - 1], chunk.u[k + 1], chunk.t[k + 1], r_path, tol
+            )
+            if r_min <= tol.loose and self._match(u_min) is None:
+                bif = classify_point(
+                    self.mech, self.ws, len(self.found), branch_id, base + k, u_min, 0.0, self.cfg
+                )
+                self._add_point(bif, branch_id, chunk.t[k])
+
+    def _scan_folds(self, chunk: Chunk, branch_id: int, base: int) -> None:
+        """Locate every fold of the drive in the chunk: the tangent's drive component changes sign."""
+        d = self.cfg.drive
+        td = chunk.t[: chunk.count, d]
+        for k in np.flatnonzero(td[:-1] * td[1:] < 0.0):
+            u_f = locate_fold(
+                self.ws, chunk.u[k], chunk.t[k], chunk.u[k + 1], chunk.t[k + 1], d, self.cfg.tol
+            )
+            angles = self.mech.angles_from_q(self.mech.q_from_u(u_f))
+            self.folds.append(Fold(branch_id, base + int(k), float(u_f[d]), angles))
+
+    def _on_sign_change(self, chunk: Chunk, basis_prev: Array, branch_id: int, step: int) -> int | None:
+        """Locate the zero of the test function in the chunk's last step; returns the id if already known."""
+        cfg, c = self.cfg, chunk.count
+        passed = self._known_on_step(chunk.u[c - 2], chunk.u[c - 1])
+        if passed is not None:
+            return passed
+        basis_a = self._basis_before(chunk.u[c - 2], chunk.t[c - 2], basis_prev)
+        u_star, width = locate(
+            self.ws, chunk.u[c - 2], chunk.t[c - 2], basis_a, chunk.u[c - 1], chunk.t[c - 1],
+            cfg.r_path, cfg.tol, cfg.n_sigma,
+        )  # fmt: skip
+        known = self._match(u_star)
+        if known is None:
+            bif = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u_star, width, cfg)
+            if bif.kind != "component" and bif.rank >= cfg.r_path:
+                self.spurious += (
+                    1  # the test function changed sign without a rank drop: not a point to report
+                )
+            else:
+                self._add_point(bif, branch_id, chunk.t[c - 2])
+        return known
+
+    def _known_on_step(self, u_a: Array, u_b: Array) -> int | None:
+        """A located point the step from ``u_a`` to ``u_b`` passes through (again), if any."""
+        periodic = self.cfg.periodic
+
+        def dist(x: Array, y: Array) -> float:
+            diff = x - y
+            diff[periodic] = wrap(diff[periodic])
+            return float(np.linalg.norm(diff))
+
+        length = dist(u_a, u_b)
+        for b in self.found:
+            if dist(u_a, b.u) + dist(b.u, u_b) <= length * (1.0 + 1e-3) + self.cfg.tol.locate:
+                return b.id
+        return None
+
+    def _add_point(self, bif: Bifurcation, branch_id: int, incoming: Array) -> None:
+        """Keep a classified point and queue its new branches (both directions) when switching branches."""
+        self.found.append(bif)
+        if not self.switch_branches or bif.kind != "bifurcation":
+            return
+        for tb in bif.tangents_u:
+            if abs(tb @ incoming) < self.cfg.tol.same_branch:
+                for direction in (1, -1):
+                    self.queue.append(QueuedBranch(branch_id, bif.id, bif.u, direction * tb, direction))
+
+    def _end_on_known(self, chunk: Chunk, known: int) -> None:
+        """End the branch exactly on a known point (its last row overshot it by part of a step)."""
+        before = chunk.u[chunk.count - 2]
+        diff = self.found[known].u - before
+        diff[self.cfg.periodic] = wrap(diff[self.cfg.periodic])
+        point = before + diff  # the same point, in this branch's continuous angles
+        r_known, _, j_known = self.ws.evaluate(point)
+        rows = self.rows
+        rows.u[-1][-1] = point
+        rows.sigma[-1][-1] = np.linalg.svd(j_known, compute_uv=False)[: self.cfg.n_sigma]
+        rows.res[-1][-1] = r_known
+        rows.tau[-1][-1] = 0.0
+
+    def _basis_before(self, u: Array, t: Array, basis_prev: Array) -> Array:
+        """The oriented range basis at point ``u`` (as the march kept it), recomputed for the locator."""
+        _, _, jac = self.ws.evaluate(u)
+        basis = basis_prev.copy()
+        self.ws.kernels.tangent_and_test(
+            jac, t.copy(), basis, self.cfg.r_path, np.empty_like(t), np.empty(min(jac.shape))
+        )
+        return basis
+
+    def _match(self, u: Array) -> int | None:
+        """Id of an already located point at ``u`` (angles compared modulo a full turn), if any."""
+        tol = self.cfg.tol.same_point * max(1.0, float(np.linalg.norm(u)))
+        for b in self.found:
+            diff = b.u - u
+            diff[self.cfg.periodic] = wrap(diff[self.cfg.periodic])
+            if np.linalg.norm(diff) < tol:
+                return b.id
+        return None
+
+    # ---- the queued branches
+    def follow_queue(self) -> None:
+        """Trace every queued branch (breadth first) while the step budget lasts."""
+        cfg = self.cfg
+        while self.queue and self.budget > 0:
+            job = self.queue.pop(0)
+            bid = len(self.branches)
+            h = cfg.max_step / 4.0
+            u1, _r, ok = correct_on_plane(self.ws, job.u + h * job.tangent, job.tangent, cfg.tol)
+            if not ok:
+                self.branches.append(
+                    Branch(
+                        bid, job.parent, job.bifurcation, job.direction, 0, "could not leave the bifurcation"
+                    )
+                )
+                continue
+            _, _, jac1 = self.ws.evaluate(u1)
+            U1, _, Vt1 = np.linalg.svd(jac1)
+            t1 = Vt1[-1] if Vt1[-1] @ job.tangent > 0 else -Vt1[-1]
+            # Record the bifurcation point itself as the branch's first point, then march on.
+            r_star, _, jst = self.ws.evaluate(job.u)
+            sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
+            self.rows.add_point(job.u, sigma_star, r_star, bid)
+            s_off = float(np.linalg.norm(u1 - job.u))
+            start_len = len(self.rows.u)
+            basis = np.ascontiguousarray(U1[:, : cfg.r_path])
+            nb, rb = self.run_branch(bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1)
+            for i in range(start_len, len(self.rows.u)):
+                self.rows.s[i] = self.rows.s[i] + s_off
+                self.rows.step[i] = self.rows.step[i] + 1
+            self.branches.append(Branch(bid, job.parent, job.bifurcation, job.direction, nb + 1, rb))

@@ -1,0 +1,69 @@
+"""The flattened mechanism the compiled kernels read, with scratch arrays for one evaluation at a time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.jit import march_kernels
+from linkwork.kinematics.mechanism import Mechanism
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class Workspace:
+    """The flattened mechanism and scratch arrays the compiled kernels need.
+
+    ``twists``, ``loop_joint``, ``loop_sign``, ``loop_ptr``, ``rows`` and ``groups`` are the arrays of
+    :meth:`Mechanism.loop_arrays` and friends, in the layout :func:`linkwork.kinematics.march.march` takes;
+    ``q``, ``res`` and ``jac`` are overwritten by every :meth:`evaluate`. ``kernels`` is the implementation of
+    the :mod:`~linkwork.kinematics.march` kernels to call (compiled, or the same functions as plain Python while
+    numba's cache is cold; chosen by :func:`linkwork.kinematics.jit.march_kernels`).
+    """
+
+    twists: Array
+    loop_joint: NDArray[np.int64]
+    loop_sign: NDArray[np.int64]
+    loop_ptr: NDArray[np.int64]
+    rows: NDArray[np.int64]
+    groups: NDArray[np.int64]
+    q: Array
+    res: Array
+    jac: Array
+    kernels: Any
+
+    @classmethod
+    def of(cls, mech: Mechanism) -> Workspace:
+        """Scratch space for ``mech``."""
+        lj, ls, lp = mech.loop_arrays()
+        return cls(
+            twists=mech.twists,
+            loop_joint=lj,
+            loop_sign=ls,
+            loop_ptr=lp,
+            rows=np.array(mech.rows, dtype=np.int64),
+            groups=mech.groups,
+            q=np.empty(mech.n_joints),
+            res=np.empty(mech.n_equations),
+            jac=np.empty((mech.n_equations, mech.n_unknowns)),
+            kernels=march_kernels(),
+        )
+
+    def kernel_arrays(
+        self,
+    ) -> tuple[
+        Array, NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]
+    ]:
+        """The mechanism arrays in the order the compiled kernels take them (``twists`` ... ``groups``)."""
+        return self.twists, self.loop_joint, self.loop_sign, self.loop_ptr, self.rows, self.groups
+
+    def evaluate(self, u: Array) -> tuple[float, Array, Array]:
+        """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
+        r = self.kernels.evaluate(
+            *self.kernel_arrays(), np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac
+        )
+        return float(r), self.res.copy(), self.jac.copy()

@@ -1,0 +1,266 @@
+"""Imperfection sensitivity by Monte Carlo along a nominal path, with its first-order prediction.
+
+:func:`prepare` traces the nominal path once and builds everything a worker needs (:class:`RobustnessSetup`);
+:func:`run_chunk` draws a chunk of imperfect samples, solves each one's misfit at every drive value (compiled
+batch kernel, :mod:`linkwork.studies.misfit`) and its first-order prediction (:mod:`linkwork.studies.first_order`),
+and returns per-sample rows plus mergeable per-drive histograms; :func:`robustness` runs the chunks on the Dask
+engine and merges them into a :class:`RobustnessResult`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.errors import SpecError
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.trace_result import Trace
+from linkwork.studies import bands
+from linkwork.studies.engine import default_workers, map_chunks
+from linkwork.studies.first_order import first_order_misfit, sensitivity_maps
+from linkwork.studies.imperfections import (
+    HingeLines,
+    ImperfectionModel,
+    component_scale,
+    hinge_errors,
+    perturbed_twists,
+    sample_seeds,
+)
+from linkwork.studies.misfit import misfit_batch
+from linkwork.studies.scale import MisfitScale, misfit_scale
+
+Array = NDArray[np.float64]
+
+#: Gauss-Newton iterations per drive value at most.
+MAX_ITER = 30
+#: Samples per task unless fewer are asked.
+CHUNK = 2000
+
+
+@dataclass(frozen=True)
+class RobustnessSetup:
+    """What every worker needs: the mechanism (as perturbed), the nominal path and the first-order maps."""
+
+    mech: Mechanism
+    model: ImperfectionModel
+    seed: int
+    lines: HingeLines
+    scale: MisfitScale
+    u_path: Array
+    drive_values: Array
+    drive_unknown: int
+    normal: Array
+    G: Array
+    ratio_weighted: Array
+    keep_tol: float
+
+    def kernel_args(self) -> tuple[Any, ...]:
+        """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists."""
+        joint, sign, ptr = self.mech.loop_arrays()
+        rows = np.array(self.mech.rows, dtype=np.int64)
+        return (self.u_path, self.normal, joint, sign, ptr, rows, self.mech.groups, self.scale.weight)
+
+
+@dataclass
+class ChunkResult:
+    """Per-sample rows of one chunk and its per-drive histograms (misfit, first order) and maxima."""
+
+    sample: NDArray[np.int64]
+    seed: NDArray[np.uint64]
+    misfit_max: Array
+    at_step: NDArray[np.int64]
+    mobility_kept: NDArray[np.bool_]
+    first_order_max: Array
+    hist: NDArray[np.int64]
+    hist_first: NDArray[np.int64]
+    drive_max: Array
+
+
+def prepare(
+    mech: Mechanism,
+    path: Trace,
+    model: ImperfectionModel,
+    seed: int = 0,
+) -> RobustnessSetup:
+    """The set-up of a study of ``mech`` along the first branch of ``path`` (its nominal motion)."""
+    if model.spatial and mech.planar:
+        mech = replace(mech, planar=False)
+    first = path.branch == (path.branches[0].id if path.branches else 0)
+    q = mech.q_from_angles(path.angles[first])
+    u_path = np.ascontiguousarray(mech.u_from_q(q))
+    if u_path.shape[0] < 1:
+        raise SpecError("the nominal path has no points")
+    drive_joint = mech.index(path.drive)
+    drive_unknown = int(mech.groups[drive_joint])
+    scale = misfit_scale(mech)
+    lines = HingeLines.of(mech, scale.centre)
+    G, ratio, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
+    comp = component_scale(mech, model, lines)
+    tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
+    return RobustnessSetup(
+        mech=mech,
+        model=model,
+        seed=int(seed),
+        lines=lines,
+        scale=scale,
+        u_path=u_path,
+        drive_values=path.angles[first, drive_joint],
+        drive_unknown=drive_unknown,
+        normal=normal,
+        G=G,
+        ratio_weighted=ratio,
+        keep_tol=1e-6 * tol_size + 1e-12 * scale.length,
+    )
+
+
+def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
+    """Samples ``start .. stop - 1``: misfits along the path by Gauss-Newton, and their first-order prediction."""
+    seeds = sample_seeds(setup.seed, start, stop)
+    errors = hinge_errors(seeds, setup.mech, setup.model, setup.lines)
+    twists = perturbed_twists(errors, setup.lines)
+    u_path, normal, joint, sign, ptr, rows, groups, weight = setup.kernel_args()
+    misfit = misfit_batch(twists, u_path, normal, joint, sign, ptr, rows, groups, weight, MAX_ITER)
+    predicted = first_order_misfit(setup.G, errors)
+    at = np.argmax(misfit, axis=1)
+    worst = misfit[np.arange(len(seeds)), at]
+    return ChunkResult(
+        sample=np.arange(start, stop, dtype=np.int64),
+        seed=seeds,
+        misfit_max=worst,
+        at_step=at.astype(np.int64),
+        mobility_kept=worst <= setup.keep_tol,
+        first_order_max=predicted.max(axis=1),
+        hist=bands.histogram(misfit, setup.scale.length),
+        hist_first=bands.histogram(predicted, setup.scale.length),
+        drive_max=misfit.max(axis=0),
+    )
+
+
+def first_order_only(setup: RobustnessSetup, start: int, stop: int) -> Array:
+    """``(S,)`` the first-order prediction of the largest misfit of samples ``start .. stop - 1`` alone."""
+    seeds = sample_seeds(setup.seed, start, stop)
+    errors = hinge_errors(seeds, setup.mech, setup.model, setup.lines)
+    return first_order_misfit(setup.G, errors).max(axis=1)
+
+
+def chunk_ranges(samples: int, chunk: int | None = None, workers: int = 1) -> list[tuple[int, int]]:
+    """``(start, stop)`` of every chunk of ``samples``: ``chunk`` samples each, by default enough chunks for four
+    per worker (so that the last ones balance) of 250 to :data:`CHUNK` samples. A sample's numbers never depend
+    on its chunk."""
+    size = chunk or min(CHUNK, max(250, -(-samples // (4 * max(1, workers)))))
+    size = max(1, size)
+    return [(a, min(a + size, samples)) for a in range(0, samples, size)]
+
+
+@dataclass
+class RobustnessResult:
+    """A finished study: summary numbers, per-drive bands, and the per-sample columns (kept in memory)."""
+
+    setup: RobustnessSetup
+    samples: int
+    misfit_max: Array
+    first_order_max: Array
+    mobility_kept: NDArray[np.bool_]
+    hist: NDArray[np.int64]
+    hist_first: NDArray[np.int64]
+    drive_max: Array
+    ratio_paper: Array
+
+    def band(self, q: float, first_order: bool = False) -> Array:
+        """``(K,)`` the ``q``-quantile of the misfit (or its first-order prediction) at every drive value."""
+        counts = self.hist_first if first_order else self.hist
+        return bands.percentiles(counts, q, self.setup.scale.length)
+
+
+def merge_chunks(
+    setup: RobustnessSetup,
+    results: Iterator[ChunkResult],
+    ratio_paper: Array,
+    sink: Callable[[ChunkResult], None] | None = None,
+) -> RobustnessResult:
+    """Merge chunk results in order (``sink`` sees each one, e.g. to stream it to Parquet)."""
+    K = setup.u_path.shape[0]
+    hist = np.zeros((K, bands.N_BINS), dtype=np.int64)
+    hist_first = np.zeros_like(hist)
+    drive_max = np.zeros(K)
+    worst, first, kept = [], [], []
+    for res in results:
+        hist += res.hist
+        hist_first += res.hist_first
+        drive_max = np.maximum(drive_max, res.drive_max)
+        worst.append(res.misfit_max)
+        first.append(res.first_order_max)
+        kept.append(res.mobility_kept)
+        if sink is not None:
+            sink(res)
+    misfit_max = np.concatenate(worst) if worst else np.zeros(0)
+    return RobustnessResult(
+        setup=setup,
+        samples=len(misfit_max),
+        misfit_max=misfit_max,
+        first_order_max=np.concatenate(first) if first else np.zeros(0),
+        mobility_kept=np.concatenate(kept) if kept else np.zeros(0, dtype=bool),
+        hist=hist,
+        hist_first=hist_first,
+        drive_max=drive_max,
+        ratio_paper=ratio_paper,
+    )
+
+
+def run_study(
+    setup: RobustnessSetup,
+    samples: int,
+    ratio_paper: Array,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    client: Any = None,
+    chunk: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    sink: Callable[[ChunkResult], None] | None = None,
+) -> RobustnessResult:
+    """Run ``samples`` samples of a prepared study on the Dask engine and merge them."""
+    if samples < 1:
+        raise SpecError(f"samples must be at least 1, got {samples}")
+    if client is not None:
+        n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+    else:
+        n_workers = workers if workers is not None else default_workers()
+    results = map_chunks(
+        run_chunk,
+        setup,
+        chunk_ranges(samples, chunk, n_workers),
+        scheduler=scheduler,
+        workers=workers,
+        client=client,
+        progress=progress,
+    )
+    return merge_chunks(setup, results, ratio_paper, sink)
+
+
+def nominal_ratio(path: Trace) -> Array:
+    """``(K,)`` the paper's Sec. 5 ratio at the points of the path's first branch."""
+    first = path.branch == (path.branches[0].id if path.branches else 0)
+    return path.condition_raw()[first]  # the raw ratio, as printed in the paper (condition() is normalised)
+
+
+def robustness(
+    mech: Mechanism,
+    path: Trace,
+    model: ImperfectionModel,
+    samples: int,
+    *,
+    seed: int = 0,
+    **engine: Any,
+) -> RobustnessResult:
+    """Monte Carlo of ``samples`` imperfect copies of ``mech`` along the nominal ``path`` (from
+    :func:`linkwork.trace`), on the Dask engine; ``engine`` are the keywords of :func:`run_study`
+    (``scheduler``, ``workers``, ``client``, ``chunk``, ``progress``, ``sink``)."""
+    if samples < 1:
+        raise SpecError(f"samples must be at least 1, got {samples}")
+    setup = prepare(mech, path, model, seed)
+    return run_study(setup, samples, nominal_ratio(path), **engine)

@@ -1,0 +1,132 @@
+"""Compiled and plain-Python tracing kernels (linkwork.kinematics.jit): the same numbers either way, the plain
+ones while numba's cache is cold, a background compile for next time, and compile time kept out of a trace's
+reported seconds.
+
+The reference for the plain-Python path is the compiled path (and the other way round): they run the same
+statements, so a trace must agree point for point to 1e-12 rad, with the same branches and bifurcation points.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import subprocess
+import sys
+import time
+import types
+
+import numpy as np
+import pytest
+from numba.core.registry import CPUDispatcher
+
+import linkwork as lw
+from linkwork.kinematics import jit, march
+from linkwork.linkages.hedgepeth_rods import deployed_angles
+
+
+def _trace_in(mode: str, monkeypatch: pytest.MonkeyPatch, mech: lw.Mechanism, **kwargs: object) -> lw.Trace:
+    monkeypatch.setenv("LINKWORK_JIT", mode)
+    return lw.trace(mech, **kwargs)  # type: ignore[arg-type]
+
+
+def _assert_same(a: lw.Trace, b: lw.Trace) -> None:
+    assert a.angles.shape == b.angles.shape
+    np.testing.assert_allclose(a.angles, b.angles, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(a.sigma, b.sigma, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a.branch, b.branch)
+    assert [br.end_reason for br in a.branches] == [br.end_reason for br in b.branches]
+    assert len(a.bifurcations) == len(b.bifurcations)
+    for p, q in zip(a.bifurcations, b.bifurcations, strict=True):
+        np.testing.assert_allclose(p.angles, q.angles, rtol=0, atol=1e-12)
+
+
+def test_python_kernels_trace_the_hexagon_as_the_compiled_ones(monkeypatch: pytest.MonkeyPatch) -> None:
+    hexagon = lw.load("hedgepeth-rods", n=6)
+    until = ("A", deployed_angles(6)[0])
+    _assert_same(
+        _trace_in("python", monkeypatch, hexagon, until=until),
+        _trace_in("compiled", monkeypatch, hexagon, until=until),
+    )
+
+
+def test_python_kernels_find_the_same_bifurcations(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Guest's frame: its first bifurcation points and the branches leaving them, with a small budget.
+    frame = lw.load("guest-frame")
+    kwargs = {"branches": True, "max_steps": 700}
+    python = _trace_in("python", monkeypatch, frame, **kwargs)
+    assert python.bifurcations, "the budget must reach a bifurcation point for this test to mean anything"
+    _assert_same(python, _trace_in("compiled", monkeypatch, frame, **kwargs))
+
+
+def test_the_python_twin_calls_no_compiled_code() -> None:
+    twin = jit.python_twin({name: getattr(march, name) for name in jit.ENTRY_POINTS})
+    seen: set[int] = set()
+
+    def walk(fn: types.FunctionType) -> None:
+        if id(fn) in seen:
+            return
+        seen.add(id(fn))
+        for name in fn.__code__.co_names:
+            value = fn.__globals__.get(name)
+            assert not isinstance(value, CPUDispatcher), f"{fn.__name__} calls compiled {name}"
+            if isinstance(value, types.FunctionType) and value.__module__.startswith("linkwork"):
+                walk(value)
+
+    for name in jit.ENTRY_POINTS:
+        walk(getattr(twin, name))
+    assert len(seen) >= 8  # march, correct, evaluate, closure_jacobian, exp_unit_twist, log_rigid, ...
+
+
+def test_a_cold_cache_traces_in_python_and_compiles_in_the_background(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    started: list[tuple[list[str], dict[str, str]]] = []
+    monkeypatch.setenv("LINKWORK_JIT", "auto")
+    monkeypatch.setattr(jit, "kernels_cached", lambda: False)
+    monkeypatch.setattr(jit, "_compile_under_way", lambda: False)
+    monkeypatch.setattr(jit, "_touch_lock", lambda: None)
+    monkeypatch.setitem(jit._state, "spawned", False)
+    monkeypatch.setattr(subprocess, "Popen", lambda cmd, **kw: started.append((cmd, kw["env"])))
+    with caplog.at_level(logging.INFO, logger="linkwork.jit"):
+        kernels = jit.march_kernels()
+        jit.march_kernels()  # a second trace in the same process starts no second compile
+    assert isinstance(kernels, jit.SwitchingKernels)
+    assert kernels.march is jit.plain_march_kernels().march
+    assert len(started) == 1
+    cmd, env = started[0]
+    assert cmd == [sys.executable, "-c", jit.BACKGROUND_COMMAND] and env["LINKWORK_JIT"] == "compiled"
+    assert "compiling kernels, first run only" in caplog.text
+    # Once the compile has finished, the next call of an entry point runs compiled code.
+    monkeypatch.setattr(jit, "kernels_cached", lambda: True)
+    monkeypatch.setattr(jit.SwitchingKernels, "CHECK_SECONDS", 0.0)
+    assert kernels.evaluate is march.evaluate
+
+
+def test_compile_time_is_not_trace_time(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("LINKWORK_JIT", "compiled")
+    monkeypatch.setattr(jit, "kernels_cached", lambda: False)
+    monkeypatch.setattr(jit, "_warm_up", lambda: time.sleep(0.5))  # a stand-in compile of a known length
+    begin = time.perf_counter()
+    tr = lw.trace(lw.load("bennett"), until=("A", np.radians(70.0)))
+    elapsed = time.perf_counter() - begin
+    assert elapsed >= 0.5
+    assert tr.stats["seconds"] <= elapsed - 0.5 + 1e-3
+
+
+def test_an_empty_cache_reads_as_cold(tmp_path: object) -> None:
+    code = (
+        "from linkwork.kinematics import jit, march; print(jit.kernels_cached(), jit.is_cached(march.march))"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]
+    assert jit.kernels_cached()  # this process has traced already: warm
+
+
+def test_an_unknown_mode_is_reported_and_auto_used(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    monkeypatch.setenv("LINKWORK_JIT", "fast")
+    with caplog.at_level(logging.WARNING, logger="linkwork.jit"):
+        assert jit.mode() == "auto"
+    assert "LINKWORK_JIT=fast" in caplog.text

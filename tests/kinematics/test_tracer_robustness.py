@@ -1,0 +1,270 @@
+"""The tracer on linkages a user brings: unreachable targets, full turns, limits, play in the hinges, stalls,
+degenerate singular sets, and the branch graph of every built-in.
+
+Outside references: the crank-rocker's rocker range from triangle geometry (law of cosines at the two positions
+where crank and coupler are collinear); Bennett's closed form ``tan(t1/2) tan(t2/2) = k`` (Bennett 1903); the
+Sarrus loop closed with an independent product of rotations about its hinge lines (Rodrigues), whose
+finite-difference Jacobian gives the mobility of its flat-folded configurations.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import linkwork as lw
+from linkwork.kinematics.rank import Tolerances, numerical_rank
+from linkwork.kinematics.tracer import trace
+from linkwork.kinematics.workspace import Workspace
+from linkwork.linkages import REGISTRY
+from linkwork.linkages.sarrus import sarrus_hinges
+
+DEG = np.pi / 180.0
+FOUR_BAR = Path(__file__).resolve().parents[2] / "examples" / "specs" / "four-bar.toml"
+#: The crank-rocker of examples/specs/four-bar.toml: ground pivots A, D; crank A-B, coupler B-C, rocker C-D.
+A0, B0, C0, D0 = (np.array(p, dtype=float) for p in ([0, 0], [1, 1], [3.5, 3], [4, 0]))
+
+
+def rocker_range_deg() -> tuple[float, float]:
+    """The rocker joint's range (degrees, from its start), from the triangle A-C-D at the two positions where
+    crank and coupler are collinear (|AC| = coupler -/+ crank), by the law of cosines."""
+    crank, coupler = np.linalg.norm(B0 - A0), np.linalg.norm(C0 - B0)
+    rocker, ground = np.linalg.norm(D0 - C0), np.linalg.norm(D0 - A0)
+
+    def angle_at_d(ac: float) -> float:  # angle between D->A and D->C
+        return float(np.degrees(np.arccos((ground**2 + rocker**2 - ac**2) / (2 * ground * rocker))))
+
+    start = angle_at_d(float(np.linalg.norm(C0 - A0)))
+    extremes = [angle_at_d(coupler - crank) - start, angle_at_d(coupler + crank) - start]
+    return min(extremes), max(extremes)
+
+
+@pytest.fixture(scope="module")
+def four_bar() -> lw.Mechanism:
+    return lw.load(str(FOUR_BAR))
+
+
+def test_rocker_range_and_folds_match_the_triangle_geometry(four_bar: lw.Mechanism) -> None:
+    tr = trace(four_bar, drive="D")
+    lo, hi = rocker_range_deg()
+    d = four_bar.index("D")
+    folds = sorted(np.degrees(f.value) for f in tr.folds)
+    # Joint D turns with the angle at D in the triangle: its range is [lo, hi] from the start.
+    np.testing.assert_allclose(folds, [lo, hi], atol=1e-7)  # located folds: to Tolerances.locate
+    sampled = np.degrees(tr.angles[:, d])
+    assert lo - 1e-9 < sampled.min() < lo + 0.01 and hi - 0.01 < sampled.max() < hi + 1e-9
+
+
+def test_unreachable_target_ends_when_the_path_closes_with_its_range(four_bar: lw.Mechanism) -> None:
+    tr = trace(four_bar, until=("D", -95 * DEG))
+    lo, hi = rocker_range_deg()
+    assert tr.branches[0].end_reason == "closed path"
+    # the crank went round once (not 19 times): exactly 360 deg, the last row snapped onto the start
+    assert np.ptp(tr.angles[:, four_bar.index("A")]) == pytest.approx(2 * np.pi, abs=1e-9)
+    assert (
+        tr.stats["unmet"] == f"D never reaches -95.00 deg on this path: its range is [{lo:.2f}, {hi:.2f}] deg"
+    )
+
+
+def test_a_crank_target_beyond_one_turn_is_reached_by_turning_on(four_bar: lw.Mechanism) -> None:
+    tr = trace(four_bar, until=("A", 1000 * DEG))
+    assert tr.branches[0].end_reason == "reached target"
+    assert np.degrees(tr.angles[-1, four_bar.index("A")]) == pytest.approx(1000.0, abs=1e-9)
+    assert "unmet" not in tr.stats
+
+
+def test_a_limit_ends_the_branch_exactly_on_it(four_bar: lw.Mechanism) -> None:
+    tr = trace(four_bar, limits={"D": (-5 * DEG, 30 * DEG)})
+    assert tr.branches[0].end_reason == "limit D"
+    assert np.degrees(tr.angles[-1, four_bar.index("D")]) == pytest.approx(-5.0, abs=1e-9)
+    assert tr.residual[-1] < 1e-12
+    assert np.all(np.degrees(tr.angles[:, four_bar.index("D")]) >= -5.0 - 1e-9)
+
+
+def bennett(a1: float, a2: float, t1: float) -> lw.Mechanism:
+    """Bennett linkage in DH form (a_i = sin alpha_i, theta3 = -theta1, theta4 = -theta2)."""
+    from linkwork.kinematics.chains import from_dh
+
+    k = np.sin((a2 + a1) / 2) / np.sin((a2 - a1) / 2)
+    t2 = 2 * np.arctan(k / np.tan(t1 / 2))
+    rows = [
+        {"theta": t1, "a": np.sin(a1), "alpha": a1},
+        {"theta": t2, "a": np.sin(a2), "alpha": a2},
+        {"theta": -t1, "a": np.sin(a1), "alpha": a1},
+        {"theta": -t2, "a": np.sin(a2), "alpha": a2},
+    ]
+    return from_dh("bennett", rows)[0]
+
+
+def test_play_in_a_hinge_is_traced_within_the_closure_tolerance() -> None:
+    a1, a2 = 45 * DEG, 75 * DEG
+    exact = bennett(a1, a2, 90 * DEG)
+    twists = np.array(exact.twists, copy=True)
+    twists[1, 3:] += [0.0, 0.0, 1e-8]  # hinge B's line moved by about 1e-8: the loop is no longer mobile
+    bent = dataclasses.replace(exact, twists=twists)
+    tol = 1e-6
+    tr = trace(bent, closure_tol=tol)
+    assert tr.branches[0].end_reason == "closed path"
+    assert tr.stats["closure_tol"] == tol
+    assert 1e-12 < tr.stats["max_misfit"] <= tol  # a real misfit, within what was allowed
+    th = tr.angles
+    k = np.sin((a2 + a1) / 2) / np.sin((a2 - a1) / 2)
+    rel = np.sin(th[:, 0] / 2) * np.sin(th[:, 1] / 2) - k * np.cos(th[:, 0] / 2) * np.cos(th[:, 1] / 2)
+    assert np.max(np.abs(rel)) < 1e-5  # Bennett's closed form, to the order of the play
+    # the exact default refuses to pretend: the loop is rigid to its corrector and ends with a reason
+    strict = trace(bent)
+    assert strict.branches[0].end_reason != "closed path"
+
+
+def test_a_corrector_that_pulls_steps_back_ends_with_no_progress_not_a_step_budget() -> None:
+    mech = lw.load("bricard-trihedral")
+    good = trace(mech)
+    assert good.branches[0].end_reason == "closed path"
+    assert np.min(np.diff(good.arclength)) > 1e-4  # every step advanced
+    # without the advance test the corrector pulls every step back near A = 123 deg: the stall is caught
+    stalled = trace(mech, tol=Tolerances(advance=-np.inf), max_steps=5000)
+    assert stalled.branches[0].end_reason.startswith("no progress")
+    assert stalled.branches[0].steps < 300
+
+
+def sarrus_closure(
+    q: np.ndarray, link: float = 1.0, height: float = 1.2, beta: float = np.pi / 2
+) -> np.ndarray:
+    """The Sarrus loop product minus the identity (12 numbers), built from its hinge lines by Rodrigues' formula."""
+    points, directions = sarrus_hinges(link, height, beta)
+    total = np.eye(4)
+    for p, d, angle in zip(points, directions, q, strict=True):
+        d = d / np.linalg.norm(d)
+        K = np.array([[0, -d[2], d[1]], [d[2], 0, -d[0]], [-d[1], d[0], 0]])
+        R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+        g = np.eye(4)
+        g[:3, :3], g[:3, 3] = R, p - R @ p
+        total = total @ g
+    return (total - np.eye(4))[:3].ravel()
+
+
+def fd_mobility(q: np.ndarray, h: float = 1e-6) -> int:
+    """Six joints minus the rank of the central-difference Jacobian of :func:`sarrus_closure`."""
+    J = np.column_stack(
+        [(sarrus_closure(q + h * e) - sarrus_closure(q - h * e)) / (2 * h) for e in np.eye(6)]
+    )
+    s = np.linalg.svd(J, compute_uv=False)
+    return 6 - int(np.sum(s > 1e-6 * s[0]))
+
+
+def test_sarrus_reports_its_two_dimensional_sheet_once_per_meeting_and_no_chain_of_points() -> None:
+    mech = lw.load("sarrus")
+    tr = trace(mech, branches=True)
+    assert np.max(np.abs([sarrus_closure(q) for q in tr.angles])) < 1e-9  # the independent closure agrees
+    components = [b for b in tr.bifurcations if b.kind == "component"]
+    points = [b for b in tr.bifurcations if b.kind == "bifurcation"]
+    assert components and len(tr.bifurcations) <= 8  # was 738 "bifurcation points"
+    for b in components:
+        assert b.dimension == 2
+        assert fd_mobility(b.angles) == mech.n_unknowns - b.rank  # where the path meets the sheet
+        # a step along the extra direction stays on the loop with mobility 2: a sheet, not an isolated point
+        J = np.column_stack([(sarrus_closure(b.angles + 1e-6 * e) - sarrus_closure(b.angles - 1e-6 * e)) / 2e-6
+                             for e in np.eye(6)])  # fmt: skip
+        null = np.linalg.svd(J)[2][-2:]
+        moved = b.angles + 0.05 * (null[0] + null[1]) / np.linalg.norm(null[0] + null[1])
+        fixed = _newton_onto(moved)
+        assert np.linalg.norm(sarrus_closure(fixed)) < 1e-10 and fd_mobility(fixed) == 2
+    for b in points:
+        assert len(b.tangents) >= 2 and b.rank < int(tr.stats["start_rank"])
+    for br in tr.branches:
+        assert br.mobility == 1 and br.steps > 0
+        assert br.end_reason in ("closed path",) or br.end_reason.startswith("reached bifurcation")
+
+
+def _newton_onto(q: np.ndarray) -> np.ndarray:
+    """Minimum-norm Gauss-Newton onto the Sarrus loop with central differences (independent of linkwork)."""
+    q = q.copy()
+    for _ in range(50):
+        r = sarrus_closure(q)
+        J = np.column_stack(
+            [(sarrus_closure(q + 1e-7 * e) - sarrus_closure(q - 1e-7 * e)) / 2e-7 for e in np.eye(6)]
+        )
+        q -= np.linalg.lstsq(J, r, rcond=1e-8)[0]
+    return q
+
+
+#: The branch graph a kinematician draws for each built-in with its default parameters: (isolated bifurcation
+#: points, meetings with a higher-dimensional component). Single loops of mobility one close without branching;
+#: the threefold Bricard loop crosses its second motion mode once (all joints at 180 deg); Guest's frame has its
+#: six published bifurcation points; the Sarrus linkage branches where a limb is straight (two points) and meets
+#: its flat-folded sheet of mobility 2.
+EXPECTED = {
+    "bennett": (0, 0),
+    "bricard-line": (0, 0),
+    "bricard-plane": (0, 0),
+    "bricard-threefold": (1, 0),
+    "bricard-trihedral": (0, 0),
+    "goldberg": (0, 0),
+    "guest-frame": (6, 0),
+    "hedgepeth": (0, 0),
+    "hedgepeth-rods": (0, 0),
+    "sarrus": (2, 4),
+}
+
+
+@pytest.mark.parametrize("name", sorted(REGISTRY))
+def test_every_builtin_gives_a_clean_branch_graph(name: str) -> None:
+    assert name in EXPECTED, f"new built-in {name}: add its expected branch graph"
+    mech = lw.load(name)
+    tr = trace(mech, branches=True)
+    kinds = [b.kind for b in tr.bifurcations]
+    assert (kinds.count("bifurcation"), kinds.count("component")) == EXPECTED[name]
+    assert len(kinds) == sum(EXPECTED[name])  # and no point labelled a fold
+    assert tr.stats["sign_changes_without_rank_drop"] == 0
+    for b in tr.bifurcations:
+        if b.kind == "bifurcation":
+            assert len(b.tangents) >= 2 and numerical_rank(b.sigma) < mech.n_unknowns - 1
+    for br in tr.branches:
+        assert br.steps > 0
+        assert not br.end_reason.startswith(("step budget", "corrector failed", "no progress", "could not"))
+
+
+def test_branch_tangents_over_the_unknowns_are_a_field_that_replace_keeps() -> None:
+    mech = lw.load("guest-frame")
+    bif = trace(mech).bifurcations[0]
+    copy = dataclasses.replace(bif, step=0)
+    assert copy.tangents_u.shape == (2, mech.n_unknowns)
+    C = mech.coupling_matrix()
+    over_joints = np.array([C @ t / np.linalg.norm(C @ t) for t in copy.tangents_u])
+    np.testing.assert_allclose(over_joints, bif.tangents, atol=1e-15)
+    _, _, jac = Workspace.of(mech).evaluate(bif.u)
+    for t in copy.tangents_u:  # each is a null vector of the Jacobian there (to the located point's accuracy)
+        assert np.linalg.norm(jac @ t) < 1e-6
+
+
+def test_a_branch_that_runs_on_the_sarrus_sheet_ends_once_as_a_component() -> None:
+    from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
+
+    mech = lw.load("sarrus")
+    meeting = next(b for b in trace(mech).bifurcations if b.kind == "component")
+    # a point of the sheet next to the meeting point (independent Newton), then march from it inside the sheet
+    J = np.column_stack([(sarrus_closure(meeting.angles + 1e-6 * e) - sarrus_closure(meeting.angles - 1e-6 * e)) / 2e-6
+                         for e in np.eye(6)])  # fmt: skip
+    null = np.linalg.svd(J)[2][-3:]
+    on_sheet = _newton_onto(meeting.angles + 0.05 * null[0])
+    assert fd_mobility(on_sheet) == 2
+    u0 = mech.u_from_q(mech.q_from_angles(on_sheet))
+    ws = Workspace.of(mech)
+    _, _, jac = ws.evaluate(u0)
+    U, _, Vt = np.linalg.svd(jac)
+    n = mech.n_unknowns
+    settings = MarchSettings(
+        drive=0, target=None, min_step=1e-9, max_step=2 * DEG, cos_turn=float(np.cos(10 * DEG)), r_path=5,
+        n_sigma=6, periodic=np.ones(n, dtype=bool), lo=np.full(n, -np.inf), hi=np.full(n, np.inf), tol=Tolerances(),
+    )  # fmt: skip
+    marcher = BranchMarcher(mech, settings, 5000, switch_branches=True)
+    steps, reason = marcher.run_branch(
+        0, u0, Vt[-1], np.ascontiguousarray(U[:, :5]), paper=False, h0=0.5 * DEG, stop_at_known=True
+    )
+    assert reason.startswith("entered a 2-dimensional component (mobility 2) at point")
+    assert steps <= Tolerances().component_points
+    assert 1 <= len(marcher.found) <= 2 and not marcher.queue  # no chain of points, no branch switching
+    assert all(p.kind == "component" and p.dimension == 2 for p in marcher.found)

@@ -1,0 +1,65 @@
+"""The Dask engine: a seeded study gives exactly the same numbers in this process, in other chunks, and on a
+two-worker dask.distributed cluster on 127.0.0.1 (started and shut down by the test)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linkwork.errors import LinkworkError
+from linkwork.studies.engine import map_chunks, scheduler_address
+from linkwork.studies.imperfections import ImperfectionModel
+from linkwork.studies.robustness import robustness
+
+
+def _same(a, b) -> None:
+    np.testing.assert_array_equal(a.misfit_max, b.misfit_max)
+    np.testing.assert_array_equal(a.first_order_max, b.first_order_max)
+    np.testing.assert_array_equal(a.mobility_kept, b.mobility_kept)
+    np.testing.assert_array_equal(a.hist, b.hist)
+    np.testing.assert_array_equal(a.drive_max, b.drive_max)
+
+
+def test_chunking_does_not_change_any_sample(bennett):
+    mech, path = bennett
+    model = ImperfectionModel(1e-4, np.radians(0.01), distribution="uniform")
+    whole = robustness(mech, path, model, 60, seed=9, workers=0)
+    pieces = robustness(mech, path, model, 60, seed=9, workers=0, chunk=7)
+    _same(whole, pieces)
+    other = robustness(mech, path, model, 60, seed=10, workers=0)
+    assert not np.array_equal(other.misfit_max, whole.misfit_max)
+
+
+def test_two_worker_cluster_gives_the_local_numbers(bennett):
+    from dask.distributed import Client, LocalCluster
+
+    mech, path = bennett
+    model = ImperfectionModel(1e-4, np.radians(0.01))
+    local = robustness(mech, path, model, 80, seed=3, workers=0)
+    seen: list[tuple[int, int]] = []
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        remote = robustness(
+            mech, path, model, 80, seed=3, client=client, chunk=20, progress=lambda d, t: seen.append((d, t))
+        )
+    _same(local, remote)
+    assert seen[-1] == (4, 4)
+
+
+def test_results_come_back_in_chunk_order_in_process():
+    out = list(map_chunks(lambda shared, a, b: shared + a * b, 1, [(1, 2), (3, 4), (5, 6)], workers=0))
+    assert out == [3, 13, 31]
+
+
+def test_scheduler_address_from_the_environment(monkeypatch):
+    monkeypatch.setenv("LINKWORK_SCHEDULER", "tcp://10.0.0.1:8786")
+    assert scheduler_address(None) == "tcp://10.0.0.1:8786"
+    assert scheduler_address("tcp://127.0.0.1:1") == "tcp://127.0.0.1:1"
+    monkeypatch.delenv("LINKWORK_SCHEDULER")
+    assert scheduler_address(None) is None
+    with pytest.raises(LinkworkError):
+        scheduler_address("nonsense")
