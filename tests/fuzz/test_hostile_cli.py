@@ -118,7 +118,7 @@ def test_a_huge_hinge_direction_is_the_same_hinge(home: Path) -> None:
         np.testing.assert_allclose(twists, results[0], rtol=0, atol=1e-15)
 
 
-@pytest.mark.parametrize("name", ["[/]", "[/italic]", "<u>x</u>", "[bold]x"])
+@pytest.mark.parametrize("name", ["[/]", "[/italic]", "[red]x[/red]", "[bold]x"])
 def test_markup_in_a_joint_or_linkage_name_is_printed_as_text(home: Path, name: str) -> None:
     file = home / "named.toml"
     file.write_text(spec_text(name=name, joint=name.replace(" ", "")), encoding="utf-8")

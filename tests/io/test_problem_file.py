@@ -252,3 +252,20 @@ def test_piece_length_limit_relative_to_the_profile(folder: Path) -> None:
     assert str(info.value).endswith("got 0.001")
     ok = GOOD.replace("piece_length = 0.25", f"piece_length = {1.01 * arc / MAX_PIECES}")
     assert load_problem(write(folder, ok)).piece_length > 0
+
+
+def test_one_reader_for_both_file_kinds_hints_at_a_mistyped_key(folder: Path, tmp_path: Path) -> None:
+    """The problem file and the spec file share one reader: the same did-you-mean hint and value quoting."""
+    from linkwork.io.spec import load_spec
+
+    path = write(folder, GOOD.replace("piece_length = 0.25", "piece_lenght = 0.25"))
+    with pytest.raises(SpecError) as problem_error:
+        load_problem(path)
+    assert str(problem_error.value).startswith(
+        f'{path}: piece_lenght: unknown key; did you mean "piece_length"?'
+    )
+    spec = tmp_path / "spec.toml"
+    spec.write_text('nmae = "x"\n', encoding="utf-8")
+    with pytest.raises(SpecError) as spec_error:
+        load_spec(spec)
+    assert str(spec_error.value).startswith(f'{spec}: nmae: unknown key; did you mean "name"?')
