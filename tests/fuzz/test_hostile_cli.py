@@ -370,3 +370,15 @@ def test_an_until_target_never_reached_is_exit_3_with_the_trace_kept(home: Path)
     assert run.code == 3
     assert "A did not reach 1e+300 deg" in run.stderr and "range so far [60.00, 60.00] deg" in run.stderr
     assert (out / "path.csv").is_file() and (out / "report.json").is_file()
+
+
+@pytest.mark.skipif(
+    not Path("/proc/self").is_dir(), reason="needs Linux /proc (a folder nobody can write into)"
+)
+def test_an_out_folder_that_cannot_be_created_is_one_line(home: Path) -> None:
+    """A FileNotFoundError traceback from the staging folder; now one line naming --out."""
+    run = run_cli(
+        ["trace", "bennett", "--out", "/proc/linkwork-out", "--no-plots", "--max-steps", "20"], home=home
+    )
+    assert run.code == 2
+    assert '--out "/proc/linkwork-out": cannot write there' in run.stderr

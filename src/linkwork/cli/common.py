@@ -58,6 +58,9 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(str(exc)) from None
         except RecursionError:
             raise fail("the input is nested too deeply to be processed") from None
+        except OSError as exc:  # the file system refused (a read-only or full disk, a vanished folder)
+            where = f"{exc.filename}: " if exc.filename else ""
+            raise fail(f"{where}{exc.strerror or exc}", code=3) from None
         except MemoryError:
             raise fail("ran out of memory; the request is too large for this machine", code=3) from None
 

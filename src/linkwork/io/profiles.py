@@ -154,7 +154,8 @@ def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 def write_profile_dat(path: str | Path, points: ArrayLike, name: str | None = None) -> None:
     """Write a profile in Selig format: ``name`` (the file stem by default), then ``x y`` lines."""
     pts = np.asarray(points, dtype=float)
-    title = name if name is not None else Path(path).stem
+    # The title is the first line of a Selig file: line breaks in a name would start the coordinates early.
+    title = " ".join((name if name is not None else Path(path).stem).split()) or "profile"
     lines = [title] + [f"{x: .12g} {y: .12g}" for x, y in pts]
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 

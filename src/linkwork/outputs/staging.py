@@ -91,9 +91,15 @@ def staged_output(out: Path) -> Iterator[Path]:
     """
     out = Path(out)
     check_output_folder(out)
-    parent = out.resolve().parent
-    parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".linkwork-", dir=parent))
+    try:
+        parent = out.resolve().parent
+        parent.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=".linkwork-", dir=parent))
+    except OSError as exc:
+        raise SpecError(
+            f"--out {show(str(out))}: cannot write there ({exc.strerror or exc}); expected a folder linkwork may "
+            "create and write into"
+        ) from None
     try:
         with _cleanup_on_signals(stage):
             yield stage
