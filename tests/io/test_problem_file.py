@@ -269,3 +269,16 @@ def test_one_reader_for_both_file_kinds_hints_at_a_mistyped_key(folder: Path, tm
     with pytest.raises(SpecError) as spec_error:
         load_spec(spec)
     assert str(spec_error.value).startswith(f'{spec}: nmae: unknown key; did you mean "name"?')
+
+
+def test_the_search_is_bounded_by_a_stated_budget(folder: Path) -> None:
+    """design "auto" with 10 segments tries 2**10 = 1024 design vectors: 100 starts each is 102400 searches."""
+    text = GOOD.replace('design = "mcm"', 'design = "auto"\nsegments = 10').replace(
+        "starts = 2", "starts = 100"
+    )
+    with pytest.raises(SpecError) as info:
+        load_problem(write(folder, text))
+    assert str(info.value).endswith(
+        'starts: design "auto" with segments = 10 and starts = 100 is 102400 searches of the segment matrix; '
+        "expected at most 20000 (fewer segments or starts)"
+    )

@@ -24,6 +24,10 @@ MAX_STARTS = 1000
 MAX_AUTO_SEGMENTS = 10
 """The most segments ``q`` of an exhaustive search (``design = "auto"`` tries all ``2**q`` design vectors)."""
 
+MAX_SEARCHES = 20_000
+"""The most segment-matrix searches one synthesis may run: design vectors tried (``2**segments`` for
+``design = "auto"``, else 1) times ``starts``."""
+
 MAX_PIECES = 2000
 """The most pieces ``m_j = ceil(C_j / s_d)`` of a target profile (Eq. 3): ``piece_length`` must be at least
 the longest profile's arc length divided by this."""
@@ -118,6 +122,16 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
             (
                 "starts",
                 f"expected a whole number of starts, 1 <= starts <= {MAX_STARTS}, got {show(p.starts)}",
+            )
+        ]
+    auto = p.design is None or (isinstance(p.design, str) and p.design.strip().lower() == "auto")
+    searches = (2 ** int(p.segments or 1) if auto else 1) * int(p.starts)
+    if searches > MAX_SEARCHES:
+        return [
+            (
+                "starts",
+                f'design "auto" with segments = {p.segments} and starts = {p.starts} is {searches} searches of the '
+                f"segment matrix; expected at most {MAX_SEARCHES} (fewer segments or starts)",
             )
         ]
     merge = p.merge_below
