@@ -289,6 +289,13 @@ def seat(folder: Path) -> dict[str, float]:
     return lengths
 
 
+def _merge_on(merge_below: float) -> str:
+    """The seat's threshold is a joint range on the joined chain, not on the targets (the paper's default)."""
+    if not merge_below:
+        return ""
+    return '\nmerge_on = "chain"   # Eq. 34 ranges on the joined chain (the paper measures them on the targets)'
+
+
 def _problem(
     folder: Path,
     *,
@@ -313,7 +320,7 @@ piece_length = {piece_length}
 min_pieces = {min_pieces}
 design = "{design}"{f"{chr(10)}segments = {segments}" if segments else ""}
 starts = {starts}
-merge_below = {merge_below}   # degrees
+merge_below = {merge_below}   # degrees{_merge_on(merge_below)}
 seed = 1
 """
     (folder / "problem.toml").write_text(text, encoding="utf-8")

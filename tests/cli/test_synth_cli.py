@@ -207,7 +207,7 @@ def test_summary_table_and_figures(problem: Path, tmp_path: Path) -> None:
         "Error matrix after joining",
         "E_max",
         "E_mean",
-        "Joint ranges (merge below 5 deg)",
+        "Joint ranges, Eq. 34 (merge below 5 deg, on the targets)",
         "viewer.html",
     ):
         assert text in result.output
@@ -278,3 +278,31 @@ def test_example_folder_copy_is_independent_of_the_package(tmp_path: Path) -> No
     result = invoke(str(tmp_path / "closed" / "problem.toml"), "--out", str(tmp_path / "out"), "--no-plots")
     assert result.exit_code == 0
     assert "CCMMCM" in result.output
+
+
+def test_a_chain_that_cannot_be_joined_is_exit_3_naming_design_and_profile(tmp_path: Path) -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("naca", ROOT / "tests" / "synthesis" / "naca.py")
+    assert spec is not None and spec.loader is not None
+    naca = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(naca)
+    for code, chord in (("0012", 1.0), ("2412", 1.1), ("4412", 1.25)):
+        save_profile(tmp_path / f"n{code}.csv", naca.naca4(code, chord))
+    body = 'type = "closed"\nprofiles = ["n0012.csv", "n2412.csv", "n4412.csv"]\npiece_length = 0.03\nstarts = 2\n'
+    # MCCC's first M-segment spans the upper surface: its chord is longer than the other three together
+    (tmp_path / "fixed.toml").write_text(body + 'design = "MCCC"\n', encoding="utf-8")
+    result = invoke(str(tmp_path / "fixed.toml"), "--out", str(tmp_path / "out"), "--no-plots")
+    assert result.exit_code == 3, result.output + result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.output + result.stderr
+    assert "design MCCC: profile 'n0012': joining: a chain of chords" in lines[0]
+    assert "cannot close on itself" in lines[0]
+    # the same design in the auto search is skipped and listed, the run succeeds
+    (tmp_path / "auto.toml").write_text(body + 'design = "auto"\nsegments = 4\n', encoding="utf-8")
+    result = invoke(str(tmp_path / "auto.toml"), "--out", str(tmp_path / "auto"), "--no-plots")
+    assert result.exit_code == 0, result.output + result.stderr
+    assert "skipped MCCC: design MCCC: profile 'n0012'" in " ".join(result.output.split())
+    chain = json.loads((tmp_path / "auto" / "chain.json").read_text(encoding="utf-8"))
+    assert "MCCC" in [s["design"] for s in chain["search"]["skipped"]]
+    assert chain["search"]["designs_tried"] == 15

@@ -10,6 +10,8 @@ from linkwork.errors import LinkworkError
 from linkwork.studies.engine import map_chunks, scheduler_address
 from linkwork.studies.imperfections import ImperfectionModel
 from linkwork.studies.robustness import robustness
+from linkwork.studies.study_file import load_study
+from linkwork.studies.sweep import run_sweep
 
 
 def _same(a, b) -> None:
@@ -30,23 +32,33 @@ def test_chunking_does_not_change_any_sample(bennett):
     assert not np.array_equal(other.misfit_max, whole.misfit_max)
 
 
-def test_two_worker_cluster_gives_the_local_numbers(bennett):
+def test_two_worker_cluster_gives_the_local_numbers(bennett, tmp_path):
     from dask.distributed import Client, LocalCluster
 
     mech, path = bennett
     model = ImperfectionModel(1e-4, np.radians(0.01))
     local = robustness(mech, path, model, 80, seed=3, workers=0)
+    study_file = tmp_path / "study.toml"
+    study_file.write_text(
+        'linkage = "bennett"\n[trace]\nuntil = "A=90"\nsteps = 8\n[grid]\nalpha1 = [30, 40, 50]\n'
+        "[robustness]\nsamples = 20\nhinge_position_tol = 1e-4\nhinge_direction_tol = 0.01\n",
+        encoding="utf-8",
+    )
+    study = load_study(study_file)
+    local_rows = [row for row, _ in run_sweep(study, workers=0)]
     seen: list[tuple[int, int]] = []
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=None
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=":0"
         ) as cluster,
         Client(cluster) as client,
     ):
         remote = robustness(
             mech, path, model, 80, seed=3, client=client, chunk=20, progress=lambda d, t: seen.append((d, t))
         )
+        remote_rows = [row for row, _ in run_sweep(study, client=client)]
     _same(local, remote)
+    assert remote_rows == local_rows  # every number of every grid point, exactly
     assert seen[-1] == (4, 4)
 
 
@@ -63,3 +75,17 @@ def test_scheduler_address_from_the_environment(monkeypatch):
     assert scheduler_address(None) is None
     with pytest.raises(LinkworkError):
         scheduler_address("nonsense")
+
+
+def test_a_samples_seed_reproduces_it_alone(bennett):
+    from linkwork.studies.imperfections import hinge_errors, perturbed_twists
+    from linkwork.studies.misfit import misfit_batch
+    from linkwork.studies.robustness import MAX_ITER, prepare, run_chunk
+
+    mech, path = bennett
+    setup = prepare(mech, path, ImperfectionModel(1e-4, np.radians(0.01)), seed=12)
+    chunk = run_chunk(setup, 30, 40)
+    seed = chunk.seed[7:8]  # sample 37, as samples.parquet records it
+    twists = perturbed_twists(hinge_errors(seed, setup.mech, setup.model, setup.lines), setup.lines)
+    alone = misfit_batch(twists, *setup.kernel_args(), MAX_ITER)
+    assert alone.max() == chunk.misfit_max[7]

@@ -153,3 +153,23 @@ def test_robustness_target_not_reached_writes_then_exits_3(tmp_path):
     assert len(text.splitlines()) == 1 and "A = 170" in text
     summary = json.loads((out / "robustness.json").read_text())
     assert summary["samples"] == 10 and summary["bands"]["drive_deg"][-1] < 170.0
+
+
+def test_couplings_only_restrict_the_misfit(tmp_path):
+    """Coupled joints stay equal in every sample: the least residual is taken over fewer motions (a subset of the
+    free loop's plane normal to the path), so no sample's misfit can be smaller than the free loop's."""
+    import pyarrow.parquet as pq
+
+    common = [
+        "hedgepeth-rods", "--until", "A=100", "--steps", "20", "--samples", "30", "--hinge-position-tol", "1e-4",
+        "--hinge-direction-tol", "0.01", "--seed", "5", "--workers", "0", "--no-plots",
+    ]  # fmt: skip
+    assert invoke("robustness", *common, "-o", str(tmp_path / "free")).exit_code == 0
+    res = invoke("robustness", *common, "--couple", "A=C=E", "--couple", "B=D=F", "-o", str(tmp_path / "sym"))
+    assert res.exit_code == 0, res.stderr
+    free = np.array(pq.read_table(tmp_path / "free" / "samples.parquet")["misfit_max"])
+    sym = np.array(pq.read_table(tmp_path / "sym" / "samples.parquet")["misfit_max"])
+    assert np.all(sym >= free * (1.0 - 1e-8))  # tolerance: the solves' 1e-8 relative accuracy
+    assert np.median(sym / free) > 1.05  # and the restriction is felt
+    bad = invoke("robustness", *common, "--couple", "A", "-o", str(tmp_path / "bad"))
+    assert bad.exit_code == 2 and "--couple" in ANSI.sub("", bad.stderr)

@@ -121,3 +121,35 @@ def test_synthesis_grid_matches_direct_runs(tmp_path):
         assert row["error"] == ""
         direct = synthesize(replace(base, piece_length=row["piece_length"], starts=1))
         assert row["design"] == direct.design and row["e_max"] == pytest.approx(direct.e_max, rel=1e-12)
+
+
+def test_design_search_one_task_per_design_matches_auto(tmp_path):
+    """``design = "each"``: every design vector of 3 segments as its own task; the best row is what the
+    built-in search (``design = "auto"``, same seeds per design) chooses."""
+    from linkwork import data
+    from linkwork.io.problem import load_problem
+    from linkwork.studies.sweep import prepare_study
+    from linkwork.synthesis import synthesize
+
+    study = prepare_study(
+        load_study(
+            _write(tmp_path, 'problem = "closed"\n[grid]\nsegments = [3]\ndesign = "each"\nstarts = [1]\n')
+        )
+    )
+    rows = [row for row, _ in run_sweep(study, workers=0)]
+    assert [row["design"] for row in rows] == ["MMM", "MMC", "MCM", "MCC", "CMM", "CMC", "CCM", "CCC"]
+    ok = [row for row in rows if not row["error"]]
+    assert "MMM" in [
+        row["design"] for row in rows if row["error"]
+    ]  # no C-segment: infeasible, with its reason
+    auto = synthesize(replace(load_problem(data.example("closed")), design=None, segments=3, starts=1))
+    best = min(ok, key=lambda row: (row["e_max"], row["e_mean"]))
+    assert best["design"] == auto.design and best["e_max"] == pytest.approx(auto.e_max, rel=1e-12)
+
+
+def test_spec_file_study_is_one_point(tmp_path):
+    spec = Path(__file__).resolve().parents[2] / "examples" / "specs" / "four-bar.toml"
+    study = load_study(_write(tmp_path, f'spec = "{spec}"\n[trace]\nuntil = "A=100"\nsteps = 11\n'))
+    [(row, _)] = run_sweep(study, workers=0)
+    assert row["error"] == "" and row["mobility"] == 1 and row["points"] == 12
+    assert row["A_min"] == pytest.approx(45.0) and row["A_max"] == pytest.approx(100.0)

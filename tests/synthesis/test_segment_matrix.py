@@ -102,3 +102,29 @@ def test_infeasible_problems_are_spec_errors() -> None:
         check_feasible("MM", [10, 12], 2)
     with pytest.raises(SpecError, match="design"):
         check_design("MXC")
+
+
+# The paper's printed example (Shamsudin et al. 2013, Eqs. 11, 25, 27): V = [M C M C], alpha = 5,
+# m* = 76, 90, 99. Printed p x q (a row per profile); linkwork holds q x p, hence the transposes.
+SM1 = np.array([[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]])
+EM1 = np.array([[0.10, 0.32, 0.04, 0.43], [0.15, 0.19, 0.03, 1.37], [0.19, 0.46, 0.06, 1.50]])
+SMF = np.array([[19, 12, 14, 31], [19, 22, 14, 35], [19, 42, 14, 24]])
+
+
+def test_paper_sm1_em1_metrics_as_printed() -> None:
+    assert is_valid(SM1.T, "MCMC", [76, 90, 99], 5) and is_valid(SMF.T, "MCMC", [76, 90, 99], 5)
+    assert EM1.max() == 1.50  # "E_max = 1.50" (Eq. 22)
+    assert round(EM1.mean(), 2) == 0.40  # "E_bar = 0.40" (Eq. 24)
+    assert (
+        round(EM1[:, 0].mean(), 2) == 0.15 and round(EM1[:, 2].mean(), 2) == 0.04
+    )  # E_bar^1, E_bar^3 (Eq. 23)
+
+
+def test_paper_sm1_through_one_adjustment() -> None:
+    # Sec. 4 by hand on the printed EM1 (E_bar = 4.84 / 12 = 0.403): both M-segments have E_bar^e < E_bar
+    # -> +1 on every profile; C-segment 2: 0.32, 0.19 < E_bar -> +1, 0.46 > E_bar -> -1; the last C-segment
+    # keeps each profile's total (Eq. 26): 39 - 3, 57 - 3, 36 - 1.
+    expected = np.array([[16, 14, 10, 36], [16, 10, 10, 54], [16, 38, 10, 35]])
+    out = adjust(SM1.T, EM1.T, "MCMC", 5)
+    np.testing.assert_array_equal(out.T, expected)
+    assert is_valid(out, "MCMC", [76, 90, 99], 5)

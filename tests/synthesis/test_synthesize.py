@@ -128,8 +128,10 @@ def test_auto_design_ranking_progress_and_compound() -> None:
     problem = wavy_problem(design=None, segments=3, starts=2, merge_below=math.radians(60.0))
     result = synthesize(problem, progress=lambda done, total: calls.append((done, total)))
     assert len(result.stats.designs) == 2**3 - 1
-    ranked = [d.joined_e_max for d in result.stats.designs]
+    ranked = [d.joined_e_max for d in result.stats.designs if d.joined_e_max is not None]
     assert ranked == sorted(ranked) and result.joined_e_max == ranked[0]
+    for d in result.stats.designs:  # a design left unjoined has a bound above the best joined E_max
+        assert d.joined_e_max is not None or d.bound > result.joined_e_max
     assert calls[-1][0] == calls[-1][1] == 7 * 3 and [c[0] for c in calls] == list(range(1, 22))
     comp = result.compound
     assert comp is not None

@@ -49,6 +49,16 @@ def robustness(
     ] = None,
     steps: Annotated[int | None, typer.Option(help="N equal steps of the drive up to --until.")] = None,
     max_steps: Annotated[int, typer.Option(help="Step budget of the nominal trace.")] = 5000,
+    couple: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="Force joints equal, e.g. A=C=E (kept in every sample); repeatable.", show_default=False
+        ),
+    ] = None,
+    fixed: Annotated[
+        list[str] | None,
+        typer.Option(help="Hold a joint at its start value; repeatable.", show_default=False),
+    ] = None,
     distribution: Annotated[
         str, typer.Option(help="normal (tolerance = standard deviation) or uniform (within the tolerance).")
     ] = "normal",
@@ -93,6 +103,10 @@ def robustness(
     target = _parse_until(until)
     loaded = resolve_spec(spec, params)
     mech = loaded.mechanism
+    if couple or fixed:
+        from linkwork.cli.trace import _parse_couple
+
+        mech = mech.with_couplings(_parse_couple(couple), fixed or [])
     model = ImperfectionModel(
         position_tol=hinge_position_tol,
         direction_tol=float(np.radians(hinge_direction_tol)),
@@ -132,8 +146,8 @@ def robustness(
     ) as bar:
         task = bar.add_task("", total=samples)
 
-        def report(done: int, total: int) -> None:
-            bar.update(task, completed=min(samples, round(samples * done / max(total, 1))))
+        def report(done: int, total: int | None) -> None:
+            bar.update(task, completed=min(samples, round(samples * done / max(total or 1, 1))))
 
         result, figures = run_and_write_robustness(
             setup,

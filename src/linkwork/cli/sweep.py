@@ -15,7 +15,7 @@ from linkwork.outputs.staging import console
 @friendly_errors
 def sweep(
     study_file: Annotated[
-        Path, typer.Argument(help="The study file (TOML): a linkage or problem and a [grid].")
+        Path, typer.Argument(help="The study file (TOML): a linkage or problem and a \\[grid] table.")
     ],
     scheduler: Annotated[
         str | None,
@@ -36,11 +36,11 @@ def sweep(
     from linkwork.errors import RequestNotMetError
     from linkwork.outputs.sweep import print_sweep_summary, write_sweep_outputs
     from linkwork.studies.study_file import load_study
-    from linkwork.studies.sweep import run_sweep
+    from linkwork.studies.sweep import prepare_study, run_sweep
 
     if workers is not None and workers < 0:
         raise fail(f"--workers {workers}: expected 0 or more")
-    study = load_study(study_file)
+    study = prepare_study(load_study(study_file))
     total = len(study.points())
     console.print(Text(study.name, style="bold"), f"{study.kind} study of {total} grid point(s)", sep=": ")
     with Progress(

@@ -38,6 +38,14 @@ def synth(
             "at a time while the error matrix improves (never worse than 'paper').",
         ),
     ] = "paper",
+    exhaustive: Annotated[
+        bool,
+        typer.Option(
+            "--exhaustive",
+            help="Join every design vector of design = 'auto' (no pruning by the lower bound on E_max; the "
+            "chosen design is the same, only slower).",
+        ),
+    ] = False,
 ) -> None:
     """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
 
@@ -70,7 +78,7 @@ def synth(
         def progress(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        result = synthesize(spec, progress=progress, search=search)  # type: ignore[arg-type]
+        result = synthesize(spec, progress=progress, search=search, prune=not exhaustive)  # type: ignore[arg-type]
 
     plots = not no_plots
     if plots and not have_matplotlib():

@@ -233,7 +233,6 @@ def _run_with_progress(run: Callable[..., Trace], mech: Mechanism, total: int, *
         TextColumn("tracing"),
         BarColumn(),
         MofNCompleteColumn(),
-        TextColumn("{task.description}", markup=False),
         TimeElapsedColumn(),
         console=console,
         transient=True,
@@ -241,7 +240,7 @@ def _run_with_progress(run: Callable[..., Trace], mech: Mechanism, total: int, *
     ) as progress:
         task = progress.add_task("", total=total)
 
-        def report(done: float, what: str) -> None:
-            progress.update(task, advance=done, description=what)
+        def report(done: int, _budget: int | None) -> None:
+            progress.update(task, completed=done)  # steps so far, against the paper steps or the budget
 
         return run(mech, **options, progress=report)

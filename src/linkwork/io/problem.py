@@ -20,6 +20,10 @@ Example
     seed = 1
     names = ["cruise", "climb", "landing"]   # optional; file stems by default
     mechanize = false                   # optional
+    merge_on = "targets"                # targets | chain: where merge_below's joint ranges are measured
+    rank_by = "error"                   # error | joints (fewest joints with E_max <= e_max_tolerance)
+    e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
+    initial_segment_matrix = [[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]]  # Eq. 11: a row per profile
 """
 
 from __future__ import annotations
@@ -49,6 +53,10 @@ KEYS = (
     "names",
     "mechanize",
     "description",
+    "merge_on",
+    "rank_by",
+    "e_max_tolerance",
+    "initial_segment_matrix",
 )
 """Every key a problem file may hold (``description`` is free text for the reader and is ignored)."""
 
@@ -81,7 +89,51 @@ def _settings(reader: TomlReader, table: dict[str, Any]) -> dict[str, Any]:
     settings["mechanize"] = reader.boolean(table, "mechanize", "", default=False)
     if "description" in table and not isinstance(table["description"], str):
         raise reader.error("description", f"expected a string, got {show(table['description'])}")
+    settings["merge_on"] = _one_of(reader, table, "merge_on", ("targets", "chain"))
+    settings["rank_by"] = _one_of(reader, table, "rank_by", ("error", "joints"))
+    tolerance = table.get("e_max_tolerance")
+    if tolerance is not None and (isinstance(tolerance, bool) or not isinstance(tolerance, int | float)):
+        raise reader.error(
+            "e_max_tolerance", f"expected a positive number (profile units), got {show(tolerance)}"
+        )
+    settings["e_max_tolerance"] = tolerance
+    settings["initial_segment_matrix"] = _initial_segment_matrix(reader, table)
     return settings
+
+
+def _one_of(reader: TomlReader, table: dict[str, Any], key: str, choices: tuple[str, ...]) -> str:
+    """One of ``choices`` (the first is the default), in the words of :class:`Problem`'s rule."""
+    value = table.get(key, choices[0])
+    if not isinstance(value, str) or value not in choices:
+        quoted = ", ".join(f'"{c}"' for c in choices)
+        raise reader.error(key, f"expected one of {quoted}, got {show(value)}")
+    return value
+
+
+def _initial_segment_matrix(reader: TomlReader, table: dict[str, Any]) -> np.ndarray | None:
+    """``initial_segment_matrix``: as printed in the paper (Eq. 11), one row of whole numbers per profile;
+    returned transposed, ``(q, p)``, as the API holds segment matrices (the rows are checked against the
+    profiles and the design by :class:`Problem`)."""
+    key = "initial_segment_matrix"
+    raw = table.get(key)
+    if raw is None:
+        return None
+    expected = "a list of rows of whole numbers, one row per profile (the paper's Eq. 11)"
+    rows_ok = isinstance(raw, list) and raw and all(isinstance(row, list) and row for row in raw)
+    whole = rows_ok and all(
+        isinstance(m, int) and not isinstance(m, bool) and 0 <= m <= 10**6 for row in raw for m in row
+    )
+    if not whole:
+        raise reader.error(key, f"expected {expected}, got {show(raw)}")
+    profiles = table.get("profiles")
+    count = len(profiles) if isinstance(profiles, list) else len(raw)
+    if len(raw) != count or len({len(row) for row in raw}) != 1:
+        raise reader.error(
+            key,
+            f"has {len(raw)} rows of lengths {sorted({len(row) for row in raw})}; expected {count} rows "
+            "(one per profile) of equal length (one entry per segment)",
+        )
+    return np.asarray(raw, dtype=np.int64).T
 
 
 def _whole(reader: TomlReader, table: dict[str, Any], key: str, default: int, expected: str) -> Any:

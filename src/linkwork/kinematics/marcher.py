@@ -10,7 +10,6 @@ Gan & Pellegrino 2006; branch switching after Kumar & Pellegrino 2000).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -31,9 +30,9 @@ from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold
 from linkwork.kinematics.workspace import Workspace
+from linkwork.progress import Progress
 
 Array = NDArray[np.float64]
-Progress = Callable[[float, str], None]
 
 
 @dataclass(frozen=True)
@@ -121,6 +120,7 @@ class BranchMarcher:
         self.mech = mech
         self.ws = Workspace.of(mech)
         self.cfg = settings
+        self.max_steps = max_steps
         self.budget = max_steps
         self.switch_branches = switch_branches
         self.progress = progress
@@ -202,7 +202,7 @@ class BranchMarcher:
             self._scan_folds(chunk, branch_id, base)
             first = False
             if self.progress:
-                self.progress(chunk.count - 1, f"branch {branch_id}")
+                self.progress(self.max_steps - self.budget, self.max_steps)
             if component is not None:
                 return n_steps, self._enter_component(chunk, branch_id, base + component)
             if chunk.code == SIGN_CHANGE:

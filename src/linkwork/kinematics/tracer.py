@@ -11,7 +11,7 @@ into a higher-dimensional component.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -24,9 +24,9 @@ from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.trace_result import Branch, Trace
 from linkwork.kinematics.workspace import Workspace
+from linkwork.progress import Progress
 
 Array = NDArray[np.float64]
-Progress = Callable[[float, str], None]
 
 
 def trace(

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
+from linkwork.progress import Progress
 from linkwork.studies.robustness import (
     RobustnessResult,
     RobustnessSetup,
@@ -35,7 +35,7 @@ def robustness_dict(result: RobustnessResult, source: str = "") -> dict[str, Any
     setup = result.setup
     mech = setup.mech
     model = setup.model
-    drive = mech.joint_names[int(np.flatnonzero(mech.groups == setup.drive_unknown)[0])]
+    drive = setup.drive
     revolute = mech.joint_types[mech.index(drive)] == "R"
     drive_values = np.degrees(setup.drive_values) if revolute else setup.drive_values
     fo = result.first_order_max
@@ -81,7 +81,7 @@ def robustness_dict(result: RobustnessResult, source: str = "") -> dict[str, Any
             "first_order_p50": _list(result.band(0.50, first_order=True)),
             "first_order_p95": _list(result.band(0.95, first_order=True)),
             "ratio": _list(result.ratio_paper),
-            "ratio_weighted": _list(setup.ratio_weighted),
+            "ratio_normalised": _list(setup.ratio_normalised),
         },
     }
 
@@ -95,14 +95,14 @@ def run_and_write_robustness(
     source: str = "",
     plots: bool = True,
     engine: dict[str, Any] | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
 ) -> tuple[RobustnessResult, list[Path]]:
     """Run the study with its samples streamed to ``samples.parquet``, then write ``robustness.json`` and (if
     matplotlib is there) the figures, all into ``out`` or nothing."""
     from linkwork.studies.parquet import SampleWriter
 
     mech = setup.mech
-    drive = int(np.flatnonzero(mech.groups == setup.drive_unknown)[0])
+    drive = mech.index(setup.drive)
     figures: list[Path] = []
     with staged_output(out) as stage:
         with SampleWriter(stage / "samples.parquet", setup.drive_values, mech.joint_types[drive] == "R") as w:
@@ -141,3 +141,18 @@ def print_robustness_summary(summary: dict[str, Any]) -> None:
         f"{tol['distribution']}, {tol['errors']} errors; misfit in length units, L = {summary['scale']['length']:.4g}"
     )
     console.print(f"mobility kept by {100.0 * (summary['mobility_kept'] or 0.0):.1f} % of the samples")
+    b = summary["bands"]
+    key = "drive_deg" if "drive_deg" in b else "drive"
+    unit = " deg" if key == "drive_deg" else ""
+    median = np.array([np.nan if v is None else v for v in b["p50"]], dtype=float)
+    ratio = np.array([np.nan if v is None else v for v in b["ratio"]], dtype=float)
+    if np.any(np.isfinite(median)) and np.nanmax(median) > 0:
+        k = int(np.nanargmax(median))
+        console.print(
+            f"median misfit largest at {summary['drive']} = {b[key][k]:.5g}{unit} (point {k}): {median[k]:.4g}"
+        )
+    if np.any(np.isfinite(ratio)):
+        k = int(np.nanargmax(ratio))
+        console.print(
+            f"Sec. 5 ratio largest at {summary['drive']} = {b[key][k]:.5g}{unit} (point {k}): {ratio[k]:.4g}"
+        )

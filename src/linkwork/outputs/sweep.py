@@ -107,7 +107,6 @@ _HEADLINE = (
     "mobility_kept",
     "design",
     "e_max",
-    "end",
     "error",
 )
 

@@ -186,6 +186,19 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
         f"{result.stats.starts} starts, {result.stats.seconds:.2f} s",
         highlight=False,
     )
+    stats = result.stats
+    if not problem.design:
+        console.print(
+            f"search: {stats.designs_tried} design vectors, {stats.designs_tried - len(stats.skipped) - stats.pruned} "
+            f"joined, {stats.pruned} pruned (their lower bound on E_max exceeds the best), "
+            f"{len(stats.skipped)} skipped (cannot be joined); ranked by {stats.rank_by}"
+            + ("" if stats.e_max_tolerance is None else f" (E_max tolerance {stats.e_max_tolerance:g})"),
+            highlight=False,
+        )
+    for design, reason in stats.skipped[:5]:
+        console.print(f"skipped {design}: {reason}", highlight=False, markup=False)
+    if len(stats.skipped) > 5:
+        console.print(f"... and {len(stats.skipped) - 5} more skipped (see chain.json search.skipped)")
     console.print(_matrix_table("Segment matrix (pieces)", result, result.segment_matrix, "d"))
     console.print(_matrix_table("Error matrix after segmentation", result, result.error_matrix, ".4f"))
     console.print(_matrix_table("Error matrix after joining", result, result.joined_error_matrix, ".4f"))
@@ -203,13 +216,21 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
     if compound is None:
         console.print("compound segments: off (merge_below = 0)")
         return
-    joints = _table(f"Joint ranges (merge below {math.degrees(compound.threshold):.3g} deg)")
-    for column in ("joint", "between", "range (deg)", "merged"):
-        joints.add_column(column, justify="right" if column == "range (deg)" else "left")
+    joints = _table(
+        f"Joint ranges, Eq. 34 (merge below {math.degrees(compound.threshold):.3g} deg, "
+        f"on the {compound.merge_on})"
+    )
+    for column in ("joint", "between", "on targets (deg)", "on chain (deg)", "merged"):
+        joints.add_column(column, justify="right" if "deg" in column else "left")
+    on_targets = compound.target_ranges if compound.target_ranges is not None else compound.joint_ranges
     for i, motion in enumerate(compound.joint_ranges):
         between = f"{i + 1} {result.design[i]} - {i + 2} {result.design[i + 1]}"
         joints.add_row(
-            str(i + 1), between, f"{math.degrees(motion):.2f}", "yes" if i in compound.merged else ""
+            str(i + 1),
+            between,
+            f"{math.degrees(on_targets[i]):.2f}",
+            f"{math.degrees(motion):.2f}",
+            "yes" if i in compound.merged else "",
         )
     console.print(joints)
     for note in compound.notes:

@@ -10,15 +10,16 @@ schedule; at most a few chunks per worker are in flight, so memory stays bounded
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar
 
 from linkwork.errors import LinkworkError
+from linkwork.progress import Progress
 
 T = TypeVar("T")
-Progress = Callable[[int, int], None]
 
 ENV_SCHEDULER = "LINKWORK_SCHEDULER"
 
@@ -60,7 +61,8 @@ def dask_client(scheduler: str | None, workers: int | None = None) -> Iterator[A
             threads_per_worker=1,
             processes=True,
             host="127.0.0.1",
-            dashboard_address=None,
+            dashboard_address=":0",
+            silence_logs=logging.ERROR,
         ) as cluster,
         Client(cluster) as client,
     ):
@@ -131,7 +133,13 @@ def _run_on(
     finished = 0
     for fut in done_set:
         index = futures.pop(fut)
-        ready[index] = fut.result()
+        try:
+            ready[index] = fut.result()
+        except ImportError as exc:
+            raise LinkworkError(
+                f"a Dask worker cannot import what the study needs ({exc}); install linkwork (the same version) "
+                "on every worker"
+            ) from None
         fut.release()
         finished += 1
         if progress is not None:

@@ -60,29 +60,23 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
     return J @ mech.coupling_matrix(), B.reshape(mech.n_equations, 4 * n)
 
 
-def sensitivity_maps(
-    mech: Mechanism, u_path: Array, lines: HingeLines, T: Array
-) -> tuple[Array, Array, Array]:
+def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array) -> tuple[Array, Array]:
     """Per path point: the map ``G_k = N_k^T T B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
-    space), ``(K,)`` the ratio of largest to smallest non-zero singular value of ``T J_k`` (the Sec. 5 ratio on the
-    weighted Jacobian), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's
-    tangent (the last right singular vector), in which the misfit is minimised."""
+    space), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's tangent (the last
+    right singular vector), in which the misfit is minimised."""
     K = u_path.shape[0]
     E = mech.n_equations
     m = mech.n_unknowns
     G = np.zeros((K, E, 4 * mech.n_joints))
-    ratio = np.full(K, np.nan)
     normal = np.zeros((K, m, m - 1))
     for k in range(K):
         J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T)
         U, sigma, Vt = np.linalg.svd(J, full_matrices=True)
         rank = numerical_rank(sigma)
-        if rank > 0 and sigma[rank - 1] > 0:
-            ratio[k] = sigma[0] / sigma[rank - 1]
         normal[k] = Vt[: m - 1].T
         N = U[:, rank:]
         G[k, : N.shape[1], :] = N.T @ B
-    return G, ratio, normal
+    return G, normal
 
 
 @njit(cache=True, fastmath=True)
@@ -113,7 +107,8 @@ def first_order_misfit(G: Array, errors: Array) -> Array:
     so that a sample's numbers never depend on how many others share its chunk.
     """
     S = errors.shape[0]
-    K, _, P = G.shape
-    rows = np.array([int(np.flatnonzero(np.any(G[k] != 0.0, axis=1)).max(initial=-1)) + 1 for k in range(K)])
+    P = G.shape[2]
+    used = np.any(G != 0.0, axis=2)  # (K, E): the rows of each G_k inside its left null space
+    rows = np.where(used.any(axis=1), used.shape[1] - np.argmax(used[:, ::-1], axis=1), 0).astype(np.int64)
     delta = np.ascontiguousarray(errors.reshape(S, P))
-    return _first_order_kernel(np.ascontiguousarray(G), rows.astype(np.int64), delta)
+    return _first_order_kernel(np.ascontiguousarray(G), rows, delta)

@@ -5,7 +5,7 @@ half-angle ``direction_tol`` and its position shifts normal to the line by up to
 structure is thus assembled, free of strain, in the start configuration; the misfit measures what it must take up
 as it moves away from there. Four numbers per joint say how: ``(t1, t2, s1, s2)``, the tilt (radians) about and
 the shift (length) along the two unit vectors ``e1, e2`` normal to the line. A planar mechanism gets in-plane
-errors (shifts in the plane, no tilt) unless spatial errors are asked for. A prismatic joint's line has no
+errors (shifts in the plane; a slider's direction turns in the plane) unless spatial errors are asked for. A prismatic joint's line has no
 position: only its direction tilts.
 
 Distributions: ``normal`` draws every component with standard deviation equal to the tolerance; ``uniform`` draws
@@ -147,11 +147,15 @@ def unit_noise(seeds: np.ndarray, n_joints: int, uniform: bool) -> np.ndarray:
 
 
 def component_scale(mech: Mechanism, model: ImperfectionModel, lines: HingeLines) -> Array:
-    """``(n, 4)`` tolerance per noise component: tilts ``direction_tol``, shifts ``position_tol``; zero tilt
-    for in-plane errors of a planar mechanism, zero shift for a prismatic joint."""
+    """``(n, 4)`` tolerance per noise component: tilts ``direction_tol``, shifts ``position_tol``; for in-plane
+    errors of a planar mechanism no tilt out of the plane (a revolute axis stays normal to it; a prismatic
+    direction turns only about the plane's normal), and zero shift for a prismatic joint."""
     scale = np.empty((mech.n_joints, 4))
     in_plane = mech.planar and not model.spatial
-    scale[:, :2] = 0.0 if in_plane else model.direction_tol
+    scale[:, :2] = model.direction_tol
+    if in_plane:
+        about_normal = np.abs(np.stack([lines.e1[:, 2], lines.e2[:, 2]], axis=1)) > 0.999
+        scale[:, :2] = np.where(about_normal & ~lines.revolute[:, None], model.direction_tol, 0.0)
     scale[:, 2:] = np.where(lines.revolute, model.position_tol, 0.0)[:, None]
     return scale
 

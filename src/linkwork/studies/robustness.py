@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
+from linkwork.progress import Progress
 from linkwork.studies import bands
 from linkwork.studies.engine import default_workers, map_chunks
 from linkwork.studies.first_order import first_order_misfit, sensitivity_maps
@@ -51,11 +52,12 @@ class RobustnessSetup:
     lines: HingeLines
     scale: MisfitScale
     u_path: Array
+    drive: str
     drive_values: Array
     drive_unknown: int
     normal: Array
     G: Array
-    ratio_weighted: Array
+    ratio_normalised: Array
     keep_tol: float
 
     def kernel_args(self) -> tuple[Any, ...]:
@@ -98,7 +100,7 @@ def prepare(
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
-    G, ratio, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
+    G, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
@@ -108,11 +110,12 @@ def prepare(
         lines=lines,
         scale=scale,
         u_path=u_path,
+        drive=mech.joint_names[drive_joint],
         drive_values=path.angles[first, drive_joint],
         drive_unknown=drive_unknown,
         normal=normal,
         G=G,
-        ratio_weighted=ratio,
+        ratio_normalised=path.condition()[first],
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,
     )
 
@@ -220,7 +223,7 @@ def run_study(
     workers: int | None = None,
     client: Any = None,
     chunk: int | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
     sink: Callable[[ChunkResult], None] | None = None,
 ) -> RobustnessResult:
     """Run ``samples`` samples of a prepared study on the Dask engine and merge them."""

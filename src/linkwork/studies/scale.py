@@ -3,12 +3,11 @@
 A closure misfit is a small twist ``(omega, v)`` (rotation and translation left over when the loop is forced
 shut). Its size is measured as ``|(L omega, v + omega x c)|``: the rotation times the linkage's length scale plus
 the translation of the point ``c``, so that the number is a length, in the linkage's units, and does not change
-when the linkage is moved, turned or relabelled, and scales with it.
+when the linkage is moved or turned, and scales with it.
 
 ``c`` is the point nearest (least squares) to every revolute hinge line, ``L`` the root-mean-square distance of
-the hinge lines from ``c`` (for concurrent lines, e.g. a spherical linkage, the RMS distance of their reference
-points from ``c``; 1 if that is zero too). This module is the one place to switch to the project's normalised
-Jacobian once it exists.
+the hinge lines from ``c`` (1 for concurrent lines, e.g. a spherical linkage): the centre and scale of the project's
+normalised Jacobian (:mod:`linkwork.kinematics.normalization`), taken at the reference configuration.
 """
 
 from __future__ import annotations
@@ -49,23 +48,19 @@ def line_points(mech: Mechanism, centre: Array | None = None) -> Array:
 
 def misfit_scale(mech: Mechanism) -> MisfitScale:
     """The centre, length scale and weight map of ``mech`` (see the module docstring)."""
-    w = mech.twists[:, :3]
-    revolute = np.einsum("ij,ij->i", w, w) > 0.5
-    if not np.any(revolute):
-        centre, length = np.zeros(3), 1.0
-    else:
-        p0 = line_points(mech)[revolute]
-        wr = w[revolute]
-        proj = np.eye(3)[None, :, :] - wr[:, :, None] * wr[:, None, :]
-        A = proj.sum(axis=0)
-        b = np.einsum("kij,kj->i", proj, p0)
-        centre = np.linalg.lstsq(A, b, rcond=1e-10)[0]
-        pts = line_points(mech, centre)[revolute]
-        length = float(np.sqrt(np.mean(np.sum((pts - centre) ** 2, axis=1))))
-        if length < 1e-12:
-            length = float(np.sqrt(np.mean(np.sum((p0 - centre) ** 2, axis=1)))) or 1.0
+    centre, length = centre_and_length(mech)
     T = np.zeros((6, 6))
     T[:3, :3] = length * np.eye(3)
     T[3:, 3:] = np.eye(3)
     T[3:, :3] = -hat3(centre)  # omega x c = -c x omega
     return MisfitScale(centre=centre, length=length, weight=T)
+
+
+def centre_and_length(mech: Mechanism) -> tuple[Array, float]:
+    """The linkage's centre ``c`` and length ``L`` at its reference: those of the project's normalised Jacobian
+    (:func:`linkwork.kinematics.normalization.hinge_centre`), so that the misfit and the normalised Sec. 5 ratio
+    share one scale."""
+    from linkwork.kinematics.normalization import hinge_centre
+
+    centre, length = hinge_centre(mech.twists, mech.joint_types)
+    return np.asarray(centre, dtype=float), float(length)

@@ -7,7 +7,8 @@ degrees, ``steps``, ``branches``, ``max_steps``), optionally ``[robustness]`` (`
 ``figures``), and a ``[grid]`` of built-in parameters in file units: each a list of values or a range
 ``{ from = A, to = B, count = N }`` (both ends included). A synthesis study names a problem (``problem =
 "problem.toml"`` or a bundled example such as ``"seat"``) and a ``[grid]`` over ``piece_length``, ``segments``,
-``design`` (``"auto"`` searches every design), ``min_pieces``, ``starts`` and ``merge_below`` (degrees).
+``design`` (``"auto"`` searches every design in one task; ``"each"``, alone, gives one row per design vector,
+each its own task), ``min_pieces``, ``starts`` and ``merge_below`` (degrees).
 Every grid is the full product of its lists, in the order written (the last parameter varies fastest).
 """
 
@@ -67,9 +68,21 @@ class Study:
     extra: dict[str, Any] = field(default_factory=dict)
 
     def points(self) -> list[dict[str, Any]]:
-        """Every grid point as ``{parameter: value}`` (one empty point for an empty grid)."""
+        """Every grid point as ``{parameter: value}`` (one empty point for an empty grid).
+
+        A synthesis grid with ``design = "each"`` has one point per design vector of each point's number of
+        segments (the design search of ``design = "auto"``, one task per design)."""
         keys = list(self.grid)
-        return [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*self.grid.values())]
+        if self.kind != "synthesis" or self.grid.get("design") != ["each"]:
+            return [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*self.grid.values())]
+        base = [k for k in keys if k != "design"]
+        out = []
+        for combo in itertools.product(*(self.grid[k] for k in base)):
+            point = dict(zip(base, combo, strict=True))
+            q = int(point.get("segments", self.extra.get("segments") or 0))
+            for letters in itertools.product("MC", repeat=q):
+                out.append({**point, "design": "".join(letters)})
+        return out
 
 
 MAX_GRID_POINTS = 100_000

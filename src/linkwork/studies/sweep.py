@@ -9,13 +9,13 @@ path ended (and the misfit percentiles with ``[robustness]``); for a synthesis t
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.progress import Progress
 from linkwork.studies.engine import map_chunks
 from linkwork.studies.study_file import Study
 
@@ -133,7 +133,14 @@ def prepare_study(study: Study) -> Study:
             from linkwork import data
 
             target = str(data.example(target))
-        return replace(study, extra={"problem": load_problem(target)})
+        problem = load_problem(target)
+        if "each" in [str(v).lower() for v in study.grid.get("design", [])]:
+            if [str(v).lower() for v in study.grid["design"]] != ["each"]:
+                raise SpecError('design "each" cannot be mixed with other designs', key="grid.design")
+            if problem.segments is None and "segments" not in study.grid:
+                raise SpecError('design "each" needs the number of segments', key="grid.segments")
+            study = replace(study, grid={**study.grid, "design": ["each"]})
+        return replace(study, extra={"problem": problem, "segments": problem.segments})
     from linkwork.io.spec import resolve_spec
 
     if study.grid:  # a built-in: its name and parameter names must be right (values are checked per point)
@@ -160,10 +167,11 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     client: Any = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
 ) -> list[tuple[Row, Any]]:
     """Every grid point's row (and robustness result when figures are asked), in grid order."""
-    study = prepare_study(study)
+    if not (study.kind == "synthesis" and "problem" in study.extra):
+        study = prepare_study(study)
     func = synthesis_point if study.kind == "synthesis" else linkage_point
     chunks = [(i,) for i in range(len(study.points()))]
     return list(

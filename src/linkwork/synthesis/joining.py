@@ -92,6 +92,40 @@ def angle_map(q: int, ties: Sequence[tuple[int, float]]) -> tuple[Array, Array]:
     return t, b
 
 
+def _group_chords(chain: ChainPose, t_map: Array, b: Array) -> Array:
+    """``(k, 2)`` chord of each rigid group of segments (segments tied at fixed joints form one body)."""
+    chords = np.einsum("qab,qb->qa", rotation(b), chain.ends)
+    return t_map.T @ chords
+
+
+def _check_reach(chain: ChainPose, t_map: Array, b: Array, span: float, closed: bool) -> None:
+    """Raise :class:`ConvergenceError` when no pose of the chain can meet Eq. 31 (closed) or Eq. 32."""
+    lengths = np.linalg.norm(_group_chords(chain, t_map, b), axis=1)
+    gap = reach_gap(lengths, span)
+    if gap <= 1e-9 * max(float(lengths.sum()), 1.0):
+        return
+    what = "close on itself" if closed else f"span its fixed ends {span:.6g} apart"
+    why = (
+        "the chain is shorter than that"
+        if span > lengths.sum()
+        else "one segment's chord is longer than all the others' together"
+    )
+    chords = ", ".join(f"{v:.4g}" for v in lengths)
+    raise ConvergenceError(f"joining: a chain of chords {chords} cannot {what} (short by {gap:.3g}): {why}")
+
+
+def _target_start(chain: ChainPose, z: Array, t_map: Array, b: Array, nf: int) -> Array:
+    """Unknowns that put every segment's chord along the target's chord between its segmentation points."""
+    first = chain.first_index
+    target_chords = z[first[1:]] - z[first[:-1]]
+    theta = np.arctan2(target_chords[:, 1], target_chords[:, 0]) - np.arctan2(
+        chain.ends[:, 1], chain.ends[:, 0]
+    )
+    theta = b + np.unwrap(theta - b)
+    phi = np.linalg.lstsq(t_map, theta - b, rcond=None)[0]
+    return np.concatenate([z[0] if nf else np.zeros(0), phi])
+
+
 def join_profile(
     shapes: Sequence[Array],
     target: ArrayLike,
@@ -168,8 +202,20 @@ def join_profile(
         sol = least_squares(residual, u0, jac=jac, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
         u = _polish(residual, jac, None, None, sol.x)
     else:
-        u = _constrained(residual, jac, constraint, constraint_jac, u0)
-        u = _project(constraint, constraint_jac, _polish(residual, jac, constraint, constraint_jac, u))
+        span = 0.0 if closed else float(np.linalg.norm(end_point - fixed_start))  # type: ignore[operator]
+        _check_reach(chain, t_map, b, span, closed)
+        starts = [u0, _target_start(chain, z, t_map, b, nf)]
+        free_angles = slice(nf, None)
+        feasible = _constrained(residual, jac, constraint, constraint_jac, starts, free_angles)
+        try:
+            u = _project(
+                constraint,
+                constraint_jac,
+                _polish(residual, jac, constraint, constraint_jac, feasible),
+                free_angles,
+            )
+        except ConvergenceError:
+            u = feasible  # the polish left the constraint for good: keep the optimiser's feasible point
     s, th = unpack(u)
     pts = chain.points(s, th)
     dist = np.linalg.norm(pts - z, axis=1)
@@ -200,31 +246,89 @@ def _polish(residual: Fn, jac: Fn, constraint: Fn | None, constraint_jac: Fn | N
         trial_cost = float(r_trial @ r_trial)
         if trial_cost > cost * (1.0 + 1e-12) + 1e-300:
             break  # no longer a descent step: we are at rounding level
+        settled = cost - trial_cost <= 1e-14 * cost
         u, cost = trial, trial_cost
+        if settled:
+            break  # the cost no longer falls beyond rounding
         if np.max(np.abs(step)) <= 1e-15 * (1.0 + np.max(np.abs(u))):
             break
     return u
 
 
-def _project(constraint: Fn, constraint_jac: Fn, u: Array) -> Array:
-    """Move ``u`` onto ``constraint(u) = 0`` by minimum-norm Newton steps."""
-    for _ in range(50):
-        g = constraint(u)
-        if np.max(np.abs(g)) < CONSTRAINT_TOL:
-            return u
-        u = u - np.linalg.lstsq(constraint_jac(u), g, rcond=None)[0]
+def reach_gap(lengths: ArrayLike, span: float) -> float:
+    """How far a chain of links of ``lengths`` is from reaching ``span`` between its ends (0 when it can).
+
+    A planar chain of links reaches every end-to-end distance in ``[max(0, 2 l_max - sum l), sum l]`` and no
+    other (a polygon inequality); a closed chain needs ``span = 0`` (Eq. 31), a fixed-end chain the distance of
+    its pinned ends (Eq. 32).
+    """
+    ell = np.abs(np.asarray(lengths, dtype=float))
+    total = float(ell.sum())
+    shortest = max(0.0, 2.0 * float(ell.max(initial=0.0)) - total)
+    return max(0.0, shortest - span, span - total)
+
+
+def _newton_to_constraint(constraint: Fn, constraint_jac: Fn, u: Array) -> Array:
+    """Minimum-norm Gauss-Newton steps on ``constraint(u) = 0``, each step halved until the residual drops."""
     g = constraint(u)
-    if np.max(np.abs(g)) < 1e3 * CONSTRAINT_TOL:
-        return u
+    norm = float(np.linalg.norm(g))
+    for _ in range(100):
+        if np.max(np.abs(g)) < CONSTRAINT_TOL:
+            break
+        step = np.linalg.lstsq(constraint_jac(u), g, rcond=None)[0]
+        for _ in range(30):
+            trial = u - step
+            g_trial = constraint(trial)
+            n_trial = float(np.linalg.norm(g_trial))
+            if n_trial < norm:
+                break
+            step = step / 2.0
+        else:
+            break  # no step lowers the residual: a collinear (singular) configuration
+        u, g, norm = trial, g_trial, n_trial
+    return u
+
+
+def _project(constraint: Fn, constraint_jac: Fn, u: Array, angles: slice | None = None) -> Array:
+    """Move ``u`` onto ``constraint(u) = 0`` by damped minimum-norm Newton steps.
+
+    When the steps stall (at a configuration whose chords are all parallel, where the constraint's Jacobian
+    loses rank), restart from seeded random turns of the angles ``u[angles]`` of growing size.
+    """
+    rng = np.random.default_rng(0)
+    best = u
+    for attempt in range(12):
+        trial = u.copy()
+        if attempt and angles is not None:
+            trial[angles] += rng.normal(0.0, 0.05 * attempt, size=trial[angles].shape)
+        trial = _newton_to_constraint(constraint, constraint_jac, trial)
+        if np.max(np.abs(constraint(trial))) < 1e3 * CONSTRAINT_TOL:
+            return trial
+        if np.linalg.norm(constraint(trial)) < np.linalg.norm(constraint(best)):
+            best = trial
+    g = constraint(best)
     raise ConvergenceError(
-        f"joining: the chain cannot meet its closure/end constraint (residual {np.max(np.abs(g)):.3g}); "
-        "the segments may be too short or too long to reach"
+        f"joining: the chain cannot meet its closure/end constraint (residual {np.max(np.abs(g)):.3g})"
     )
 
 
-def _constrained(residual: Fn, jac: Fn, constraint: Fn, constraint_jac: Fn, u0: Array) -> Array:
-    """Minimise ``|residual|^2 / 2`` subject to ``constraint = 0``: SLSQP, then an exact projection."""
-    u_start = _project(constraint, constraint_jac, u0)
+def _constrained(
+    residual: Fn, jac: Fn, constraint: Fn, constraint_jac: Fn, starts: Sequence[Array], angles: slice
+) -> Array:
+    """Minimise ``|residual|^2 / 2`` subject to ``constraint = 0``: SLSQP, then an exact projection.
+
+    The first of ``starts`` that can be projected onto the constraint is the optimiser's start.
+    """
+    failure: ConvergenceError | None = None
+    for u0 in starts:
+        try:
+            u_start = _project(constraint, constraint_jac, u0, angles)
+            break
+        except ConvergenceError as exc:
+            failure = exc
+    else:
+        assert failure is not None
+        raise failure
 
     def f(u: Array) -> float:
         r = residual(u)
@@ -242,7 +346,10 @@ def _constrained(residual: Fn, jac: Fn, constraint: Fn, constraint_jac: Fn, u0: 
         options={"ftol": 1e-15, "maxiter": 500},
     )
     u = sol.x if np.all(np.isfinite(sol.x)) else u_start
-    u = _project(constraint, constraint_jac, u)
+    try:
+        u = _project(constraint, constraint_jac, u, angles)
+    except ConvergenceError:
+        u = u_start
     if f(u) > f(u_start):  # SLSQP wandered: keep the feasible start
         u = u_start
     return u
@@ -257,11 +364,16 @@ def join_chain(
 ) -> tuple[JoinedProfile, ...]:
     """Join the segments on every profile (Sec. 5), each profile on its own.
 
-    The initial guess is where the segmentation placed each segment (or ``initial``, a previous joining). A
-    fixed-end chain is pinned to profile 1's end points (the ground pivots of the mechanism).
+    The initial guess is where the segmentation placed each segment (or ``initial``, a previous joining); when
+    that cannot be moved onto the constraint, the chords along the target's chords between segmentation points.
+    A fixed-end chain is pinned on each profile at that profile's own first and last points (Eq. 32).
+
+    Raises
+    ------
+    ConvergenceError
+        Naming the profile, when the chain cannot meet its closure or end constraint there.
     """
     out = []
-    ends = (targets[0].points[0], targets[0].points[-1]) if kind == "fixed-end" else None
     for j, target in enumerate(targets):
         shapes = [seg.local_points(j) for seg in segments]
         if initial is None:
@@ -269,8 +381,9 @@ def join_chain(
             angles = np.array([chord_angle(seg.instances[j]) for seg in segments])
         else:
             start, angles = initial[j].joints[0], initial[j].angles
-        out.append(
-            join_profile(
+        ends = (target.points[0], target.points[-1]) if kind == "fixed-end" else None
+        try:
+            joined = join_profile(
                 shapes,
                 target.points,
                 start,
@@ -279,5 +392,8 @@ def join_chain(
                 ends=ends,
                 ties=() if ties is None else ties[j],
             )
-        )
+        except ConvergenceError as exc:
+            name = target.name or str(j + 1)
+            raise ConvergenceError(f"profile {name!r}: {exc}") from None
+        out.append(joined)
     return tuple(out)

@@ -14,6 +14,8 @@ from linkwork.errors import SpecError
 from linkwork.io.toml_reader import MAX_NAME_CHARS, show
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
+RankBy = Literal["error", "joints"]
+MergeOn = Literal["targets", "chain"]
 
 KINDS: tuple[ProfileKind, ...] = ("open", "closed", "fixed-end")
 """The values of ``kind`` (``type`` in a problem file)."""
@@ -43,7 +45,8 @@ class Problem:
         The design curves, each a polyline of shape ``(N_j, 2)``. A closed profile's polyline returns to its
         first point (its last row equals its first).
     kind
-        ``"open"``, ``"closed"`` or ``"fixed-end"`` (both ends pinned to where profile 1 has them).
+        ``"open"``, ``"closed"`` or ``"fixed-end"`` (each profile's chain pinned at that profile's own first
+        and last points, Eq. 32).
     piece_length
         The desired piece length ``s_d`` of the target profiles (Sec. 2 of the paper).
     min_pieces
@@ -57,6 +60,18 @@ class Problem:
     merge_below
         Joint-range threshold (radians) below which adjacent segments are merged into a compound segment
         (Sec. 6); ``0`` disables merging.
+    merge_on
+        Where the joint ranges that ``merge_below`` is compared with are measured (Eq. 34): ``"targets"``, on
+        the target profiles as the paper does, or ``"chain"``, on the joined chain.
+    rank_by
+        How the design vectors of ``design = None`` are ranked: ``"error"``, by the joined ``E_max``;
+        ``"joints"``, fewest joints among those whose joined ``E_max`` is at most ``e_max_tolerance``, then by
+        error (the trade-off of Sec. 5).
+    e_max_tolerance
+        The largest acceptable joined ``E_max`` (profile units) for ``rank_by = "joints"``.
+    initial_segment_matrix
+        ``(q, p)`` the segment matrix the search starts from (Eq. 11, transposed: one row per segment), or
+        ``None`` for the even split.
     seed
         Seed of the random generator of the initial segment matrices.
     names
@@ -77,6 +92,10 @@ class Problem:
     names: tuple[str, ...] = field(default=())
     source: Path | None = None
     mechanize: bool = False
+    merge_on: MergeOn = "targets"
+    rank_by: RankBy = "error"
+    e_max_tolerance: float | None = None
+    initial_segment_matrix: NDArray[np.int64] | None = None
 
     def __post_init__(self) -> None:
         """Check every rule of a problem; a broken one is a :class:`SpecError` naming the problem file's key
@@ -140,7 +159,36 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
         return [("merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {shown}")]
     if not _whole(p.seed, 0):
         return [("seed", f"expected a whole number >= 0, got {show(p.seed)}")]
-    return _name_rules(p) or _profile_rules(p)
+    return _ranking_rules(p) or _name_rules(p) or _profile_rules(p)
+
+
+def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
+    """``merge_on``, ``rank_by`` with its ``e_max_tolerance``, and an initial segment matrix's design."""
+    if p.merge_on not in ("targets", "chain"):
+        return [("merge_on", f'expected one of "targets", "chain", got {show(p.merge_on)}')]
+    if p.rank_by not in ("error", "joints"):
+        return [("rank_by", f'expected one of "error", "joints", got {show(p.rank_by)}')]
+    tol = p.e_max_tolerance
+    if tol is not None and not (
+        isinstance(tol, int | float) and not isinstance(tol, bool) and math.isfinite(tol) and tol > 0
+    ):
+        return [("e_max_tolerance", f"expected a positive number (profile units), got {show(tol)}")]
+    if p.rank_by == "joints" and tol is None:
+        return [("e_max_tolerance", 'missing; rank_by = "joints" needs the largest acceptable E_max')]
+    sm = p.initial_segment_matrix
+    if sm is not None:
+        design = (p.design or "").strip()
+        if not design or design.lower() == "auto":
+            return [("initial_segment_matrix", 'needs a design vector, not design = "auto"')]
+        rows = np.asarray(sm).shape[0] if np.asarray(sm).ndim == 2 else -1
+        if rows != len(design):
+            return [
+                (
+                    "initial_segment_matrix",
+                    f'has {rows} entries per row but design "{design.upper()}" has {len(design)} segments',
+                )
+            ]
+    return []
 
 
 def _design_rules(p: Problem) -> list[tuple[str, str]]:

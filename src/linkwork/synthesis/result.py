@@ -181,10 +181,12 @@ class Compound:
     Attributes
     ----------
     joint_angles
-        ``(q - 1, p)`` relative angle ``sigma_j^i`` at joint ``i`` on profile ``j`` (radians) before merging:
-        the turn from the chain's last piece of segment ``i`` to the first piece of segment ``i + 1``.
+        ``(q - 1, p)`` relative angle ``sigma_j^i`` at joint ``i`` on profile ``j`` (radians) before merging,
+        on the joined chain: the turn from its last piece of segment ``i`` to its first piece of segment
+        ``i + 1``. A merged joint is clamped at the mean of its row.
     joint_ranges
-        ``(q - 1,)`` range of motion ``max_j sigma - min_j sigma`` of each joint (Eq. 34), radians.
+        ``(q - 1,)`` range of motion ``max_j sigma - min_j sigma`` of each joint (Eq. 34) on the joined chain,
+        radians.
     threshold
         ``merge_below`` (radians).
     merged
@@ -197,6 +199,13 @@ class Compound:
         Largest entry of ``error_matrix`` (Eq. 22).
     profiles
         The merged chain posed on every profile.
+    target_angles
+        ``(q - 1, p)`` the same relative angles measured on the target profiles at the segmentation points, as
+        the paper does (Sec. 6).
+    target_ranges
+        ``(q - 1,)`` their ranges (Eq. 34).
+    merge_on
+        ``"targets"`` or ``"chain"``: which ranges ``threshold`` was applied to.
     """
 
     joint_angles: Array
@@ -207,12 +216,22 @@ class Compound:
     error_matrix: Array
     e_max: float
     profiles: tuple[JoinedProfile, ...]
+    target_angles: Array | None = None
+    target_ranges: Array | None = None
+    merge_on: str = "chain"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, angles in degrees."""
         return {
             "joint_ranges": [math.degrees(float(v)) for v in self.joint_ranges],
             "joint_angles": _matrix(np.degrees(self.joint_angles)),
+            "ranges": {
+                "targets": None
+                if self.target_ranges is None
+                else [math.degrees(float(v)) for v in self.target_ranges],
+                "chain": [math.degrees(float(v)) for v in self.joint_ranges],
+            },
+            "merge_on": self.merge_on,
             "merge_below": math.degrees(self.threshold),
             "merged": [int(i) for i in self.merged],
             "notes": list(self.notes),
@@ -224,13 +243,20 @@ class Compound:
 
 @dataclass(frozen=True)
 class DesignScore:
-    """How one design vector fared in the search: its best segment matrix and errors before/after joining."""
+    """How one design vector fared in the search: its best segment matrix and errors before/after joining.
+
+    ``joined_e_max`` is ``None`` for a design that was not joined: skipped (its chain cannot meet the closure
+    or end constraint) or pruned (``bound``, a lower bound on its joined ``E_max``, exceeds the best found).
+    ``joints`` counts the chain's joints (the paper's measure of complexity, Sec. 5).
+    """
 
     design: str
     segment_matrix: IntArray
     e_max: float
     e_mean: float
-    joined_e_max: float
+    joined_e_max: float | None
+    bound: float = 0.0
+    joints: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -239,7 +265,9 @@ class DesignScore:
             "segment_matrix": _matrix(self.segment_matrix),
             "e_max": float(self.e_max),
             "e_mean": float(self.e_mean),
-            "joined_e_max": float(self.joined_e_max),
+            "joined_e_max": None if self.joined_e_max is None else float(self.joined_e_max),
+            "bound": float(self.bound),
+            "joints": int(self.joints),
         }
 
 
@@ -253,7 +281,8 @@ class SearchStats:
         ``"paper"`` (Sec. 4 adjustment rules) or ``"refined"`` (paper, then a local search over
         segmentation points).
     designs
-        Every design vector tried, best first (ranked by ``joined_e_max``).
+        Every design vector tried: the joined ones best first (in the order of ``rank_by``), then the skipped
+        ones, then the pruned ones.
     starts
         Initial segment matrices per design vector.
     iterations
@@ -266,6 +295,14 @@ class SearchStats:
         Wall time of :func:`linkwork.synthesis.synthesize`.
     paper_e_max
         ``E_max`` the paper's search reached for the chosen design (before any refinement).
+    designs_tried
+        Number of design vectors whose segment matrix was searched.
+    skipped
+        ``(design, reason)`` of every design vector whose chain could not be joined.
+    pruned
+        Number of design vectors not joined because their lower bound could not beat the best.
+    rank_by, e_max_tolerance
+        The ranking of the design vectors (see :class:`~linkwork.synthesis.problem.Problem`).
     """
 
     search: str
@@ -276,12 +313,22 @@ class SearchStats:
     cache_hits: int
     seconds: float
     paper_e_max: float
+    designs_tried: int = 0
+    skipped: tuple[tuple[str, str], ...] = ()
+    pruned: int = 0
+    rank_by: str = "error"
+    e_max_tolerance: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {
             "search": self.search,
             "designs": [d.to_dict() for d in self.designs],
+            "designs_tried": self.designs_tried,
+            "skipped": [{"design": d, "reason": r} for d, r in self.skipped],
+            "pruned": self.pruned,
+            "rank_by": self.rank_by,
+            "e_max_tolerance": self.e_max_tolerance,
             "starts": self.starts,
             "iterations": self.iterations,
             "evaluations": self.evaluations,

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.synthesis.arc_segment import fit_arc_segment
+from linkwork.synthesis.compiled_search import CompiledTables
 from linkwork.synthesis.error_kernels import ProfileTables
 from linkwork.synthesis.frames import to_local_frame
 from linkwork.synthesis.mean_segment import fit_mean_segment
@@ -39,10 +40,18 @@ class SegmentFitter:
         Keep every error vector computed (on by default).
     vectorised
         Use the numpy fits; ``False`` uses the plain-Python reference (the benchmark's baseline).
+    compiled
+        Run the segment-matrix search compiled (:mod:`~linkwork.synthesis.compiled_search`, same decisions);
+        ``False`` runs it in Python through :meth:`error_matrix` and its cache. Needs ``vectorised``.
     """
 
     def __init__(
-        self, targets: Sequence[TargetProfile], *, cached: bool = True, vectorised: bool = True
+        self,
+        targets: Sequence[TargetProfile],
+        *,
+        cached: bool = True,
+        vectorised: bool = True,
+        compiled: bool = True,
     ) -> None:
         self.points = [t.points for t in targets]
         self.tables = ProfileTables(self.points)
@@ -51,6 +60,7 @@ class SegmentFitter:
         self.cache: dict[tuple[str, tuple[int, ...], tuple[int, ...]], Array] = {}
         self.evaluations = 0
         self.hits = 0
+        self.compiled_tables = CompiledTables.from_tables(self.tables) if compiled and vectorised else None
 
     def pieces(self, starts: Sequence[int], counts: Sequence[int]) -> list[Array]:
         """Each profile's piece: ``counts[j] + 1`` points from ``starts[j]``."""
@@ -59,7 +69,7 @@ class SegmentFitter:
     def errors(self, kind: str, starts: Sequence[int], counts: Sequence[int]) -> Array:
         """``(p,)`` errors ``E_j^e`` (Eq. 21) of a segment of ``kind`` spanning the given pieces."""
         self.evaluations += 1
-        key = (kind, tuple(int(s) for s in starts), tuple(int(m) for m in counts))
+        key = (kind, tuple(map(int, starts)), tuple(map(int, counts)))
         if self.cached:
             hit = self.cache.get(key)
             if hit is not None:
@@ -81,8 +91,13 @@ class SegmentFitter:
 
     def error_matrix(self, design: str, segment_matrix: IntArray) -> Array:
         """``(q, p)`` error matrix ``EM`` of a segment matrix (Sec. 4)."""
-        starts = segment_starts(segment_matrix)
-        return np.vstack([self.errors(k, starts[e], segment_matrix[e]) for e, k in enumerate(design)])
+        rows = np.asarray(segment_matrix).tolist()
+        first = [0] * len(rows[0])
+        out = []
+        for kind, counts in zip(design, rows, strict=True):
+            out.append(self.errors(kind, first, counts))
+            first = [f + m for f, m in zip(first, counts, strict=True)]
+        return np.vstack(out)
 
     def segment(self, kind: SegmentKind, starts: Sequence[int], counts: Sequence[int]) -> Segment:
         """The full :class:`Segment` (shape, instances, errors) for the given pieces."""

@@ -139,35 +139,46 @@ def adjust(segment_matrix: IntArray, error_matrix: Array, design: str, min_piece
     takes whatever keeps every column sum (Eq. 26); if that would push it below ``alpha``, the gains of that
     profile are withdrawn, largest error first, until it fits.
     """
-    sm = np.asarray(segment_matrix, dtype=np.int64)
-    em = np.asarray(error_matrix, dtype=float)
-    q, p = sm.shape
-    e_bar = em.mean()  # Eq. (24)
+    sm_arr = np.asarray(segment_matrix, dtype=np.int64)
+    em_arr = np.asarray(error_matrix, dtype=float)
+    q, p = sm_arr.shape
+    # plain Python on these small matrices: this runs once per iteration of every start of every design
+    e_bar = float(em_arr.mean())  # Eq. (24)
+    row_mean = em_arr.mean(axis=1).tolist()  # Eq. (23)
+    sm, em = sm_arr.tolist(), em_arr.tolist()
     absorber = design.rfind("C") if "C" in design else q - 1
-    delta = np.zeros((q, p), dtype=np.int64)
+    delta = [[0] * p for _ in range(q)]
     for e, kind in enumerate(design):
         if e == absorber:
             continue
         if kind == "M":
-            e_seg = em[e].mean()  # Eq. (23)
-            delta[e] = 1 if e_seg < e_bar else (-1 if e_seg > e_bar else 0)
+            step = 1 if row_mean[e] < e_bar else (-1 if row_mean[e] > e_bar else 0)
+            delta[e] = [step] * p
         else:
-            delta[e] = np.where(em[e] < e_bar, 1, np.where(em[e] > e_bar, -1, 0))
-    delta[(sm + delta) < min_pieces] = 0
+            delta[e] = [1 if v < e_bar else (-1 if v > e_bar else 0) for v in em[e]]
+        delta[e] = [d if m + d >= min_pieces else 0 for m, d in zip(sm[e], delta[e], strict=True)]
+    others = [sum(delta[e][j] for e in range(q) if e != absorber) for j in range(p)]
     while True:
-        delta[absorber] = 0
-        delta[absorber] = -delta.sum(axis=0)  # Eq. (26)
-        short = np.flatnonzero(sm[absorber] + delta[absorber] < min_pieces)
-        if short.size == 0:
-            return sm + delta
-        j = int(short[0])
-        gains = [e for e in range(q) if e != absorber and delta[e, j] > 0]
+        short = [j for j in range(p) if sm[absorber][j] - others[j] < min_pieces]  # Eq. (26)
+        if not short:
+            delta[absorber] = [-v for v in others]
+            return np.asarray(
+                [
+                    [m + d for m, d in zip(row, drow, strict=True)]
+                    for row, drow in zip(sm, delta, strict=True)
+                ],
+                dtype=np.int64,
+            ).reshape(q, p)
+        j = short[0]
+        gains = [e for e in range(q) if e != absorber and delta[e][j] > 0]
         c_gains = [e for e in gains if design[e] == "C"]
-        pick = max(c_gains or gains, key=lambda e: em[e, j])
-        if design[pick] == "M":
-            delta[pick, :] = 0  # an M-segment changes on every profile or on none
+        pick = max(c_gains or gains, key=lambda e: em[e][j])
+        if design[pick] == "M":  # an M-segment changes on every profile or on none
+            others = [v - d for v, d in zip(others, delta[pick], strict=True)]
+            delta[pick] = [0] * p
         else:
-            delta[pick, j] = 0
+            others[j] -= delta[pick][j]
+            delta[pick][j] = 0
 
 
 @dataclass(frozen=True)

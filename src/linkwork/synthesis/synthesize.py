@@ -6,57 +6,109 @@ compound segments.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
-from linkwork.errors import SpecError
+from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.progress import Progress
 from linkwork.synthesis.compound import merge_joints
-from linkwork.synthesis.joining import join_chain
 from linkwork.synthesis.problem import Problem
-from linkwork.synthesis.refine import refine_segment_matrix
-from linkwork.synthesis.result import DesignScore, JoinedProfile, SearchStats, Segment, SynthesisResult
-from linkwork.synthesis.segment_fit import SegmentFitter
-from linkwork.synthesis.segment_matrix import (
-    check_design,
-    check_feasible,
-    design_vectors,
-    initial_segment_matrices,
-    search_segment_matrix,
+from linkwork.synthesis.result import DesignScore, SearchStats, SynthesisResult, TargetProfile
+from linkwork.synthesis.search import (
+    JoinedDesign,
+    SegmentedDesign,
+    SkippedDesign,
+    chain_joints,
+    join_design,
+    segment_design,
 )
+from linkwork.synthesis.segment_fit import SegmentFitter
+from linkwork.synthesis.segment_matrix import check_design, check_feasible, design_vectors, is_valid
 from linkwork.synthesis.targets import target_profiles
 
-Progress = Callable[[int, int], None]
 SearchMethod = Literal["paper", "refined"]
 
 
-@dataclass(frozen=True)
-class _Candidate:
-    design: str
-    segment_matrix: NDArray[np.int64]
-    error_matrix: NDArray[np.float64]
-    segments: tuple[Segment, ...]
-    joined: tuple[JoinedProfile, ...]
-    joined_e_max: float
-    history: tuple[tuple[float, ...], ...]
-    paper_e_max: float
+def _check_initial(problem: Problem, designs: list[str], pieces: list[int]) -> None:
+    """The given initial segment matrix fits the (single) design vector and the target profiles."""
+    sm = problem.initial_segment_matrix
+    if sm is None:
+        return
+    key = "initial_segment_matrix"
+    src = None if problem.source is None else str(problem.source)
+    if len(designs) != 1:
+        raise SpecError("needs a design vector, not design 'auto'", source=src, key=key)
+    design = designs[0]
+    arr = np.asarray(sm)
+    if arr.shape != (len(design), len(pieces)):
+        raise SpecError(
+            f"has shape {arr.shape}; expected one entry per segment ({len(design)}) and profile ({len(pieces)})",
+            source=src,
+            key=key,
+        )
+    if not is_valid(arr.astype(np.int64), design, pieces, problem.min_pieces):
+        raise SpecError(
+            f"is not a valid segment matrix for design {design}: each profile's entries must sum to its "
+            f"pieces {pieces}, M-segments must have equal entries on every profile, every entry >= "
+            f"min_pieces {problem.min_pieces}",
+            source=src,
+            key=key,
+        )
 
-    @property
-    def rank_key(self) -> tuple[float, float, float]:
-        return (self.joined_e_max, float(self.error_matrix.max()), float(self.error_matrix.mean()))
+
+def _ranked(joined: list[JoinedDesign], problem: Problem) -> list[JoinedDesign]:
+    """Joined designs best first: by error, or by joints within ``e_max_tolerance`` (Sec. 5)."""
+    by_error = sorted(joined, key=lambda c: c.rank_key)
+    if problem.rank_by == "error":
+        return by_error
+    tol = float(problem.e_max_tolerance or 0.0)
+    good = [c for c in by_error if c.joined_e_max <= tol]
+    good.sort(key=lambda c: (chain_joints(c.design, problem.kind), c.rank_key))
+    return good + [c for c in by_error if c.joined_e_max > tol]
 
 
-def _design_seed(seed: int, design: str) -> list[int]:
-    """Seed material of one design vector's random starts: independent of the order designs are tried."""
-    return [seed, len(design), int(design.replace("M", "0").replace("C", "1"), 2)]
+def _join_pruned(
+    problem: Problem,
+    segmented: list[SegmentedDesign],
+    targets: tuple[TargetProfile, ...],
+    fitter: SegmentFitter,
+    prune: bool,
+    tick: Callable[[], None],
+) -> tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign]]:
+    """Join the designs in the order of their lower bounds; skip those whose bound cannot beat the best.
+
+    A design is left unjoined ("pruned") only when its bound exceeds the best joined ``E_max`` so far and, for
+    ``rank_by = "joints"``, also ``e_max_tolerance``: it can then neither rank first nor be acceptable.
+    """
+    joined: list[JoinedDesign] = []
+    skipped: list[SkippedDesign] = []
+    pruned: list[SegmentedDesign] = []
+    best = math.inf
+    tol = -math.inf if problem.rank_by == "error" else float(problem.e_max_tolerance or 0.0)
+    for seg in sorted(segmented, key=lambda d: (d.bound, d.design)):
+        if prune and seg.bound > best and seg.bound > tol:
+            pruned.append(seg)
+        else:
+            outcome = join_design(problem, seg, targets, fitter)
+            if isinstance(outcome, SkippedDesign):
+                skipped.append(outcome)
+            else:
+                joined.append(outcome)
+                best = min(best, outcome.joined_e_max)
+        tick()
+    return joined, skipped, pruned
 
 
 def synthesize(
-    problem: Problem, progress: Progress | None = None, *, search: SearchMethod = "paper"
+    problem: Problem,
+    progress: Progress | None = None,
+    *,
+    search: SearchMethod = "paper",
+    prune: bool = True,
 ) -> SynthesisResult:
     """Synthesise a chain of M- and C-segments that approximates every profile of ``problem``.
 
@@ -70,19 +122,24 @@ def synthesize(
         ``"paper"``: the adjustment rules of Section 4 from ``problem.starts`` initial segment matrices.
         ``"refined"``: the same, then a local search over the segmentation points from the paper's best matrix
         (never worse: it only accepts improvements).
+    prune
+        Join only the design vectors whose lower bound on the joined ``E_max`` (see
+        :func:`linkwork.synthesis.search.joined_error_bound`) does not exceed the best joined ``E_max`` found;
+        the chosen design is the same as with ``prune=False``, which joins every design vector.
 
     Returns
     -------
     SynthesisResult
-        The design vector with the lowest ``E_max`` after joining, its segments, the joined chain on every
+        The design vector ranked first (``problem.rank_by``; by default the lowest ``E_max`` after joining), its segments, the joined chain on every
         profile and, when ``merge_below > 0``, the compound segments.
 
     Raises
     ------
     SpecError
         For an invalid problem (unknown design letters, too few pieces for the segments, ...).
-    ConvergenceError
-        When a closed or fixed-end chain cannot be joined.
+    RequestNotMetError
+        When no design vector can be joined (each closed or fixed-end chain misses its constraint); a design
+        that cannot be joined is otherwise skipped and listed in ``stats.skipped``.
 
     References
     ----------
@@ -103,6 +160,7 @@ def synthesize(
         designs = design_vectors(problem.segments, pieces)
     for design in designs:
         check_feasible(design, pieces, problem.min_pieces)
+    _check_initial(problem, designs, pieces)
 
     fitter = SegmentFitter(targets)
     total = len(designs) * (problem.starts + 1)
@@ -114,90 +172,75 @@ def synthesize(
         if progress is not None:
             progress(done, total)
 
-    candidates: list[_Candidate] = []
-    iterations = 0
-    for design in designs:
-        rng = np.random.default_rng(_design_seed(problem.seed, design))
-        starts = initial_segment_matrices(design, pieces, problem.min_pieces, problem.starts, rng)
-        outcome = search_segment_matrix(
-            design,
-            starts,
-            lambda sm, d=design: fitter.error_matrix(d, sm),  # type: ignore[misc]
-            problem.min_pieces,
-            on_start_done=tick,
-        )
-        iterations += outcome.iterations
-        options = [(outcome.segment_matrix, outcome.error_matrix)]
-        if search == "refined":
-            options.append(refine_segment_matrix(design, outcome.segment_matrix, fitter, problem.min_pieces))
-        best: _Candidate | None = None
-        for sm, em in options:
-            segments = fitter.segments(design, sm)
-            joined = join_chain(segments, targets, problem.kind)
-            joined_e_max = max(float(prof.errors.max()) for prof in joined)
-            cand = _Candidate(
-                design,
-                sm,
-                em,
-                segments,
-                joined,
-                joined_e_max,
-                outcome.history,
-                float(outcome.error_matrix.max()),
-            )
-            if best is None or cand.rank_key < best.rank_key:
-                best = cand
-        assert best is not None
-        candidates.append(best)
-        tick()
-
-    candidates.sort(key=lambda c: c.rank_key)
-    chosen = candidates[0]
+    segmented = [
+        segment_design(problem, design, targets, fitter, search=search, on_start_done=tick)
+        for design in designs
+    ]
+    joined, skipped, pruned = _join_pruned(problem, segmented, targets, fitter, prune, tick)
+    if not joined:
+        reasons = "; ".join(s.reason for s in skipped[:3]) + ("; ..." if len(skipped) > 3 else "")
+        raise RequestNotMetError(f"no design vector of the {len(designs)} tried could be joined: {reasons}")
+    ranked = _ranked(joined, problem)
+    chosen = ranked[0]
+    opt = chosen.segmentation
     joined_em = np.column_stack([prof.errors for prof in chosen.joined])
     compound = None
     if problem.merge_below > 0.0:
         compound = merge_joints(
             chosen.design,
-            chosen.segment_matrix,
+            opt.segment_matrix,
             chosen.segments,
             targets,
             chosen.joined,
             problem.merge_below,
             problem.kind,
+            merge_on=problem.merge_on,
         )
-    scores = tuple(
-        DesignScore(
-            c.design,
-            c.segment_matrix,
-            float(c.error_matrix.max()),
-            float(c.error_matrix.mean()),
-            c.joined_e_max,
-        )
-        for c in candidates
-    )
+    scores = [_score(c.segmented, c, problem) for c in ranked]
+    scores += [_score(s.segmented, None, problem) for s in skipped]
+    scores += [_score(p, None, problem) for p in pruned]
     stats = SearchStats(
         search=search,
-        designs=scores,
+        designs=tuple(scores),
         starts=problem.starts,
-        iterations=iterations,
+        iterations=sum(d.iterations for d in segmented),
         evaluations=fitter.evaluations,
         cache_hits=fitter.hits,
         seconds=time.perf_counter() - t0,
-        paper_e_max=chosen.paper_e_max,
+        paper_e_max=chosen.segmented.paper_e_max,
+        designs_tried=len(designs),
+        skipped=tuple((s.design, s.reason) for s in skipped),
+        pruned=len(pruned),
+        rank_by=problem.rank_by,
+        e_max_tolerance=problem.e_max_tolerance,
     )
     return SynthesisResult(
         problem=problem,
         targets=targets,
         design=chosen.design,
-        segment_matrix=chosen.segment_matrix,
-        error_matrix=chosen.error_matrix,
-        e_max=float(chosen.error_matrix.max()),  # Eq. (22)
-        e_mean=float(chosen.error_matrix.mean()),  # Eq. (24)
+        segment_matrix=opt.segment_matrix,
+        error_matrix=opt.error_matrix,
+        e_max=float(opt.error_matrix.max()),  # Eq. (22)
+        e_mean=float(opt.error_matrix.mean()),  # Eq. (24)
         segments=chosen.segments,
         joined_error_matrix=joined_em,
         joined_e_max=float(joined_em.max()),
         joined=chosen.joined,
         compound=compound,
         stats=stats,
-        history=chosen.history,
+        history=chosen.segmented.history,
+    )
+
+
+def _score(seg: SegmentedDesign, joined: JoinedDesign | None, problem: Problem) -> DesignScore:
+    """A design's line of the search table: its (best joined, else paper's) matrix, errors and bound."""
+    opt = joined.segmentation if joined is not None else seg.options[0]
+    return DesignScore(
+        seg.design,
+        opt.segment_matrix,
+        float(opt.error_matrix.max()),
+        float(opt.error_matrix.mean()),
+        None if joined is None else joined.joined_e_max,
+        bound=seg.bound,
+        joints=chain_joints(seg.design, problem.kind),
     )

@@ -37,20 +37,26 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     ax.plot(x, _positive(b["max"]), ":", color="tab:blue", label="largest sample")
     ax.plot(x, _positive(b["first_order_p50"]), "--", color="tab:orange", label="median (first order)")
     ax.plot(x, _positive(b["first_order_p95"]), "-.", color="tab:orange", label="95 % (first order)")
-    if np.any(np.isfinite(_positive(b["p95"]))):
+    top = np.nanmax(_positive(b["max"])) if np.any(np.isfinite(_positive(b["max"]))) else np.nan
+    if np.isfinite(top):
         ax.set_yscale("log")
+        # The start (where the imperfect structure is assembled) has no misfit: show five decades below the top.
+        ax.set_ylim(bottom=10.0 ** (np.floor(np.log10(top)) - 4.0), top=top * 2.0)
     unit = " (deg)" if key == "drive_deg" else ""
     if monotonic:
         ax.set_xlabel(f"drive {summary['drive']}{unit}")
     else:
         ax.set_xlabel(
-            f"point along the nominal path (drive {summary['drive']} from {drive.min():.4g} to {drive.max():.4g}{unit})"
+            f"point along the nominal path (drive {summary['drive']} between {drive.min():.4g} and "
+            f"{drive.max():.4g}{unit.replace('(', '').replace(')', '')})"
         )
     ax.set_ylabel(f"closure misfit (length units, L = {summary['scale']['length']:.3g})")
     ratio = _positive(b["ratio"])
     twin = ax.twinx()
     twin.plot(x, ratio, color="tab:gray", lw=1.0, label="Sec. 5 ratio (paper)")
-    twin.plot(x, _positive(b["ratio_weighted"]), color="tab:green", lw=1.0, label="ratio (scaled Jacobian)")
+    twin.plot(
+        x, _positive(b["ratio_normalised"]), color="tab:green", lw=1.0, label="ratio (normalised Jacobian)"
+    )
     if np.any(np.isfinite(ratio)):
         twin.set_yscale("log")
     twin.set_ylabel("largest / smallest non-zero singular value")

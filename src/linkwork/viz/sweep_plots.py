@@ -94,10 +94,12 @@ def write_sweep_figures(study: Study, rows: list[dict[str, Any]], folder: Path) 
         return figures
     numeric_params = [p for p in study.grid if np.isfinite(_numeric(rows, p)).all()]
     for metric in METRICS:
-        if not np.isfinite(_numeric(rows, metric)).any():
-            continue
+        values = _numeric(rows, metric)
+        finite = values[np.isfinite(values)]
+        if finite.size == 0 or (len(rows) > 1 and np.all(finite == finite[0])):
+            continue  # nothing to see: absent, or the same at every grid point
         if numeric_params:
             figures.append(plot_lines(study, rows, metric, Path(folder) / f"sweep_{metric}.png"))
-        if len(study.grid) == 2:
+        if len(study.grid) == 2 and len(rows) == np.prod([len(v) for v in study.grid.values()]):
             figures.append(plot_heatmap(study, rows, metric, Path(folder) / f"heatmap_{metric}.png"))
     return figures
