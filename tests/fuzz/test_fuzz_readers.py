@@ -50,6 +50,62 @@ values = st.recursive(
 SPEC_LINES = dump_spec(bennett()).splitlines()
 SPEC_KEYS = [i for i, line in enumerate(SPEC_LINES) if " = " in line and not line.startswith("#")]
 
+#: A planar [mechanism] spec: a four-bar (A and C coupled) with a slider on the rocker.
+MECHANISM_LINES = """name = "four-bar"
+[mechanism]
+planar = true
+couple = [["A", "C"]]
+fixed = []
+
+[[mechanism.joints]]
+name = "A"
+type = "R"
+bodies = ["ground", "crank"]
+point = [0.0, 0.0]
+
+[[mechanism.joints]]
+name = "B"
+bodies = ["crank", "coupler"]
+point = [1.0, 0.0]
+
+[[mechanism.joints]]
+name = "C"
+bodies = ["coupler", "rocker"]
+point = [1.0, 1.0]
+
+[[mechanism.joints]]
+name = "D"
+bodies = ["rocker", "ground"]
+point = [0.0, 1.0]
+direction = [0.0, 0.0, 1.0]
+
+[[mechanism.joints]]
+name = "E"
+type = "P"
+bodies = ["rocker", "slider"]
+point = [0.0, 1.0]
+direction = [1.0, 0.0]
+value = 0.5
+""".splitlines()
+MECHANISM_KEYS = [i for i, line in enumerate(MECHANISM_LINES) if " = " in line]
+
+
+@FUZZ
+@given(edits=st.lists(st.tuples(st.sampled_from(MECHANISM_KEYS), values), min_size=1, max_size=3))
+def test_mechanism_spec_reader_reads_or_says_one_line(tmp_path_factory, edits) -> None:  # type: ignore[no-untyped-def]
+    lines = list(MECHANISM_LINES)
+    for index, value in edits:
+        key = lines[index].split(" = ")[0]
+        lines[index] = f"{key} = {value}"
+    file = tmp_path_factory.mktemp("mechanism") / "fuzz.toml"
+    file.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    message = one_line_error(lambda: load_spec(file), (LinkworkError,))
+    if message is not None:
+        assert message.startswith(str(file))
+    else:
+        mech = load_spec(file).mechanism
+        assert np.all(np.isfinite(mech.twists)) and np.all(np.isfinite(mech.offsets))
+
 
 @FUZZ
 @given(edits=st.lists(st.tuples(st.sampled_from(SPEC_KEYS), values), min_size=1, max_size=3),
@@ -169,3 +225,30 @@ def _reads_or_one_line(file: Path) -> None:
         assert np.all(np.isfinite(points)) and np.abs(points).max() <= MAX_COORDINATE
     else:
         assert message.startswith(str(file))
+
+
+anything = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(min_value=-(10**20), max_value=10**20),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from(HOSTILE_TEXT),
+    st.sampled_from(["auto", "MC", "mc", "open", "closed", "chain", "joints", "targets", "error"]),
+)
+
+
+@FUZZ
+@given(settings=st.dictionaries(
+    st.sampled_from(["kind", "piece_length", "min_pieces", "design", "segments", "starts", "merge_below", "seed",
+                     "merge_on", "rank_by", "e_max_tolerance"]), anything, max_size=4))  # fmt: skip
+def test_problem_built_in_a_script_is_sound_or_one_line(settings: dict) -> None:  # type: ignore[type-arg]
+    """Problem validates itself: any settings give a Problem whose rules hold, or one SpecError line."""
+    from linkwork.synthesis import Problem
+
+    profiles = (np.array([[0.0, 0.0], [3.0, 0.0]]), np.array([[0.0, 0.0], [4.0, 1.0]]))
+    base = {"piece_length": 0.3, "design": "MC"}
+    message = one_line_error(lambda: Problem(profiles=profiles, **{**base, **settings}), (LinkworkError,))
+    if message is None:
+        problem = Problem(profiles=profiles, **{**base, **settings})
+        assert problem.piece_length > 0 and 1 <= problem.starts <= 1000 and problem.min_pieces >= 2
+        assert not isinstance(problem.piece_length, bool) and not isinstance(problem.merge_below, bool)

@@ -109,6 +109,13 @@ class Problem:
         return len(self.profiles)
 
 
+def _real(value: Any) -> bool:
+    """A number (``True`` and ``False`` are not)."""
+    return isinstance(value, int | float | np.integer | np.floating) and not isinstance(
+        value, bool | np.bool_
+    )
+
+
 def _whole(value: Any, minimum: int, maximum: int | None = None) -> bool:
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
         return False
@@ -123,7 +130,7 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
         return [("type", f'expected one of "open", "closed", "fixed-end", got {show(p.kind)}')]
     if len(p.profiles) < 2:
         return [("profiles", f"lists {len(p.profiles)} profile(s); expected at least 2 profiles")]
-    if not (isinstance(p.piece_length, int | float) and math.isfinite(p.piece_length) and p.piece_length > 0):
+    if not (_real(p.piece_length) and math.isfinite(p.piece_length) and p.piece_length > 0):
         return [("piece_length", f"expected a positive number, got {show(p.piece_length)}")]
     if not _whole(p.min_pieces, 2):
         return [
@@ -154,8 +161,8 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
             )
         ]
     merge = p.merge_below
-    if not (isinstance(merge, int | float) and 0.0 <= merge < math.pi):
-        shown = f"{math.degrees(merge):g}" if isinstance(merge, int | float) else show(merge)
+    if not (_real(merge) and 0.0 <= merge < math.pi):
+        shown = f"{math.degrees(merge):g}" if _real(merge) else show(merge)
         return [("merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {shown}")]
     if not _whole(p.seed, 0):
         return [("seed", f"expected a whole number >= 0, got {show(p.seed)}")]
@@ -169,9 +176,7 @@ def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
     if p.rank_by not in ("error", "joints"):
         return [("rank_by", f'expected one of "error", "joints", got {show(p.rank_by)}')]
     tol = p.e_max_tolerance
-    if tol is not None and not (
-        isinstance(tol, int | float) and not isinstance(tol, bool) and math.isfinite(tol) and tol > 0
-    ):
+    if tol is not None and not (_real(tol) and math.isfinite(tol) and tol > 0):
         return [("e_max_tolerance", f"expected a positive number (profile units), got {show(tol)}")]
     if p.rank_by == "joints" and tol is None:
         return [("e_max_tolerance", 'missing; rank_by = "joints" needs the largest acceptable E_max')]
