@@ -39,11 +39,13 @@ def test_help_has_no_python_type_placeholders(command: str | None) -> None:
 
 @pytest.mark.parametrize("command", COMMANDS)
 def test_every_out_option_has_the_short_form(command: str) -> None:
-    params = typer.main.get_command(app).commands[command].params  # type: ignore[attr-defined]
-    for param in params:
-        if "--out" in param.opts:
-            assert "-o" in param.opts, f"{command} --out has no -o"
-    assert command in ("linkages", "show") or any("--out" in p.opts for p in params)
+    cli = typer.main.get_command(app).commands[command]  # type: ignore[attr-defined]
+    subcommands = getattr(cli, "commands", None)  # a group (export): every subcommand writes a file
+    for sub in subcommands.values() if subcommands else [cli]:
+        for param in sub.params:
+            if "--out" in param.opts:
+                assert "-o" in param.opts, f"{command} --out has no -o"
+        assert command in ("linkages", "show") or any("--out" in p.opts for p in sub.params)
 
 
 def test_short_out_writes_where_asked(tmp_path: Path) -> None:

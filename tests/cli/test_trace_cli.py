@@ -151,10 +151,8 @@ def test_max_condition_raw_is_the_largest_ratio_of_the_csv_singular_values(paper
 
 
 def test_no_plots_writes_no_figure(paper: Path) -> None:
-    assert sorted(p.name for p in paper.iterdir() if p.name != ".linkwork-manifest.json") == [
-        "path.csv",
-        "report.json",
-    ]
+    names = sorted(p.name for p in paper.iterdir() if p.name != ".linkwork-manifest.json")
+    assert names == ["drawing.json", "mechanism.toml", "path.csv", "points.csv", "report.json"]
     assert not list(paper.glob("*.png"))
 
 

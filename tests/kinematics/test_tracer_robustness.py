@@ -202,11 +202,13 @@ EXPECTED = {
     "bricard-plane": (0, 0),
     "bricard-threefold": (1, 0),
     "bricard-trihedral": (0, 0),
+    "four-bar": (0, 0),  # a Grashof crank-rocker: the crank turns round, no change point
     "goldberg": (0, 0),
     "guest-frame": (6, 0),
     "hedgepeth": (0, 0),
     "hedgepeth-rods": (0, 0),
     "sarrus": (2, 4),
+    "slider-crank": (0, 0),  # the rod longer than crank + offset: no dead point
 }
 
 

@@ -195,7 +195,7 @@ def trace(
 
     figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
     print_trace_summary(path)
-    written = ["path.csv", "report.json", *[f.name for f in figures]]
+    written = ["path.csv", "report.json", "points.csv", "mechanism.toml", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
     if "unmet" in path.stats:
         raise RequestNotMetError(str(path.stats["unmet"]))

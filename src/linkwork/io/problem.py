@@ -24,6 +24,7 @@ Example
     rank_by = "error"                   # error | joints (fewest joints with E_max <= e_max_tolerance)
     e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
     initial_segment_matrix = [[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]]  # Eq. 11: a row per profile
+    units = "mm"                        # optional: length unit of the profile files, carried into DXF/SVG
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from linkwork.io.profiles import COINCIDENT, load_profile
+from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
 from linkwork.io.toml_reader import TomlReader, escape_line, key_path, read_toml, show
 from linkwork.synthesis.problem import KINDS, Problem, ProfileKind
 
@@ -52,6 +53,7 @@ KEYS = (
     "seed",
     "names",
     "mechanize",
+    "units",
     "description",
     "merge_on",
     "rank_by",
@@ -98,6 +100,10 @@ def _settings(reader: TomlReader, table: dict[str, Any]) -> dict[str, Any]:
         )
     settings["e_max_tolerance"] = tolerance
     settings["initial_segment_matrix"] = _initial_segment_matrix(reader, table)
+    units = table.get("units")
+    if units is not None and (not isinstance(units, str) or units not in LENGTH_UNITS):
+        raise reader.error("units", f"expected one of {', '.join(LENGTH_UNITS)}, got {show(units)}")
+    settings["units"] = units
     return settings
 
 

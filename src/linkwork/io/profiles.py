@@ -51,6 +51,7 @@ __all__ = [
     "COINCIDENT",
     "FLATTEN_TOLERANCE",
     "FORMATS",
+    "LENGTH_UNITS",
     "MAX_BULGE",
     "MAX_COORDINATE",
     "MAX_FLATTENED_POINTS",
@@ -61,6 +62,7 @@ __all__ = [
     "find_self_crossing",
     "is_closed",
     "load_profile",
+    "new_dxf",
     "read_profile_csv",
     "read_profile_dat",
     "read_profile_dxf",
@@ -76,6 +78,18 @@ __all__ = [
 ]
 
 _CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier control points
+
+
+#: Length units a problem file may name (``units = "mm"``): DXF ``$INSUNITS`` code, and the SVG unit and factor
+#: that express one such length (SVG has no metre, foot or micrometre).
+LENGTH_UNITS: dict[str, tuple[int, str, float]] = {
+    "mm": (4, "mm", 1.0),
+    "cm": (5, "cm", 1.0),
+    "m": (6, "mm", 1000.0),
+    "um": (13, "mm", 0.001),
+    "in": (1, "in", 1.0),
+    "ft": (2, "in", 12.0),
+}
 
 
 # ---------------------------------------------------------------------------------------------------- CSV
@@ -242,18 +256,25 @@ def _svg_path(d: str, colour: str, *, dashed: bool = False, label: str | None = 
     )
 
 
-def _svg_document(body: Iterable[str], extents: Sequence[Points], pixels: float = 800.0) -> str:
-    """An SVG document whose viewBox holds every point of ``extents`` (profile coordinates, y up)."""
+def _svg_document(
+    body: Iterable[str], extents: Sequence[Points], pixels: float = 800.0, units: str | None = None
+) -> str:
+    """An SVG document whose viewBox holds every point of ``extents`` (profile coordinates, y up); with ``units``
+    (a key of :data:`LENGTH_UNITS`) its width and height are the drawing's true size in that unit, else
+    ``pixels`` across."""
     everything = np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents])
     lo, hi = everything.min(axis=0), everything.max(axis=0)
     margin = 0.05 * _size(everything)
     x0, y0 = lo[0] - margin, -hi[1] - margin
     width, height = hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin
-    scale = pixels / max(width, height)
+    if units is None:
+        scale, unit = pixels / max(width, height), ""
+    else:
+        _code, unit, scale = LENGTH_UNITS[units]
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{width * scale:.1f}" height="{height * scale:.1f}" '
-        f'viewBox="{x0:.12g} {y0:.12g} {width:.12g} {height:.12g}">',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{width * scale:.6g}{unit}" '
+        f'height="{height * scale:.6g}{unit}" viewBox="{x0:.12g} {y0:.12g} {width:.12g} {height:.12g}">',
         *body,
         "</svg>",
     ]
@@ -342,6 +363,18 @@ def final_chain(result: SynthesisResult) -> tuple[JoinedProfile, ...]:
     return result.joined
 
 
+def new_dxf(units: str | None = None) -> Any:
+    """A new ezdxf document (R2010) whose ``$INSUNITS`` says the drawing's length unit (0, unitless, when
+    ``units`` is ``None``) and whose ``$MEASUREMENT`` is metric or imperial to match."""
+    import ezdxf
+
+    document = ezdxf.new("R2010")
+    code = LENGTH_UNITS[units][0] if units is not None else 0
+    document.header["$INSUNITS"] = code
+    document.header["$MEASUREMENT"] = 0 if units in ("in", "ft") else 1
+    return document
+
+
 def write_outline_svg(path: str | Path, result: SynthesisResult) -> None:
     """Write the chain's outline on every profile as one SVG drawing (y up, profile coordinates).
 
@@ -366,7 +399,8 @@ def write_outline_svg(path: str | Path, result: SynthesisResult) -> None:
             for x, y in chain.joints[joints]
         ]
         body.append("</g>")
-    Path(path).write_text(_svg_document(body, extents), encoding="utf-8")
+    units = result.problem.units
+    Path(path).write_text(_svg_document(body, extents, units=units), encoding="utf-8")
 
 
 def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
@@ -374,14 +408,13 @@ def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
 
     Per profile ``NAME``: layer ``NAME-target`` holds the target profile, ``NAME-chain`` the chain (an
     LWPOLYLINE through the chain's points) and ``NAME-joints`` a circle at every joint and at both ends; the
-    chain is the final one (:func:`final_chain`), without the joints merged into compound segments.
+    chain is the final one (:func:`final_chain`), without the joints merged into compound segments. Lengths are
+    in the problem's ``units`` (``$INSUNITS``).
     """
-    import ezdxf
-
     chains = final_chain(result)
     joints = _live_joints(result)
     radius = 0.006 * _size(np.vstack([t.points for t in result.targets]))
-    document = ezdxf.new("R2010")
+    document = new_dxf(result.problem.units)
     space = document.modelspace()
     layers = _dxf_layer_names([t.name or f"profile {j + 1}" for j, t in enumerate(result.targets)])
     for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):

@@ -171,3 +171,24 @@ def write_report_json(path: Trace, file: Path, assembly: Any | None = None) -> N
     with open(file, "w") as fh:
         json.dump(report_dict(path, assembly), fh, indent=2)
         fh.write("\n")
+
+
+def write_points_csv(path: Trace, file: Path) -> None:
+    """Write ``points.csv``: ``branch,step``, then ``<name>_x,<name>_y,<name>_z`` for every joint and every named
+    point (world coordinates, the mechanism's length unit), then ``transmission`` (degrees) when the mechanism
+    declares a transmission angle (four-bar, slider-crank)."""
+    from linkwork.kinematics.points import points_columns, positions, transmission_angles
+
+    mech = path.mechanism
+    joints, named = positions(mech, path.angles)
+    xyz = np.concatenate([joints, named], axis=1).reshape(len(path.angles), -1)
+    header = ["branch", "step", *[f"{name}_{c}" for name in points_columns(mech) for c in "xyz"]]
+    mu = transmission_angles(mech, joints)
+    if mu is not None:
+        header.append("transmission")
+        xyz = np.column_stack([xyz, np.degrees(mu)])
+    with open(file, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(header)
+        for b, s, row in zip(path.branch, path.step, xyz, strict=True):
+            writer.writerow([int(b), int(s), *(f"{v:.17g}" for v in row)])

@@ -40,7 +40,7 @@ import pkgutil
 import re
 from collections import deque
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -62,7 +62,8 @@ CONVENTIONS = ("dh", "hinge-lines", "rods")
 ANGLE_UNITS = ("deg", "rad")
 """The values of ``angles``."""
 
-TOP_KEYS = ("name", "angles", "description", "loop", "mechanism")
+TOP_KEYS = ("name", "angles", "description", "loop", "mechanism", "points")
+POINT_KEYS = ("name", "body", "position")
 LOOP_KEYS = ("convention", "couple", "fixed", "joints")
 MECHANISM_KEYS = ("planar", "couple", "fixed", "joints")
 JOINT_KEYS = {
@@ -101,7 +102,7 @@ _ELSEWHERE = {
 }
 
 #: Joint names end up in CSV headers and in flags such as ``--until A=30`` and ``--couple A=C``.
-_JOINT_NAME = re.compile(r"[^\s=,\"']+")
+_JOINT_NAME = re.compile(r"[^\s=,\"'\x00-\x1f\x7f]+")
 
 
 @dataclass(frozen=True)
@@ -168,6 +169,10 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     reader = _Reader(source)
     reader.check_keys(table, "", TOP_KEYS)
     name = reader.string(table, "name", "", default=path.stem, limit=MAX_NAME_CHARS)
+    if re.search(r"[\x00-\x1f\x7f\u2028\u2029]", name):
+        raise reader.error(
+            "name", f"expected a name without line breaks or control characters, got {_show(name)}"
+        )
     reader.string(table, "description", "", default="")  # free text for the reader
     unit = reader.choice(table, "angles", "", ANGLE_UNITS, default="deg")
     reader.degrees = unit == "deg"
@@ -194,6 +199,8 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
         mech = mech.with_couplings(couple, fixed)
     if assembly is None:
         _check_not_near_mobile(mech, source, closure_tol)
+    if "points" in table:
+        mech = replace(mech, meta={**mech.meta, "points": _read_points(reader, table["points"], mech)})
     return LoadedSpec(mechanism=mech, assembly=assembly, source=path)
 
 
@@ -482,6 +489,31 @@ def _read_mechanism(
     return mech, couplings
 
 
+def _read_points(reader: _Reader, value: Any, mech: Mechanism) -> list[dict[str, Any]]:
+    """The optional ``[[points]]`` tables: named points (``name``, ``body``, ``position`` in the start
+    configuration) whose world coordinates ``points.csv`` follows along the path."""
+    if not isinstance(value, list):
+        raise reader.error("points", f"expected [[points]] tables, got {_show(value)}")
+    out: list[dict[str, Any]] = []
+    taken = set(mech.joint_names)
+    for i, entry in enumerate(value):
+        here = _key("points", i)
+        entry = reader.table(entry, here, POINT_KEYS)
+        name = reader.string(entry, "name", here, default=f"P{i + 1}")
+        if name in taken or not _JOINT_NAME.fullmatch(name):
+            raise reader.error(_key(here, "name"), f"expected a new name without spaces, got {_show(name)}")
+        taken.add(name)
+        body = reader.require(entry, "body", here, f"one of the bodies {', '.join(mech.bodies)}")
+        if body not in mech.bodies:
+            raise reader.error(
+                _key(here, "body"), f"expected one of {', '.join(mech.bodies)}, got {_show(body)}"
+            )
+        position = reader.vector(entry, "position", here, sizes=(2, 3))
+        position = np.append(position, 0.0) if position.size == 2 else position
+        out.append({"name": name, "body": body, "position": [float(x) for x in position]})
+    return out
+
+
 def _joint_line(
     reader: _Reader, joint: Mapping[str, Any], here: str, kind: str, planar: bool
 ) -> tuple[Array, Array]:
@@ -549,7 +581,8 @@ def dump_spec(mech: Mechanism) -> str:
     A single loop of revolute joints in loop order is written in the ``[loop]`` ``hinge-lines`` form, anything
     else in the ``[mechanism]`` form; couplings and fixed joints are written as ``couple`` and ``fixed``.
     :func:`load_spec` of the text gives back the same joints, twists (to rounding), offsets, bodies, loops and
-    couplings. ``meta`` is not written.
+    couplings, and the named points ``meta["points"]`` as ``[[points]]``; the rest of ``meta`` is not
+    written.
 
     Parameters
     ----------
@@ -612,6 +645,12 @@ def dump_spec(mech: Mechanism) -> str:
         else:
             lines.append(f"direction = {_toml_vector(direction)}")
         lines.append(f"value = {_toml_float(reading)}")
+    for point in mech.meta.get("points", ()):
+        lines += ["", "[[points]]", f"name = {_toml_string(str(point['name']))}"]
+        lines += [
+            f"body = {_toml_string(str(point['body']))}",
+            f"position = {_toml_vector(point['position'])}",
+        ]
     return "\n".join(lines) + "\n"
 
 

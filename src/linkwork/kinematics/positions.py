@@ -4,16 +4,19 @@ A joint's *point* is a fixed point on its axis: for a revolute joint, the mean o
 with its neighbours in the loop (for a Denavit-Hartenberg loop with ``d = 0`` both feet coincide at the DH frame
 origin, so consecutive points are the link lengths ``a`` apart); where a neighbour's axis is parallel, the foot
 of the perpendicular from the origin (the joint's pivot in a planar mechanism drawn in ``z = 0``). A prismatic
-joint has a direction only: its point is the mean of the revolute points of its two bodies. The points move with
-the body before each joint (a revolute joint's axis is fixed in both of its bodies).
+joint has a direction only: its point is the mean of the revolute points of the body sliding on it (the body
+after it), and moves with that body (a slider's pin); a revolute joint's point moves with the body before it (its
+axis is fixed in both of its bodies).
 """
 
 from __future__ import annotations
 
+from collections import deque
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from linkwork.kinematics.closure import body_poses
+from linkwork.geometry import exp_se3
 from linkwork.kinematics.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -69,23 +72,41 @@ def joint_points(mech: Mechanism) -> Array:
         points[j] = np.mean(feet, axis=0) if feet else axis[0]
     for j in range(n):
         if axes[j] is None:
-            pool = [
-                k
-                for k in range(n)
-                if axes[k] is not None and set(mech.joint_bodies[k]) & set(mech.joint_bodies[j])
-            ]
+            after = mech.joint_bodies[j][1]
+            pool = [k for k in range(n) if axes[k] is not None and after in mech.joint_bodies[k]]
+            pool = pool or [k for k in range(n) if axes[k] is not None]
             points[j] = points[pool].mean(axis=0) if pool else 0.0
     return points
 
 
+def carrier(mech: Mechanism, j: int) -> str:
+    """The body whose pose carries joint ``j``'s point: the body before a revolute joint, the sliding body (after)
+    for a prismatic one."""
+    before, after = mech.joint_bodies[j]
+    return after if mech.joint_types[j] == "P" else before
+
+
 def poses_along(mech: Mechanism, angles: ArrayLike) -> dict[str, Array]:
-    """``{body: (N, 4, 4)}`` the world pose of every body at each row of joint values ``angles (N, n)``."""
-    rows = np.atleast_2d(np.asarray(angles, dtype=float))
-    out = {name: np.empty((len(rows), 4, 4)) for name in mech.bodies}
-    for i, row in enumerate(rows):
-        for name, pose in body_poses(mech, angles=row).items():
-            out[name][i] = pose
-    return out
+    """``{body: (N, 4, 4)}`` the world pose of every body at each row of joint values ``angles (N, n)``: what
+    :func:`linkwork.kinematics.closure.body_poses` gives row by row (the same spanning tree from the ground or the
+    first body), for all rows at once."""
+    q = mech.q_from_angles(np.atleast_2d(np.asarray(angles, dtype=float)))
+    if not mech.bodies:
+        return {}
+    root = "ground" if "ground" in mech.bodies else mech.bodies[0]
+    adjacency: dict[str, list[tuple[int, str, int]]] = {b: [] for b in mech.bodies}
+    for j, (a, b) in enumerate(mech.joint_bodies):
+        adjacency[a].append((j, b, 1))
+        adjacency[b].append((j, a, -1))
+    poses = {root: np.broadcast_to(np.eye(4), (len(q), 4, 4)).copy()}
+    queue = deque([root])
+    while queue:
+        body = queue.popleft()
+        for j, other, sign in adjacency[body]:
+            if other not in poses:
+                poses[other] = poses[body] @ exp_se3(sign * mech.twists[j] * q[:, j, None])
+                queue.append(other)
+    return poses
 
 
 def joint_positions(mech: Mechanism, angles: ArrayLike, poses: dict[str, Array] | None = None) -> Array:
@@ -94,7 +115,7 @@ def joint_positions(mech: Mechanism, angles: ArrayLike, poses: dict[str, Array] 
     poses = poses_along(mech, rows) if poses is None else poses
     ref = joint_points(mech)
     out = np.empty((len(rows), mech.n_joints, 3))
-    for j, (before, _after) in enumerate(mech.joint_bodies):
-        T = poses[before]
+    for j in range(mech.n_joints):
+        T = poses[carrier(mech, j)]
         out[:, j] = T[:, :3, :3] @ ref[j] + T[:, :3, 3]
     return out

@@ -1,15 +1,16 @@
-"""The files of a traced linkage (path.csv, report.json, figures, sequence, animation, viewer) and its printed
+"""The files of a traced linkage (path.csv, report.json, points.csv, mechanism.toml, figures, sequence, animation, viewer) and its printed
 summary."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 
 if TYPE_CHECKING:
     from linkwork.kinematics.chains import Assembly
+    from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Trace
 
 
@@ -25,12 +26,14 @@ def write_trace_outputs(
     first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
     (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
     ``viewer.html`` into ``out``, all or nothing. Returns the figures, animation and viewer written."""
-    from linkwork.io.results import write_path_csv, write_report_json
+    from linkwork.io.results import write_path_csv, write_points_csv, write_report_json
 
     figures: list[Path] = []
     with staged_output(out) as stage:
         write_path_csv(path, stage / "path.csv")
         write_report_json(path, stage / "report.json", assembly)
+        write_points_csv(path, stage / "points.csv")
+        write_trace_mechanism(path.mechanism, stage)
         if plots:
             if have_matplotlib():
                 from linkwork.viz.snapshots import deployment_sequence
@@ -50,6 +53,31 @@ def write_trace_outputs(
 
             figures.append(write_trace_viewer(path, stage / "viewer.html"))
     return [Path(out) / f.name for f in figures]
+
+
+def write_trace_mechanism(mech: Mechanism, folder: Path) -> None:
+    """Write what rebuilds the traced mechanism next to its path: ``mechanism.toml`` (a spec file, read back by
+    ``linkwork trace`` and ``linkwork export``) and ``drawing.json`` (the constructor's parameters, which choose
+    how its solids are drawn: Hedgepeth's and Guest's rods)."""
+    import json
+
+    from linkwork.io.spec import dump_spec
+
+    (folder / "mechanism.toml").write_text(dump_spec(mech))
+    (folder / "drawing.json").write_text(json.dumps(_plain(dict(mech.meta)), indent=1) + "\n")
+
+
+def _plain(value: Any) -> Any:
+    """``value`` with numpy scalars and arrays turned into JSON numbers and lists."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
 
 
 def print_trace_summary(path: Trace) -> None:

@@ -78,6 +78,9 @@ class Problem:
         A name per profile (file stem by default).
     source
         The problem file this came from, if any (for messages and relative paths).
+    units
+        The length unit of the profile files (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``, ``"um"``), carried
+        into the DXF (``$INSUNITS``) and SVG (width and height) drawings; ``None``: unitless.
     """
 
     profiles: tuple[NDArray[np.float64], ...]
@@ -96,6 +99,7 @@ class Problem:
     rank_by: RankBy = "error"
     e_max_tolerance: float | None = None
     initial_segment_matrix: NDArray[np.int64] | None = None
+    units: str | None = None
 
     def __post_init__(self) -> None:
         """Check every rule of a problem; a broken one is a :class:`SpecError` naming the problem file's key
@@ -171,6 +175,10 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
 
 def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
     """``merge_on``, ``rank_by`` with its ``e_max_tolerance``, and an initial segment matrix's design."""
+    from linkwork.io.profiles import LENGTH_UNITS
+
+    if p.units is not None and (not isinstance(p.units, str) or p.units not in LENGTH_UNITS):
+        return [("units", f"expected one of {', '.join(LENGTH_UNITS)}, got {show(p.units)}")]
     if p.merge_on not in ("targets", "chain"):
         return [("merge_on", f'expected one of "targets", "chain", got {show(p.merge_on)}')]
     if p.rank_by not in ("error", "joints"):

@@ -393,6 +393,7 @@ class SynthesisResult:
             "kind": self.problem.kind,
             "piece_length": float(self.problem.piece_length),
             "min_pieces": int(self.problem.min_pieces),
+            "units": self.problem.units,
             "profiles": [
                 {
                     "name": t.name,

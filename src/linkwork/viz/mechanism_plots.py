@@ -105,6 +105,8 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
     """One panel per profile: the mechanism in that profile's configuration over the target profile."""
     from matplotlib.figure import Figure
 
+    from linkwork.viz.labels import number
+
     design, check = found.design, found.verification
     mech = design.mechanism()
     p = len(check.states)
@@ -116,17 +118,20 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
     revolute = mech.joint_types[mech.index(design.drive)] == "R"
     for j, (ax, state) in enumerate(zip(axes, check.states, strict=True)):
         _draw(ax, found, mech, state.values, j, target=True)
-        value = f"{math.degrees(state.drive_value):.2f} deg" if revolute else f"{state.drive_value:.4g}"
+        value = (
+            f"{number(math.degrees(state.drive_value), '.2f')} deg" if revolute else number(state.drive_value)
+        )
         ax.set_title(
-            f"profile {j + 1}: {plain(str(design.drive))} = {value}\nE_max = {state.e_max:.3g}", fontsize=9
+            f"profile {j + 1}: {plain(str(design.drive))} = {value}\nE_max = {state.e_max:.3g} (profile unit)",
+            fontsize=9,
         )
         ax.set_aspect("equal")
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
-        ax.set_xlabel("x")
+        ax.set_xlabel("x (profile unit)")
         ax.tick_params(labelsize=7)
         if j == 0:
-            ax.set_ylabel("y")
+            ax.set_ylabel("y (profile unit)")
             ax.legend(fontsize=7, loc="best")
     fig.suptitle(f"{plain(design.name)}: DOF {check.dof}, drive {plain(str(design.drive))}", fontsize=10)
     return fig

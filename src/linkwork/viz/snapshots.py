@@ -189,9 +189,11 @@ def drive_label(path: Trace, i: int, joint: int | None = None) -> str:
     d = label_joint(path, int(path.branch[i])) if joint is None else joint
     name = mech.joint_names[d]
     value = path.angles[i, d]
+    from linkwork.viz.labels import number
+
     if mech.joint_types[d] == "P":
-        return f"{plain(name)} = {value:.3g}"
-    return f"{subscript(chr(92) + 'theta', name)} = {np.degrees(value):.1f}°"
+        return f"{plain(name)} = {number(value, '.3g')}"
+    return f"{subscript(chr(92) + 'theta', name)} = {number(np.degrees(value), '.1f')}°"
 
 
 def deployment_sequence(

@@ -62,8 +62,16 @@ def _extent(arrays: Sequence[Array]) -> tuple[float, float]:
     return float(width), float(height)
 
 
-def _figure(panels: int, extent: tuple[float, float], *, width: float = 8.0) -> tuple[Figure, list[Axes]]:
-    """A figure of ``panels`` equal-aspect axes, stacked when the drawing is wide, side by side when tall."""
+def length_unit(result: SynthesisResult) -> str:
+    """The profiles' length unit for labels: the problem's ``units``, else "profile unit"."""
+    return result.problem.units or "profile unit"
+
+
+def _figure(
+    panels: int, extent: tuple[float, float], *, width: float = 8.0, unit: str = "profile unit"
+) -> tuple[Figure, list[Axes]]:
+    """A figure of ``panels`` equal-aspect axes, stacked when the drawing is wide, side by side when tall, its
+    axes labelled in ``unit``."""
     from matplotlib.figure import Figure
 
     aspect = extent[1] / extent[0] if extent[0] > 0 else 1.0
@@ -76,8 +84,8 @@ def _figure(panels: int, extent: tuple[float, float], *, width: float = 8.0) -> 
     axes = figure.subplots(rows, cols, squeeze=False).ravel().tolist()
     for ax in axes:
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
+        ax.set_xlabel(f"x ({unit})")
+        ax.set_ylabel(f"y ({unit})")
         ax.grid(True, linewidth=0.3, alpha=0.5)
     return figure, axes
 
@@ -122,7 +130,7 @@ def _draw_targets(ax: Axes, result: SynthesisResult, *, label: bool = True) -> N
 
 def plot_profiles(result: SynthesisResult) -> Figure:
     """Design profiles (solid), target profiles (dots) and segmentation points (black) (paper's Fig. 3)."""
-    figure, (ax,) = _figure(1, _extent(result.problem.profiles))
+    figure, (ax,) = _figure(1, _extent(result.problem.profiles), unit=length_unit(result))
     for j, (design, target) in enumerate(zip(result.problem.profiles, result.targets, strict=True)):
         ax.plot(
             *design.T,
@@ -149,7 +157,9 @@ def plot_profiles(result: SynthesisResult) -> Figure:
             )
     for target in result.targets:
         ax.plot(*target.points[-1], "o", color="black", markersize=4)
-    ax.set_title(f"Design and target profiles (desired piece length {result.problem.piece_length:g})")
+    figure.suptitle(
+        f"Design and target profiles (desired piece length {result.problem.piece_length:g} {length_unit(result)})"
+    )
     _legend(ax, ncols=2)
     return figure
 
@@ -171,7 +181,7 @@ def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
     pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
     moved = [pieces[0]] + [register(piece, pieces[0]).apply(piece) for piece in pieces[1:]]
     mean = np.mean(moved, axis=0)
-    figure, axes = _figure(4, _extent(pieces + list(segment.instances)))
+    figure, axes = _figure(4, _extent(pieces + list(segment.instances)), unit=length_unit(result))
     panels = (
         "(a) pieces on the target profiles",
         "(b) registered onto profile 1",
@@ -211,7 +221,7 @@ def plot_arc_segment(result: SynthesisResult, index: int) -> Figure:
     if segment.kind != "C":
         raise ValueError(f"Expected a C-segment, segment {index + 1} is a {segment.kind}-segment")
     pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
-    figure, axes = _figure(2, _extent(pieces + list(segment.instances)))
+    figure, axes = _figure(2, _extent(pieces + list(segment.instances)), unit=length_unit(result))
     lengths = segment.lengths
     for j, piece in enumerate(pieces):
         axes[0].plot(
@@ -243,7 +253,7 @@ def plot_arc_segment(result: SynthesisResult, index: int) -> Figure:
 def plot_chain(result: SynthesisResult) -> Figure:
     """The chain on every profile before and after joining (paper's Fig. 8): segments where each fits best,
     then moved to unite their end points at revolute joints."""
-    figure, axes = _figure(2, _extent([t.points for t in result.targets]))
+    figure, axes = _figure(2, _extent([t.points for t in result.targets]), unit=length_unit(result))
     _draw_targets(axes[0], result)
     _draw_targets(axes[1], result, label=False)
     for e, segment in enumerate(result.segments):
@@ -259,10 +269,12 @@ def plot_chain(result: SynthesisResult) -> Figure:
     for j, chain in enumerate(result.joined):
         _draw_chain(axes[1], chain, _colour(j), f"chain on {_name(result, j)}")
     axes[0].set_title(
-        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g}", fontsize="medium"
+        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g} {length_unit(result)}",
+        fontsize="medium",
     )
     axes[1].set_title(
-        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g}", fontsize="medium"
+        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g} {length_unit(result)}",
+        fontsize="medium",
     )
     for ax in axes:
         _legend(ax)
@@ -281,7 +293,7 @@ def plot_compound(result: SynthesisResult) -> Figure:
     compound = result.compound
     if compound is None:
         raise ValueError("Expected a result with a compound stage (merge_below > 0), got compound = None")
-    figure, axes = _figure(2, _extent([t.points for t in result.targets]))
+    figure, axes = _figure(2, _extent([t.points for t in result.targets]), unit=length_unit(result))
     merged_per_panel: tuple[tuple[int, ...], ...] = ((), compound.merged)
     for ax, chains, fused in zip(axes, (result.joined, compound.profiles), merged_per_panel, strict=True):
         _draw_targets(ax, result, label=ax is axes[0])
@@ -301,12 +313,13 @@ def plot_compound(result: SynthesisResult) -> Figure:
             weight="bold" if is_merged else "normal",
         )
     axes[0].set_title(
-        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g}", fontsize="medium"
+        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {length_unit(result)}",
+        fontsize="medium",
     )
     merged_list = ", ".join(str(i + 1) for i in compound.merged) or "none"
     axes[1].set_title(
         f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; "
-        f"E_max = {compound.e_max:.3g}",
+        f"E_max = {compound.e_max:.3g} {length_unit(result)}",
         fontsize="medium",
     )
     for ax in axes:

@@ -18,8 +18,30 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-def _unwrap_branch(path: Trace, mask: np.ndarray) -> np.ndarray:
-    return np.degrees(path.angles[mask])
+def branch_degrees(path: Trace, mask: np.ndarray) -> np.ndarray:
+    """Joint values of the points ``mask`` for plotting: revolute joints in degrees wrapped into [-180, 180)
+    (:func:`linkwork.geometry.angles.wrap`), prismatic joints as they are. Guest's 13 branches, which turn
+    hinges through whole revolutions, stay in one window."""
+    return display_degrees(path, path.angles[mask])
+
+
+def display_degrees(path: Trace, values: np.ndarray) -> np.ndarray:
+    """``values`` (radians, ``(..., n)``) with the revolute joints wrapped into [-180, 180) deg."""
+    from linkwork.geometry.angles import wrap
+
+    out = np.array(values, dtype=float)
+    revolute = np.array([t == "R" for t in path.mechanism.joint_types])
+    out[..., revolute] = np.degrees(wrap(out[..., revolute]))
+    return out
+
+
+def broken_at_wraps(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x``, ``y`` with a NaN put between points where either jumps by more than 180 (a wrap), so the plotted
+    line breaks there instead of crossing the figure."""
+    if len(x) < 2:
+        return x, y
+    jumps = np.flatnonzero((np.abs(np.diff(x)) > 180.0) | (np.abs(np.diff(y)) > 180.0)) + 1
+    return np.insert(x.astype(float), jumps, np.nan), np.insert(y.astype(float), jumps, np.nan)
 
 
 def _save(fig: Figure, file: Path) -> Path:
@@ -45,15 +67,13 @@ def angles_figure(path: Trace) -> Figure:
     colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     styles = ["-", "--", ":", "-."]
     for br in path.branches:
-        mask = path.of_branch(br.id)
-        deg = _unwrap_branch(path, mask)
+        deg = branch_degrees(path, path.of_branch(br.id))
         for j, name in enumerate(mech.joint_names):
             if j == d:
                 continue
             # One line style per joint, so that coincident curves (B = D = F) stay visible as dashes.
             ax.plot(
-                deg[:, d],
-                deg[:, j],
+                *broken_at_wraps(deg[:, d], deg[:, j]),
                 styles[j % len(styles)],
                 color=colors[j % len(colors)],
                 lw=2.2 - 0.3 * (j % len(styles)) if br.id == 0 else 0.8,
@@ -61,10 +81,10 @@ def angles_figure(path: Trace) -> Figure:
                 label=f"θ{plain(name)}" if br.id == 0 else None,
             )
     for b in path.bifurcations:
-        a = np.degrees(b.angles)
+        a = display_degrees(path, b.angles)
         ax.plot(np.full(len(a) - 1, a[d]), np.delete(a, d), "ko", ms=4)
-    ax.set_xlabel(f"θ{plain(str(path.drive))} (deg)")
-    ax.set_ylabel("hinge angle (deg)")
+    ax.set_xlabel(f"θ{plain(str(path.drive))} (deg, wrapped to [-180, 180))")
+    ax.set_ylabel("hinge angle (deg, wrapped to [-180, 180))")
     title = f"{plain(mech.name)}: hinge angles"
     if len(path.branches) > 1:
         title += f" ({len(path.branches)} branches, {len(path.bifurcations)} bifurcation points ●)"
@@ -83,10 +103,12 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
     """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
     from matplotlib.figure import Figure
 
+    from linkwork.viz.labels import number
+
     mech = path.mechanism
     d = mech.index(path.drive)
     mask = path.of_branch(branch)
-    x = np.degrees(path.angles[mask, d])
+    x = branch_degrees(path, mask)[:, d]
     s = path.sigma[mask]
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     axes = fig.subplots(1, 2)
@@ -100,10 +122,13 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
     axes[0].set_ylim(0, None)
     for i in range(s.shape[1]):
         axes[1].semilogy(steps, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
-    axes[1].set_xlabel(f"step (θ{plain(str(path.drive))} from {x[0]:.4g}° to {x[-1]:.4g}°)")
+    unit = "°" if mech.joint_types[d] == "R" else ""
+    span = float(np.ptp(x)) if len(x) else 1.0
+    low, high = (number(v, scale=max(span, 1.0)) for v in (x[0], x[-1]))
+    axes[1].set_xlabel(f"step (θ{plain(str(path.drive))} from {low}{unit} to {high}{unit})")
     axes[1].set_ylim(1e-17, None)
     for ax in axes:
-        ax.set_ylabel("singular value")
+        ax.set_ylabel("singular value (1 and length per rad)")
         ax.grid(alpha=0.3, which="both")
     for b in path.bifurcations:
         if b.branch == branch:
@@ -114,7 +139,58 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
     return fig
 
 
+def plot_points(path: Trace, file: Path) -> Path:
+    """Paths of the named points (a four-bar's coupler curve) and of the joints in the plane, and the transmission
+    angle against the drive angle when the mechanism declares one."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from linkwork.kinematics.points import named_points, positions, transmission_angles
+
+    mech = path.mechanism
+    joints, named = positions(mech, path.angles)
+    mu = transmission_angles(mech, joints)
+    fig, axes = plt.subplots(
+        1, 2 if mu is not None else 1, figsize=(10.0, 4.4), layout="constrained", squeeze=False
+    )
+    ax = axes[0, 0]
+    for j, name in enumerate(mech.joint_names):
+        ax.plot(joints[:, j, 0], joints[:, j, 1], lw=0.8, color="0.6")
+        ax.annotate(name, joints[0, j, :2], fontsize=8)
+    for k, point in enumerate(named_points(mech)):
+        ax.plot(named[:, k, 0], named[:, k, 1], lw=1.6, label=f"{point['name']} (on {point['body']})")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (length unit of the mechanism)")
+    ax.set_ylabel("y (length unit of the mechanism)")
+    ax.set_title("paths of the joints (grey) and named points", fontsize=10)
+    if named.shape[1]:
+        ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    if mu is not None:
+        d = mech.index(path.drive)
+        for br in path.branches:
+            mask = path.of_branch(br.id)
+            axes[0, 1].plot(np.degrees(path.angles[mask, d]), np.degrees(mu[mask]), lw=1.4)
+        axes[0, 1].axhline(40.0, color="k", lw=0.8, ls="--", label="40 deg, a common lower limit")
+        axes[0, 1].set_xlabel(f"θ{path.drive} (deg)")
+        axes[0, 1].set_ylabel("transmission angle (deg)")
+        axes[0, 1].set_title("transmission angle", fontsize=10)
+        axes[0, 1].legend(fontsize=8)
+        axes[0, 1].grid(alpha=0.3)
+    fig.suptitle(f"{mech.name}: positions", fontsize=10)
+    fig.savefig(file, dpi=120)
+    fig.savefig(Path(file).with_suffix(".svg"))
+    plt.close(fig)
+    return Path(file)
+
+
 def write_trace_figures(path: Trace, out: Path) -> list[Path]:
-    """All trace figures into folder ``out``; returns the PNG paths."""
+    """All trace figures into folder ``out``; returns the PNG paths (``points.png`` for a planar mechanism or one
+    with named points)."""
     out = Path(out)
-    return [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]
+    figures = [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]
+    if path.mechanism.planar or path.mechanism.meta.get("points"):
+        figures.append(plot_points(path, out / "points.png"))
+    return figures

@@ -217,10 +217,14 @@ def _steady_rows(path: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[np
     """``(N, 12)`` per point sent to the page, the rigid motion of the whole mechanism that keeps the drawing
     steady (rotation rows, then translation): each branch fitted point by point
     (:func:`linkwork.viz.snapshots.follow`), a branch leaving a bifurcation point starting from the pose its
-    parent has there, and everything levelled by the flattest configuration of the first branch."""
+    parent has there, and everything levelled by the flattest configuration of the first branch. A grounded
+    mechanism (a body called ``ground``) is held by its ground: no motion at all."""
     from linkwork.viz.snapshots import follow, leveling, mesh_clouds
 
     mech = path.mechanism
+    if "ground" in mech.bodies:
+        count = sum(len(idx) for idx in per_branch)
+        return np.tile(np.array([1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0, 0, 0, 0]), (count, 1))
     revolute = np.array([t == "R" for t in mech.joint_types])
     index = {br.id: bi for bi, br in enumerate(path.branches)}
     done: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}  # branch index -> (clouds, moves)
