@@ -169,7 +169,7 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     reader = _Reader(source)
     reader.check_keys(table, "", TOP_KEYS)
     name = reader.string(table, "name", "", default=path.stem, limit=MAX_NAME_CHARS)
-    if re.search(r"[\x00-\x1f\x7f\u2028\u2029]", name):
+    if re.search(r"[\x00-\x08\x0a-\x1f\x7f\u2028\u2029]", name):  # a tab is fine (and valid XML)
         raise reader.error(
             "name", f"expected a name without line breaks or control characters, got {_show(name)}"
         )
