@@ -1,4 +1,4 @@
-"""Generate linkwork's four shape-change synthesis example sets, reproducibly, from closed-form curves.
+"""Generate linkwork's five shape-change synthesis example sets, reproducibly, from closed-form curves.
 
 Run from anywhere: ``python examples/make_examples.py``. Every set is written twice, to
 ``examples/<name>/`` (to read and edit) and to ``src/linkwork/data/examples/<name>/`` (bundled with the
@@ -18,6 +18,8 @@ profile files it names.
 * ``seat``: a driver's seat in the spirit of Shamsudin et al. (2013) Sec. 8.2: cushion and back rest for a
   small, an average and a large driver, built from straight runs and circular arcs with the paper's arc
   lengths 44.42, 51.98 and 54.39 (about 127, 149 and 155 pieces at ``s_d = 0.35``), as CSV.
+* ``wing-six``: six profiles end to end, NACA 1412 -> 2412 -> ... -> 6412 with the chord growing 1 -> 1.3 in
+  equal steps, as Selig ``.dat`` files (its ``mechanize.toml`` mechanizes it to one DOF).
 """
 
 from __future__ import annotations
@@ -153,6 +155,28 @@ def wing(folder: Path) -> dict[str, float]:
         min_pieces=4,
         design="auto",
         segments=5,
+        starts=4,
+        merge_below=0.0,
+    )
+    return lengths
+
+
+def wing_six(folder: Path) -> dict[str, float]:
+    """Six profiles end to end: NACA 1412 -> 6412 with the chord growing 1 -> 1.3 in equal steps (Selig files)."""
+    sections = [(f"camber{k}", f"{k}412", 1.0 + 0.06 * (k - 1)) for k in range(1, 7)]
+    lengths = {}
+    for name, code, chord in sections:
+        outline = naca4_outline(code, chord)
+        write_profile_dat(folder / f"{name}.dat", outline, name=f"NACA {code} chord {chord:g} ({name})")
+        lengths[name] = arc_length(outline)
+    _problem(
+        folder,
+        description="Six-profile morphing wing: NACA 1412 -> 6412, chord 1 -> 1.3 (full outline, open profile)",
+        kind="open",
+        profiles=[f"{name}.dat" for name, _, _ in sections],
+        piece_length=0.02,
+        min_pieces=4,
+        design="MCMC",
         starts=4,
         merge_below=0.0,
     )
@@ -326,13 +350,26 @@ seed = 1
     (folder / "problem.toml").write_text(text, encoding="utf-8")
 
 
-SETS = {"wing": wing, "closed": closed, "fixed-end": fixed_end, "seat": seat}
+SETS = {"wing": wing, "closed": closed, "fixed-end": fixed_end, "seat": seat, "wing-six": wing_six}
 
 # Sets that also get a ``mechanize.toml`` (the problem with ``mechanize = true``), and the design they fix if any:
 # the wing's best 5-segment design CCCMC has 9 bodies and no dyad set passes; MCMC mechanizes in under a second.
 MECHANIZE = {
     "wing": 'design = "MCMC"           # the best 5-segment design CCCMC has 9 bodies; MCMC mechanizes in under a second',
     "seat": None,
+    "wing-six": None,
+}
+
+# Mechanization keys added to ``mechanize.toml`` (after ``mechanize = true``): six profiles need least-squares
+# dyads, and the trailing edge (whose arc slide lengthens the chord) is guided by a dyad to another body.
+MECHANIZE_KEYS = {
+    "seat": [
+        'binary_links = "prismatic"   # sliders on the frame and between segments; a slider drives (paper, Fig. 14)'
+    ],
+    "wing-six": [
+        'anchors = "any"          # dyads between bodies too (the trailing edge moves 0.3 chords)',
+        "attempts = 3             # designs traced per root: the first passing ones are ranked",
+    ],
 }
 
 
@@ -353,6 +390,7 @@ def write_mechanize(folder: Path, name: str, design_line: str | None) -> None:
         body.append(line)
         if line.startswith("seed = "):
             body.append("mechanize = true")
+            body += MECHANIZE_KEYS.get(name, [])
     (folder / "mechanize.toml").write_text("\n".join(header + body) + "\n", encoding="utf-8")
 
 

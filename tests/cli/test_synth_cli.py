@@ -146,7 +146,9 @@ def test_writes_every_contract_file_with_the_contract_keys(problem: Path, tmp_pa
         "target_profiles.csv",
         "outline.svg",
         "outline.dxf",
+        "problem",  # a copy of the problem and its profiles, for `linkwork mechanize OUT`
     }
+    assert (out / "problem" / "problem.toml").read_bytes() == problem.read_bytes()
 
     chain = json.loads((out / "chain.json").read_text(encoding="utf-8"))
     for key in (

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+
+SEAT = Path(__file__).resolve().parents[2] / "examples" / "seat" / "mechanize.toml"
 
 GROUND_A = np.array([0.0, 0.0])
 GROUND_D = np.array([4.0, 0.0])
@@ -31,3 +35,17 @@ def coupler_pose(
 def four_bar_poses() -> np.ndarray:
     """Five coupler poses of the four-bar A(0,0)-B-C-D(4,0) at crank angles 40..110 degrees."""
     return np.array([coupler_pose(p) for p in np.radians([40.0, 55.0, 70.0, 90.0, 110.0])])
+
+
+@pytest.fixture(scope="session")
+def seat_mechanized(tmp_path_factory: pytest.TempPathFactory) -> tuple[object, object, Path]:
+    """The bundled seat synthesised and mechanized with its problem file's options, written to a folder."""
+    from linkwork.io.problem import load_problem
+    from linkwork.mechanization import mechanize, write_mechanization
+    from linkwork.synthesis import synthesize
+
+    result = synthesize(load_problem(SEAT))
+    found = mechanize(result)
+    folder = tmp_path_factory.mktemp("seat")
+    write_mechanization(found, folder)
+    return result, found, folder

@@ -34,7 +34,7 @@ def _app() -> typer.Typer:
 
 def test_mechanize_command_writes_the_mechanism_and_report(tmp_path: Path) -> None:
     folder = _synth_folder(tmp_path)
-    run = CliRunner().invoke(_app(), [str(folder), "--no-plots"])
+    run = CliRunner().invoke(_app(), [str(folder), "--no-plots", "--designs", "1"])
     assert run.exit_code == 0, run.output
     report = json.loads((folder / "mechanization.json").read_text())
     chain = json.loads((folder / "chain.json").read_text())

@@ -471,3 +471,28 @@ def test_demo_index_shows_every_result_and_its_hexagon_opens_flat(browser: Brows
     browser.events[:mark] = []
     assert browser.errors() == []
     assert_offline(browser)
+
+
+def test_mechanism_viewer_opens_fixed_with_the_target_profiles(browser: Browser, tmp_path: Path) -> None:
+    from linkwork.io.problem import load_problem
+    from linkwork.mechanization import MechanizeOptions, mechanize
+    from linkwork.viz.mechanism_viewer import write_mechanism_viewer
+
+    wing = Path(__file__).resolve().parents[2] / "examples" / "wing" / "mechanize.toml"
+    found = mechanize(lw.synthesize(load_problem(wing)), MechanizeOptions(designs=1))
+    page = write_mechanism_viewer(found, tmp_path / "mechanism.html")
+    browser.open(page)
+    assert browser.js("document.getElementById('centred').checked") is False  # ground fixed, profiles still
+    fixed, ink = canvas(browser)
+    assert ink > 0.01
+    browser.screenshot(tmp_path / "wing-mechanism.png")
+    browser.js("document.getElementById('centred').click()")  # the steady view moves: no profiles drawn there
+    assert browser.js("document.getElementById('centred').checked") is True
+    for _ in range(50):  # the page redraws on its next animation frame
+        steady, _ = canvas(browser)
+        if steady != fixed:
+            break
+        time.sleep(0.1)
+    assert steady != fixed
+    assert browser.errors() == []
+    assert_offline(browser)

@@ -1,44 +1,25 @@
 """``linkwork mechanize DIR``: add binary links to a synthesised chain, verify by tracing, write the mechanism.
 
 A thin layer over :func:`linkwork.mechanization.mechanize`. ``DIR`` is a ``linkwork synth`` output folder: its
-``chain.json`` and the problem it came from (``DIR/problem/problem.toml``, as ``linkwork demo`` writes it, or
+``chain.json`` and the problem it came from (``DIR/problem/problem.toml``, which ``linkwork synth`` writes, or
 ``--problem``). The synthesis is run again from the problem (it is seeded, so it is the same) and checked
-against ``chain.json`` before mechanizing. :func:`mechanize_into` is what ``linkwork synth`` calls for a problem
-with ``mechanize = true``.
+against ``chain.json`` before mechanizing. The problem file's mechanization keys are the defaults; the flags
+override them.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from linkwork.cli import mechanize_flags as mf
 from linkwork.cli.common import check_range, friendly_errors
-from linkwork.errors import SpecError
-from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console, staged_output
 
-
-def _region(text: str | None) -> tuple[float, float, float, float] | None:
-    if text is None:
-        return None
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if (
-        len(values) != 4
-        or not all(math.isfinite(v) for v in values)
-        or values[0] >= values[2]
-        or values[1] >= values[3]
-    ):
-        raise SpecError(
-            f"--ground-region {show(text)}: expected XMIN,YMIN,XMAX,YMAX (finite numbers) with XMIN < XMAX and "
-            "YMIN < YMAX"
-        )
-    return values
+MAX_DOF = 20
+"""The most degrees of freedom ``--dof`` may ask for (each one more actuator and a search over more dyads)."""
 
 
 @friendly_errors
@@ -52,48 +33,64 @@ def mechanize(
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="Folder to write into (default: DIR).")
     ] = None,
-    dof: Annotated[int, typer.Option(help="Degrees of freedom (number of actuators).")] = 1,
-    drive: Annotated[str | None, typer.Option(help="The driven joint (default: chosen).")] = None,
-    root: Annotated[
-        str | None, typer.Option(help="The chain body guided first (default: tried in turn).")
-    ] = None,
-    anchors: Annotated[
-        str, typer.Option(help="Dyads to 'ground', between links too ('any'), or 'auto'.")
-    ] = "auto",
-    actuator: Annotated[
-        str, typer.Option(help="'revolute' (a crank) or 'prismatic' (a linear actuator).")
-    ] = "revolute",
-    ground_region: Annotated[
-        str | None, typer.Option(help="Fixed pivots only in XMIN,YMIN,XMAX,YMAX (profile units).")
-    ] = None,
-    min_transmission: Annotated[float, typer.Option(help="Smallest transmission angle (degrees).")] = 15.0,
+    dof: mf.Dof = None,
+    drive: mf.Drive = None,
+    root: mf.Root = None,
+    anchors: mf.Anchors = None,
+    actuator: mf.Actuator = None,
+    binary_links: mf.BinaryLinks = None,
+    ground_region: mf.GroundRegion = None,
+    link_offset: mf.LinkOffset = None,
+    max_link: mf.MaxLink = None,
+    min_transmission: mf.MinTransmission = None,
+    attempts: mf.Attempts = None,
+    designs: mf.Designs = None,
+    time_limit: mf.TimeLimit = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Do not draw the figures and animation.")
     ] = False,
+    html: Annotated[
+        bool,
+        typer.Option("--html", help="Also write mechanism.html: the mechanism over the target profiles."),
+    ] = False,
 ) -> None:
-    """Add binary links (RR dyads, a linear actuator) to a synthesised chain until it has DOF degrees of freedom,
+    """Add binary links (RR dyads, linear actuators) to a synthesised chain until it has DOF degrees of freedom,
     verify that it moves through every profile in order without circuit, branch or order defects, and write
     mechanism.toml (for `linkwork trace`), mechanization.json, figures and an animation."""
-    from linkwork.mechanization import MechanizeOptions
+    from linkwork.mechanization.options import options_from_values
+    from linkwork.outputs.mechanization import (
+        mechanize_into,
+        print_mechanization,
+        progress_bar,
+        resolve_options,
+    )
+    from linkwork.outputs.synthesis import load_synthesis
 
-    check_output_folder(out or folder)
-    check_range("--dof", dof, 1, 20, "a whole number of degrees of freedom")
-    check_range("--min-transmission", min_transmission, 0.0, 90.0, "an angle in degrees", open_low=False)
-    options = MechanizeOptions(
+    flags = mf.flag_values(
         dof=dof,
         drive=drive,
         root=root,
         anchors=anchors,
         actuator=actuator,
-        ground_region=_region(ground_region),
-        min_transmission=math.radians(min_transmission),
+        binary_links=binary_links,
+        ground_region=ground_region,
+        link_offset=link_offset,
+        max_link=max_link,
+        min_transmission=min_transmission,
+        attempts=attempts,
+        designs=designs,
+        time_limit=time_limit,
     )
-    from linkwork.outputs.mechanization import mechanize_into, print_mechanization
-    from linkwork.outputs.synthesis import load_synthesis
-
+    check_output_folder(out or folder)
+    if dof is not None:
+        check_range("--dof", dof, 1, MAX_DOF, "a whole number of degrees of freedom")
+    options_from_values(flags, source="command line")  # a bad flag is found before the synthesis runs again
     result = load_synthesis(folder, problem)
+    options = resolve_options(result.problem, flags)
     target = out or folder
-    with staged_output(target) as stage:
-        found, written = mechanize_into(result, stage, options=options, plots=not no_plots)
+    with staged_output(target) as stage, progress_bar() as progress:
+        found, written = mechanize_into(
+            result, stage, options=options, plots=not no_plots, progress=progress, html=html
+        )
     print_mechanization(found)
     console.print(f"wrote {len(written)} files to {target}/: " + ", ".join(p.name for p in written))

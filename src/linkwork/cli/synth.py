@@ -13,6 +13,7 @@ from typing import Annotated
 
 import typer
 
+from linkwork.cli import mechanize_flags as mf
 from linkwork.cli.common import friendly_errors
 from linkwork.errors import SpecError
 from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
@@ -38,6 +39,27 @@ def synth(
             "at a time while the error matrix improves (never worse than 'paper').",
         ),
     ] = "paper",
+    mechanize: Annotated[
+        bool | None,
+        typer.Option(
+            "--mechanize/--no-mechanize",
+            rich_help_panel=mf.PANEL,
+            help="Also mechanize the chain (default: the problem's `mechanize` key, or any mechanization flag).",
+        ),
+    ] = None,
+    dof: mf.Dof = None,
+    drive: mf.Drive = None,
+    root: mf.Root = None,
+    anchors: mf.Anchors = None,
+    actuator: mf.Actuator = None,
+    binary_links: mf.BinaryLinks = None,
+    ground_region: mf.GroundRegion = None,
+    link_offset: mf.LinkOffset = None,
+    max_link: mf.MaxLink = None,
+    min_transmission: mf.MinTransmission = None,
+    attempts: mf.Attempts = None,
+    designs: mf.Designs = None,
+    time_limit: mf.TimeLimit = None,
     exhaustive: Annotated[
         bool,
         typer.Option(
@@ -51,11 +73,15 @@ def synth(
 
     Writes chain.json, target_profiles.csv, outline.svg, outline.dxf and the figures (PNG and SVG) into --out,
     and prints a summary: the profiles, the design vector, the segment and error matrices, E_max and E_mean
-    before and after joining, and the joints merged into compound segments.
+    before and after joining, and the joints merged into compound segments. A copy of the problem and its
+    profiles goes to --out/problem/ (for `linkwork mechanize OUT`). With mechanization (the problem's
+    `mechanize = true`, --mechanize or any mechanization flag) the chain's files are written first; if no
+    mechanism passes they stay and the command exits with code 3 naming the closest design.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from linkwork.io.problem import load_problem
+    from linkwork.outputs.problem_copy import copy_problem
     from linkwork.outputs.synthesis import print_synthesis_summary, write_synthesis_outputs
     from linkwork.synthesis import synthesize
 
@@ -64,7 +90,27 @@ def synth(
         raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")
     from linkwork.data import problem_file
 
-    spec = load_problem(problem_file(problem))
+    problem = problem_file(problem)
+    spec = load_problem(problem)
+    from linkwork.outputs.mechanization import resolve_options
+
+    flags = mf.flag_values(
+        dof=dof,
+        drive=drive,
+        root=root,
+        anchors=anchors,
+        actuator=actuator,
+        binary_links=binary_links,
+        ground_region=ground_region,
+        link_offset=link_offset,
+        max_link=max_link,
+        min_transmission=min_transmission,
+        attempts=attempts,
+        designs=designs,
+        time_limit=time_limit,
+    )
+    options = resolve_options(spec, flags)  # a bad flag or key stops here, before the synthesis
+    mechanizing = (spec.mechanize or bool(flags)) if mechanize is None else mechanize
     with Progress(
         TextColumn("[bold]synthesising[/]"),
         BarColumn(),
@@ -84,21 +130,22 @@ def synth(
     if plots and not have_matplotlib():
         console.print("note: matplotlib is not installed (pip install 'linkwork[viz]'): no figures drawn")
         plots = False
-    found = None
     with staged_output(out) as stage:
         written = write_synthesis_outputs(result, stage, plots=plots)
+        written += copy_problem(problem, stage / "problem")
         if html:
             from linkwork.viz.viewer import write_synthesis_viewer
 
             written.append(write_synthesis_viewer(result, stage / "viewer.html"))
-        if spec.mechanize:
-            from linkwork.outputs.mechanization import mechanize_into
-
-            found, more = mechanize_into(result, stage, plots=plots)
-            written += more
     print_synthesis_summary(result)
-    if found is not None:
-        from linkwork.outputs.mechanization import print_mechanization
-
-        print_mechanization(found)
     console.print(f"wrote {len(written)} files to {out}/: " + ", ".join(path.name for path in written))
+    if mechanizing:
+        # the chain is on disk already: a mechanization that fails (exit 3) loses nothing of it
+        from linkwork.outputs.mechanization import mechanize_into, print_mechanization, progress_bar
+
+        with staged_output(out) as stage, progress_bar() as step:
+            found, more = mechanize_into(
+                result, stage, options=options, plots=plots, progress=step, html=html
+            )
+        print_mechanization(found)
+        console.print(f"wrote {len(more)} files to {out}/: " + ", ".join(path.name for path in more))

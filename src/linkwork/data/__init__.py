@@ -8,12 +8,12 @@ from pathlib import Path
 
 from linkwork.errors import SpecError
 
-EXAMPLES = ("wing", "closed", "fixed-end", "seat")
+EXAMPLES = ("wing", "closed", "fixed-end", "seat", "wing-six")
 """The example problems bundled with linkwork (``linkwork/data/examples/<name>/problem.toml``)."""
 
 
 def example(name: str = "wing", file: str = "problem.toml") -> Path:
-    """The problem file (``problem.toml``, or ``mechanize.toml`` for wing and seat) of a bundled example (one of
+    """The problem file (``problem.toml``, or ``mechanize.toml`` for wing, seat and wing-six) of a bundled example (one of
     :data:`EXAMPLES`).
 
     Raises

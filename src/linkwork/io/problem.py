@@ -19,7 +19,10 @@ Example
     merge_below = 5.0                   # degrees; 0 disables compound segments
     seed = 1
     names = ["cruise", "climb", "landing"]   # optional; file stems by default
-    mechanize = false                   # optional
+    mechanize = false                   # optional; the mechanization options (dof, drive, actuator,
+                                        # binary_links, ground_region, link_offset, max_link, min_transmission,
+                                        # anchors, attempts, designs, time_limit, root) are keys too:
+                                        # docs/mechanization.md
     merge_on = "targets"                # targets | chain: where merge_below's joint ranges are measured
     rank_by = "error"                   # error | joints (fewest joints with E_max <= e_max_tolerance)
     e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
@@ -37,6 +40,7 @@ import numpy as np
 
 from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
 from linkwork.io.toml_reader import TomlReader, escape_line, key_path, read_toml, show
+from linkwork.mechanization.options import OPTION_KEYS, options_from_values
 from linkwork.synthesis.problem import KINDS, Problem, ProfileKind
 
 __all__ = ["KEYS", "KINDS", "REQUIRED", "load_problem"]
@@ -55,6 +59,7 @@ KEYS = (
     "mechanize",
     "units",
     "description",
+    *OPTION_KEYS,
     "merge_on",
     "rank_by",
     "e_max_tolerance",
@@ -104,6 +109,9 @@ def _settings(reader: TomlReader, table: dict[str, Any]) -> dict[str, Any]:
     if units is not None and (not isinstance(units, str) or units not in LENGTH_UNITS):
         raise reader.error("units", f"expected one of {', '.join(LENGTH_UNITS)}, got {show(units)}")
     settings["units"] = units
+    options = {key: table[key] for key in OPTION_KEYS if key in table}
+    options_from_values(options, source=reader.source)  # checked here: a mistake is found before synthesis
+    settings["mechanize_options"] = options
     return settings
 
 

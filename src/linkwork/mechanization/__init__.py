@@ -12,14 +12,16 @@ from linkwork.mechanization.guidance import (
     fit_circle_point,
 )
 from linkwork.mechanization.mechanize import Mechanization, mechanize
+from linkwork.mechanization.options import GroundRegion, MechanizeOptions, options_from_values
 from linkwork.mechanization.report import mechanization_dict, write_mechanization
-from linkwork.mechanization.search import MechanizationError, MechanizeOptions
+from linkwork.mechanization.search import MechanizationError
 from linkwork.mechanization.verify import ProfileState, Verification, verify
 
 __all__ = [
     "BinaryLink",
     "Design",
     "Dyad",
+    "GroundRegion",
     "Mechanization",
     "MechanizationError",
     "MechanizeOptions",
@@ -34,6 +36,7 @@ __all__ = [
     "fit_circle_point",
     "mechanization_dict",
     "mechanize",
+    "options_from_values",
     "spec_text",
     "verify",
     "write_mechanization",

@@ -22,20 +22,20 @@ Array = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class BinaryLink:
-    """An RR dyad (binary link) or an RPR actuator added to the chain.
+    """An RR dyad (binary link), a PR slider on a guide, or an RPR actuator added to the chain.
 
     Attributes
     ----------
     name
         ``D1``, ``D2``, ... (dyads) or ``A1`` (prismatic actuator).
     kind
-        ``"RR"`` or ``"RPR"``.
+        ``"RR"``, ``"PR"`` (a slider on a straight guide of the anchor, pivoted to the body) or ``"RPR"``.
     anchor
         The body the fixed end is pivoted on (``"ground"`` or a chain body).
     body
         The chain body the moving end is pivoted on.
     centre
-        ``(2,)`` the anchor pivot (the centre point) on profile 1.
+        ``(2,)`` the anchor pivot (the centre point) on profile 1; for a slider, where it is on its guide then.
     circle
         ``(2,)`` the moving pivot (the circle point) on profile 1.
     structural_error
@@ -44,6 +44,8 @@ class BinaryLink:
         Smallest transmission angle over the profiles, radians (90 degrees is best).
     via
         The chain joint (or, for the root's four-bar, the other link) that with this link places the body.
+    direction
+        ``(2,)`` a slider's guide direction (unit, anchor frame on profile 1); ``None`` for the others.
     """
 
     name: str
@@ -55,24 +57,31 @@ class BinaryLink:
     structural_error: float = 0.0
     transmission: float = math.pi / 2
     via: str | None = None
+    direction: Array | None = None
 
     @property
     def length(self) -> float:
-        """Link length (RR) or the actuator's length on profile 1 (RPR)."""
+        """Link length (RR), the actuator's length on profile 1 (RPR), 0 for a slider (PR)."""
+        if self.kind == "PR":
+            return 0.0
         return float(np.linalg.norm(self.circle - self.centre))
 
     def to_dict(self) -> dict[str, object]:
-        """JSON-ready: lengths as given, angles in degrees."""
+        """JSON-ready: lengths as given, angles in degrees; ``ground_pivot`` is ``None`` when the anchor is a
+        moving body (``fixed_pivot`` is then the anchor pivot on profile 1)."""
         return {
             "name": self.name,
             "type": self.kind,
             "anchor": self.anchor,
             "body": self.body,
+            "ground_pivot": [float(v) for v in self.centre] if self.anchor == "ground" else None,
             "fixed_pivot": [float(v) for v in self.centre],
             "moving_pivot": [float(v) for v in self.circle],
             "length": self.length,
             "structural_error": float(self.structural_error),
             "transmission_deg": math.degrees(self.transmission),
+            "guide_direction": [float(v) for v in self.direction] if self.direction is not None else None,
+            "via": self.via,
             "joints": self.joint_names(),
         }
 
@@ -80,6 +89,8 @@ class BinaryLink:
         """The link's joints, anchor side first."""
         if self.kind == "RR":
             return [f"{self.name}a", f"{self.name}m"]
+        if self.kind == "PR":
+            return [f"{self.name}s", f"{self.name}m"]
         return [f"{self.name}a", f"{self.name}s", f"{self.name}m"]
 
 
@@ -122,6 +133,12 @@ class Design:
             phi = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
             phi = phi - phi[0]
             c = link.centre
+            if link.kind == "PR":
+                assert link.direction is not None
+                travel = (m - m[0]) @ link.direction
+                slide = np.column_stack([np.outer(travel, link.direction), np.zeros(p)])
+                disp[link.name] = _compose(ga, slide)
+                continue
             if link.kind == "RR":
                 rot = np.array([[ga_pose(c, a)] for a in phi]).reshape(p, 3)
                 disp[f"{link.name}"] = _compose(ga, rot)
@@ -146,7 +163,27 @@ class Design:
             out.append(entry)
         for link in self.links:
             c, m = [float(v) for v in link.centre], [float(v) for v in link.circle]
-            if link.kind == "RR":
+            if link.kind == "PR":
+                assert link.direction is not None
+                out.append(
+                    {
+                        "name": f"{link.name}s",
+                        "type": "P",
+                        "bodies": [link.anchor, link.name],
+                        "point": c,
+                        "direction": [float(v) for v in link.direction],
+                    }
+                )
+                out.append(
+                    {
+                        "name": f"{link.name}m",
+                        "type": "R",
+                        "bodies": [link.name, link.body],
+                        "point": m,
+                        "direction": [0.0, 0.0, 1.0],
+                    }
+                )
+            elif link.kind == "RR":
                 out.append(
                     {
                         "name": f"{link.name}a",
@@ -248,7 +285,8 @@ def spec_text(design: Design) -> str:
         "# Bodies s<e> are M-segments; s<e>a / s<e>b are the first and last pieces of C-segment e, joined by the",
         "# arc slide S<e> (a revolute joint at the centre of the arc = a curved prismatic joint; prismatic when",
         "# the arc is straight). J<i> joins segments i and i + 1. D<k> are the added binary links (D<k>a the",
-        "# fixed pivot, D<k>m the moving pivot), A<k> prismatic actuators. The start is profile 1.",
+        "# fixed pivot, D<k>m the moving pivot; a slider D<k> has D<k>s on its guide), A<k> prismatic actuators.",
+        "# The start is profile 1.",
         f"# drive: {design.drive}  (see mechanization.json for its value on every profile)",
     ]
     return "\n".join(header) + "\n" + text

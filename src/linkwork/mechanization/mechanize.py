@@ -8,16 +8,18 @@ attempts run out.
 
 from __future__ import annotations
 
+import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
+from linkwork.mechanization.options import MechanizeOptions, ProgressCallback, options_from_values
+from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
-    MechanizeOptions,
     Plan,
     plan,
     prismatic_actuator,
@@ -28,13 +30,22 @@ from linkwork.synthesis.result import SynthesisResult
 
 
 @dataclass(frozen=True)
+class RankedDesign:
+    """A design that passed verification, and its quality factor (:mod:`linkwork.mechanization.quality`)."""
+
+    design: Design
+    verification: Verification
+    quality: Quality
+
+
+@dataclass(frozen=True)
 class Mechanization:
     """A verified mechanized design and how it was found.
 
     Attributes
     ----------
     design
-        The chain, its binary links and drive.
+        The chain, its binary links and drive: the passing design of highest quality factor.
     verification
         DOF, the state on every profile, the traced paths.
     attempts
@@ -43,6 +54,8 @@ class Mechanization:
         One line per rejected design: why.
     seconds
         Wall time.
+    ranked
+        Up to ``options.designs`` (5) passing designs, best quality factor first (``ranked[0]`` is ``design``).
     """
 
     design: Design
@@ -50,6 +63,43 @@ class Mechanization:
     attempts: int
     rejected: tuple[str, ...]
     seconds: float
+    ranked: tuple[RankedDesign, ...] = ()
+
+
+@dataclass
+class _Search:
+    """The state of one mechanization search: what passed, what came closest, how much was traced."""
+
+    options: MechanizeOptions
+    started: float
+    progress: ProgressCallback | None
+    total: int
+    attempts: int = 0
+    passed: list[RankedDesign] = field(default_factory=list)
+    rejected: list[str] = field(default_factory=list)
+    closest: tuple[int, str] | None = None
+
+    def out_of_time(self) -> bool:
+        return time.perf_counter() - self.started > self.options.time_limit
+
+    def traced(self, label: str, design: Design, check: Verification) -> None:
+        """Record a verified design (passed or rejected) and report progress."""
+        self.attempts += 1
+        if check.passed:
+            final = _with_transmissions(design, check)
+            self.passed.append(RankedDesign(final, check, quality(final, check)))
+        else:
+            self.rejected.append(f"{label}: {check.reason}")
+            reached = len(check.states)
+            if self.closest is None or reached > self.closest[0]:
+                links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
+                self.closest = (
+                    reached,
+                    f"{label} (links {links}; drive {design.drive}) reached profile {reached} of {design.chain.count}, "
+                    f"then: {check.reason}",
+                )
+        if self.progress is not None:
+            self.progress(self.attempts, self.total, f"{len(self.passed)} passed, {self.attempts} traced")
 
 
 def _design(
@@ -71,13 +121,11 @@ def _design(
         first = step.candidates[k].link
         add(first)
         if step.links == 2:
-            size = chain.size
             second = next(
                 (
                     c.link
                     for c in step.candidates[k + 1 :]
-                    if c.link.anchor != first.anchor
-                    or np.linalg.norm(c.link.circle - first.circle) > 0.1 * size
+                    if _independent(first, c.link, chain.size, options)
                 ),
                 step.candidates[(k + 1) % len(step.candidates)].link,
             )
@@ -88,10 +136,14 @@ def _design(
         drive = options.drive
     elif options.actuator == "prismatic":
         drive = "A1s"
+    elif any(link.kind == "PR" for link in links):
+        drive = next(
+            f"{link.name}s" for link in links if link.kind == "PR"
+        )  # a slider drives (paper, Fig. 14)
     elif pl.pinned_root is not None:
         drive = pl.pinned_root
     else:
-        drive = "D1a"
+        drive = links[0].joint_names()[0]  # the root's crank
     notes = (
         f"root body {pl.root}",
         f"bodies closed by two chain joints: {', '.join(pl.paired) or 'none'}",
@@ -100,8 +152,22 @@ def _design(
     return Design(chain, tuple(links), drive, options.dof, name, notes)
 
 
+def _independent(first: BinaryLink, second: BinaryLink, size: float, options: MechanizeOptions) -> bool:
+    """Two links that together can hold a body: apart, and two sliders not on parallel guides."""
+    if first.kind == "PR" and second.kind == "PR" and first.anchor == second.anchor:
+        assert first.direction is not None and second.direction is not None
+        sine = abs(float(first.direction[0] * second.direction[1] - first.direction[1] * second.direction[0]))
+        if sine < math.sin(options.min_transmission):
+            return False
+    return first.anchor != second.anchor or float(np.linalg.norm(second.circle - first.circle)) > 0.1 * size
+
+
 def mechanize(
-    result: SynthesisResult | ShapeChain, options: MechanizeOptions | None = None, *, name: str | None = None
+    result: SynthesisResult | ShapeChain,
+    options: MechanizeOptions | None = None,
+    *,
+    name: str | None = None,
+    progress: ProgressCallback | None = None,
 ) -> Mechanization:
     """Mechanize a synthesised chain to ``options.dof`` degrees of freedom (1 by default), verified.
 
@@ -110,27 +176,26 @@ def mechanize(
     result
         A synthesis result (its compound chain is used when joints were merged), or a chain already built.
     options
-        Designer choices: DOF, ground region, link offsets, anchors, drive, actuator type.
+        Designer choices: DOF, ground region, link offsets, anchors, drive, actuator type (default: the
+        problem file's mechanization keys).
     name
         The mechanism's name (default: from the problem file).
+    progress
+        Called as ``progress(done, total, message)`` after every design traced (``total``: the most the search
+        will trace).
 
     Raises
     ------
     MechanizationError
-        When no design passes: the last reason, and how many designs were tried.
+        When no design passes: the design that came closest (the most profiles reached) and what it violated,
+        and how many designs were tried.
     """
-    started = time.perf_counter()
-    options = options or MechanizeOptions()
-    if options.dof < 1:
-        raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
-    if options.actuator not in ("revolute", "prismatic"):
-        raise MechanizationError(
-            f"mechanize: actuator {options.actuator!r}: expected 'revolute' or 'prismatic'"
+    if options is None:
+        problem = getattr(result, "problem", None)
+        options = (
+            options_from_values(problem.mechanize_options) if problem is not None else MechanizeOptions()
         )
-    if options.anchors not in ("ground", "any", "auto"):
-        raise MechanizationError(
-            f"mechanize: anchors {options.anchors!r}: expected 'ground', 'any' or 'auto'"
-        )
+    _check(options)
     if isinstance(result, ShapeChain):
         chain = result
         label = name or "mechanized chain"
@@ -143,31 +208,59 @@ def mechanize(
             f"mechanize: needs at least three profiles, got {chain.count}: rigid-body guidance places each pivot "
             "through three or more positions of a body (Sec. 7)"
         )
-    rejected: list[str] = []
-    attempts = 0
-    modes = ("ground", "any") if options.anchors == "auto" else (options.anchors,)
-    for root in roots(chain, options):
+    # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
+    # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
+    modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
+    order = roots(chain, options)
+    state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
+    for root in order:
         for mode in modes:
-            if time.perf_counter() - started > options.time_limit:
+            if state.out_of_time() or len(state.passed) >= state.options.designs:
                 break
             opts = replace(options, anchors=mode)
             try:
                 pl = plan(chain, root, opts)
             except MechanizationError as exc:
-                rejected.append(f"root {root}, anchors {mode}: {exc}")
+                state.rejected.append(f"root {root}, anchors {mode}: {exc}")
+                if state.closest is None:
+                    state.closest = (-1, f"root {root}, anchors {mode}: {exc}")
                 continue
-            found, tried = _search(chain, pl, opts, label, rejected)
-            attempts += tried
-            if found is not None:
-                design = _with_transmissions(*found)
-                return Mechanization(
-                    design, found[1], attempts, tuple(rejected), time.perf_counter() - started
-                )
-    last = rejected[-1].split(": ", 1)[1] if rejected else "no design"
+            _search(chain, pl, opts, label, state)
+        if state.passed:  # the designs of one root are compared; other roots only when none passed
+            break
+    seconds = time.perf_counter() - state.started
+    if state.passed:
+        # ties (the same weakest link) keep the order found: rounding keeps that order stable to the last bits
+        ranked = tuple(sorted(state.passed, key=lambda r: -round(r.quality.factor, 9)))
+        best = ranked[0]
+        return Mechanization(
+            best.design, best.verification, state.attempts, tuple(state.rejected), seconds, ranked
+        )
+    closest = state.closest[1].removeprefix("mechanize: ") if state.closest else "no design"
+    timed_out = " (time limit reached)" if state.out_of_time() else ""
     raise MechanizationError(
-        f"mechanize: no design passes after {attempts} traced ({len(rejected)} rejected); the last: {last}"
+        f"mechanize: no design passes after {state.attempts} traced{timed_out}"
         + (f" (DOF {options.dof} asked for)" if options.dof != 1 else "")
+        + f"; closest: {closest}"
     )
+
+
+def _check(options: MechanizeOptions) -> None:
+    """Reject options no search can use (the problem reader and the flags check them too)."""
+    if options.dof < 1:
+        raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
+    if options.actuator not in ("revolute", "prismatic"):
+        raise MechanizationError(
+            f"mechanize: actuator {options.actuator!r}: expected 'revolute' or 'prismatic'"
+        )
+    if options.binary_links not in ("revolute", "prismatic", "both"):
+        raise MechanizationError(
+            f"mechanize: binary_links {options.binary_links!r}: expected 'revolute', 'prismatic' or 'both'"
+        )
+    if options.anchors not in ("ground", "any", "auto"):
+        raise MechanizationError(
+            f"mechanize: anchors {options.anchors!r}: expected 'ground', 'any' or 'auto'"
+        )
 
 
 def _with_transmissions(design: Design, check: Verification) -> Design:
@@ -188,10 +281,9 @@ def _with_transmissions(design: Design, check: Verification) -> Design:
     return replace(design, links=links)
 
 
-def _search(
-    chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, rejected: list[str]
-) -> tuple[tuple[Design, Verification] | None, int]:
-    """Trace designs of one plan, replacing the link blamed for each defect, until one passes."""
+def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, state: _Search) -> None:
+    """Trace designs of one plan, replacing the link blamed for each defect; after a pass, vary the links to
+    find further passing designs to rank, until ``options.designs`` passed or the attempts or the time run out."""
     choice = [0] * len(pl.steps)
     root_pair = 0
     index: dict[str, int] = {}
@@ -201,18 +293,24 @@ def _search(
             count += 1
             index[f"D{count}"] = i
     for attempt in range(1, options.attempts + 1):
+        if state.out_of_time() or len(state.passed) >= state.options.designs:
+            return
         design = _design(chain, pl, root_pair, choice, options, label)
         if options.drive is not None and options.drive not in design.joint_names():
-            raise MechanizationError(
-                f"mechanize: unknown drive joint {options.drive!r}; joints are {', '.join(design.joint_names())}"
+            # a link's joint names depend on the design: this one has no such joint, another may
+            state.rejected.append(
+                f"root {pl.root}, anchors {options.anchors}, design {attempt}: no joint {options.drive!r} "
+                f"(joints are {', '.join(design.joint_names())})"
             )
+            if state.closest is None:
+                state.closest = (-1, state.rejected[-1])
+            return
         check = verify(design)
-        if check.passed:
-            return (design, check), attempt
-        rejected.append(f"root {pl.root}, anchors {options.anchors}, design {attempt}: {check.reason}")
+        state.traced(f"root {pl.root}, anchors {options.anchors}, design {attempt}", design, check)
         if check.defect == "dof":
-            break
-        culprit = check.culprit
+            return
+        # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
+        culprit = _weakest(state.passed[-1].design) if check.passed else check.culprit
         if culprit in index and choice[index[culprit]] + 1 < len(pl.steps[index[culprit]].candidates) - 1:
             choice[index[culprit]] += 1
             continue
@@ -221,9 +319,14 @@ def _search(
             continue
         movable = [i for i, s in enumerate(pl.steps) if choice[i] + 1 < len(s.candidates) - 1]
         if not movable:
-            break
+            return
         choice[movable[attempt % len(movable)]] += 1
-    return None, options.attempts
 
 
-__all__ = ["Mechanization", "MechanizationError", "MechanizeOptions", "mechanize"]
+def _weakest(design: Design) -> str | None:
+    """The binary link with the smallest transmission angle."""
+    links = [link for link in design.links if link.kind in ("RR", "PR")]
+    return min(links, key=lambda link: link.transmission).name if links else None
+
+
+__all__ = ["Mechanization", "MechanizationError", "MechanizeOptions", "RankedDesign", "mechanize"]

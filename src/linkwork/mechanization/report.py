@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from linkwork.mechanization.assemble import spec_text
-from linkwork.mechanization.mechanize import Mechanization
+from linkwork.mechanization.mechanize import Mechanization, RankedDesign
 
 
 def _value(kind: str, value: float) -> float:
@@ -69,9 +69,24 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
             "attempts": result.attempts,
             "rejected": list(result.rejected),
         },
+        "quality": result.ranked[0].quality.to_dict(d_kind) if result.ranked else None,
+        "designs": [_ranked(rank, r) for rank, r in enumerate(result.ranked, start=1)],
         "notes": list(design.notes),
         "seconds": result.seconds,
         "trace_command": f"linkwork trace mechanism.toml --drive {design.drive} --until {design.drive}=<drive_value>",
+    }
+
+
+def _ranked(rank: int, ranked: RankedDesign) -> dict[str, Any]:
+    """One of the best designs: its rank, quality factor and parts, drive and links."""
+    mech = ranked.design.mechanism()
+    kind = mech.joint_types[mech.index(ranked.design.drive)]
+    return {
+        "rank": rank,
+        **ranked.quality.to_dict(kind),
+        "drive": ranked.design.drive,
+        "e_max": max(s.e_max for s in ranked.verification.states),
+        "dyads": [link.to_dict() for link in ranked.design.links],
     }
 
 

@@ -25,72 +25,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, MechanizationError
-from linkwork.mechanization import guidance
+from linkwork.mechanization import guidance, sliders
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, apply, relative
+from linkwork.mechanization.options import GroundRegion, MechanizeOptions
 
 Array = NDArray[np.float64]
 
+#: Fixed pivots sampled in the ground region per body (candidates by kinematic inversion).
+REGION_SAMPLES = 81
 
-@dataclass(frozen=True)
-class MechanizeOptions:
-    """What the designer may choose (all optional).
-
-    Attributes
-    ----------
-    dof
-        Degrees of freedom (number of actuators) of the mechanism; 1 by default.
-    ground_region
-        ``(xmin, ymin, xmax, ymax)``: fixed pivots on the ground must lie in it. Default: the box of the
-        profiles grown by ``margin`` of their size on every side.
-    margin
-        See ``ground_region``.
-    link_offset
-        Moving pivots may sit off the chain, along its normal, up to this multiple of the body's length.
-    anchors
-        ``"ground"``: every dyad to the ground; ``"any"``: also between links (to a body already placed);
-        ``"auto"``: try ``"ground"`` first, then ``"any"``.
-    min_transmission
-        Radians: dyads whose transmission angle drops below this on a profile are dropped.
-    max_link
-        Longest link, as a multiple of the profiles' size.
-    root
-        The body guided first (default: the body with the longest outline).
-    drive
-        The driven joint (default: the crank of the root, else a chain joint that moves monotonically).
-    actuator
-        ``"revolute"``: the drive is a revolute joint; ``"prismatic"``: add a linear actuator (RPR) between the
-        ground (``ground_region``) and the root and drive its slider.
-    candidates
-        Moving-pivot candidates along each body (times 7 offsets).
-    attempts
-        Designs traced at most per root and anchor choice.
-    time_limit
-        Seconds after which the search stops with the best reason it has.
-    """
-
-    dof: int = 1
-    ground_region: tuple[float, float, float, float] | None = None
-    margin: float = 0.25
-    link_offset: float = 1.5
-    anchors: str = "auto"
-    min_transmission: float = math.radians(15.0)
-    max_link: float = 1.5
-    root: str | None = None
-    drive: str | None = None
-    actuator: str = "revolute"
-    candidates: int = 9
-    attempts: int = 6
-    time_limit: float = 60.0
-
-    def region(self, chain: ShapeChain) -> tuple[float, float, float, float]:
-        """The ground region in use."""
-        if self.ground_region is not None:
-            return tuple(float(v) for v in self.ground_region)  # type: ignore[return-value]
-        pts = np.vstack(chain.targets)
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        pad = self.margin * chain.size
-        return (float(lo[0] - pad), float(lo[1] - pad), float(hi[0] + pad), float(hi[1] + pad))
+#: With more than five profiles, this many moving pivots per body are moved to fit a circle best.
+POLISHED = 12
 
 
 @dataclass(frozen=True)
@@ -183,41 +129,110 @@ def body_candidates(
     options: MechanizeOptions,
     name: str = "D",
 ) -> list[Candidate]:
-    """Ranked RR dyads guiding ``body`` relative to each anchor (best first)."""
+    """Ranked binary links guiding ``body`` relative to each anchor (best first): RR dyads and, as
+    ``options.binary_links`` allows, PR sliders."""
     p = chain.count
-    xmin, ymin, xmax, ymax = options.region(chain)
+    region = options.region_of(chain.targets, chain.size)
     out: list[Candidate] = []
     g_body = chain.body(body).displacements
-    limit = math.sin(options.min_transmission)
     for anchor in anchors:
         g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
         rel = relative(g_anchor, g_body)
-        pivots = _pivot_candidates(chain, body, rel, options)
-        for m, dyad in pivots:
-            c = dyad.centre_point
-            r = dyad.radius
-            if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
-                continue
-            if anchor == "ground" and not (xmin <= c[0] <= xmax and ymin <= c[1] <= ymax):
-                continue
-            world_m = np.array([apply(x, m) for x in g_body])
-            world_c = np.array([apply(x, c) for x in g_anchor])
-            u = world_m - world_c
-            u /= np.linalg.norm(u, axis=1, keepdims=True)
-            free = _free_directions(chain, body, via, m)
-            if free is not None and np.any(~np.isfinite(free)):
-                continue
-            s = _quality(u, free)
-            if free is not None and (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0))):
-                continue
-            mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
-            ratio = abs(math.log(r / (0.5 * chain.size)))
-            score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
-            link = BinaryLink(
-                name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via
-            )
-            out.append(Candidate(link, score, s))
+        if options.binary_links in ("revolute", "both"):
+            pivots = _pivot_candidates(chain, body, rel, options)
+            if anchor == "ground":
+                pivots += _pivots_from_region(chain, rel, region)
+            out += _rr_candidates(chain, body, via, anchor, pivots, options, region, name)
+        if options.binary_links in ("prismatic", "both"):
+            out += _slider_candidates(chain, body, via, anchor, rel, options, region, name)
     out.sort(key=lambda cand: -cand.score)
+    return out
+
+
+def _accepts(s: Array | None, options: MechanizeOptions) -> bool:
+    """Transmission above the limit on every profile, one assembly mode throughout (one sign)."""
+    if s is None:
+        return True
+    limit = math.sin(options.min_transmission)
+    return not (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0)))
+
+
+def _rr_candidates(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    anchor: str,
+    pivots: list[tuple[Array, guidance.Dyad]],
+    options: MechanizeOptions,
+    region: GroundRegion,
+    name: str,
+) -> list[Candidate]:
+    """RR dyads from their pivots: long, short, outside the region or badly transmitting ones dropped."""
+    p = chain.count
+    g_body = chain.body(body).displacements
+    g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+    out = []
+    for m, dyad in pivots:
+        c = dyad.centre_point
+        r = dyad.radius
+        if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
+            continue
+        if anchor == "ground" and not bool(region.contains(c)[0]):
+            continue
+        world_m = np.array([apply(x, m) for x in g_body])
+        world_c = np.array([apply(x, c) for x in g_anchor])
+        u = world_m - world_c
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        free = _free_directions(chain, body, via, m)
+        if free is not None and np.any(~np.isfinite(free)):
+            continue
+        s = _quality(u, free)
+        if not _accepts(None if free is None else s, options):
+            continue
+        mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+        ratio = abs(math.log(r / (0.5 * chain.size)))
+        score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
+        link = BinaryLink(name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via)
+        out.append(Candidate(link, score, s))
+    return out
+
+
+def _slider_candidates(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    anchor: str,
+    rel: Array,
+    options: MechanizeOptions,
+    region: GroundRegion,
+    name: str,
+) -> list[Candidate]:
+    """PR sliders: slider points of the body (exact for three profiles), guides fitted through their positions,
+    kept when the slider moves one way, its guide lies in the region (on the ground) and it transmits well."""
+    p = chain.count
+    g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+    grid = _moving_pivots(chain, body, max(3, options.candidates // 2), options.link_offset)
+    out = []
+    for g in grid:
+        for v in (np.array([1.0, 0.0]), np.array([0.0, 1.0])):
+            for m in sliders.slider_points(rel, g, v * chain.size, reach=options.link_offset):
+                start, u, travel, error = sliders.fit_guide(rel, m)
+                if not sliders.monotonic(travel, chain.size) or error > 0.05 * chain.size:
+                    continue
+                ends = start + np.outer([travel[0], travel[-1]], u)
+                if anchor == "ground" and not np.all(region.contains(ends)):
+                    continue
+                free = _free_directions(chain, body, via, m)
+                if free is not None and np.any(~np.isfinite(free)):
+                    continue
+                world_u = np.array([apply(np.array([0.0, 0.0, x[2]]), u) for x in g_anchor])
+                s = sliders.transmission(world_u, free) if free is not None else np.ones(p)
+                if not _accepts(None if free is None else s, options):
+                    continue
+                mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+                score = math.degrees(mu) - 1e3 * error / chain.size
+                link = BinaryLink(name, "PR", anchor, body, start, np.asarray(m, float), error, mu, via, u)
+                out.append(Candidate(link, score, s))
     return out
 
 
@@ -240,9 +255,36 @@ def _pivot_candidates(
     elif p == 5:
         out = [(d.circle_point, d) for d in guidance.burmester_points(rel)]
     else:
-        for m in grid:
+        # least squares: every grid point's best circle (fast), then the circle point itself moved to fit best
+        # (a small optimisation each) for the few that fit best already
+        rough = [(m, d) for m in grid if (d := _guide(rel, m)) is not None]
+        rough.sort(key=lambda md: md[1].structural_error)
+        out = rough[POLISHED:]
+        for m, _ in rough[:POLISHED]:
             d = guidance.fit_circle_point(rel, m)
             out.append((d.circle_point, d))
+    return out
+
+
+def _pivots_from_region(
+    chain: ShapeChain, rel: Array, region: GroundRegion
+) -> list[tuple[Array, guidance.Dyad]]:
+    """Dyads whose fixed pivot is sampled in the ground region: the moving pivot by kinematic inversion.
+
+    Seen from the body, a fixed pivot ``c`` takes the positions of the inverted motion; the moving pivot is the
+    centre of the circle through them (exact for three positions, least squares beyond), McCarthy ch. 4.
+    """
+    inverse = guidance.inverse_poses(rel)
+    out: list[tuple[Array, guidance.Dyad]] = []
+    for c in region.samples(REGION_SAMPLES):
+        try:
+            inv = guidance.centre_point(inverse, c)
+        except LinkworkError:
+            continue
+        m = inv.centre_point
+        if not np.all(np.isfinite(m)):
+            continue
+        out.append((m, guidance.Dyad(m, np.asarray(c, dtype=float), inv.radius, inv.structural_error)))
     return out
 
 
@@ -311,37 +353,37 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
     order = order[: len(order) - extra] if extra else order
     steps = []
     done = ["ground", root]
-    deferred: str | None = None
+    deferred: list[str] = []  # bodies no single dyad can guide: a body placed from each takes two
+    joints = {j.name: j for j in chain.joints}
     for body, via in order:
         anchors = ["ground"]
         if options.anchors == "any":
             adjacent = {o for _, o in _adjacent(chain, body)}
             anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
-        if deferred is not None:
-            # the body before had no dyad: this one takes two, and the pair is placed together
+        parent = next(b for b in joints[via].bodies if b != body)
+        if parent in deferred:
+            # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)
             if len(cands) >= 2:
                 steps.append(Step(body, None, tuple(cands), 2))
-                done += [deferred, body]
-                deferred = None
+                done += [parent, body]
+                deferred.remove(parent)
                 continue
+            raise MechanizationError(
+                f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it: "
+                f"every candidate pivot leaves the ground region, is too long, has a transmission angle below "
+                f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
+                "(try a larger ground region or link offset)"
+            )
+        cands = body_candidates(chain, body, via, anchors, options)
+        if cands:
+            steps.append(Step(body, via, tuple(cands)))
+            done.append(body)
         else:
-            cands = body_candidates(chain, body, via, anchors, options)
-            if cands:
-                steps.append(Step(body, via, tuple(cands)))
-                done.append(body)
-                continue
-            deferred = body
-            continue
+            deferred.append(body)
+    if deferred:
         raise MechanizationError(
-            f"mechanize: no dyad can guide body {deferred or body} (root {root}): every candidate pivot leaves "
-            f"the ground region, is too long, has a transmission angle below "
-            f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
-            "(try a larger ground region or link offset)"
-        )
-    if deferred is not None:
-        raise MechanizationError(
-            f"mechanize: no dyad can guide body {deferred} (root {root}), the last body placed from it "
+            f"mechanize: no dyad can guide body {deferred[0]} (root {root}), the last body placed from it "
             f"(transmission angle below {math.degrees(options.min_transmission):.0f} deg or a change of "
             "assembly mode between profiles; try a larger ground region or link offset)"
         )
@@ -367,11 +409,12 @@ def _root_pairs(
     out = []
     for i, a in enumerate(singles):
         wa = np.array([apply(x, a.link.circle) for x in g])
-        ca = a.link.centre
-        phi = np.unwrap(np.arctan2(wa[:, 1] - ca[1], wa[:, 0] - ca[0]))
-        dphi = np.diff(phi)
-        if not (np.all(dphi > 1e-6) or np.all(dphi < -1e-6)):
-            continue  # the crank must turn one way through the profiles (order)
+        if a.link.kind == "RR":
+            ca = a.link.centre
+            phi = np.unwrap(np.arctan2(wa[:, 1] - ca[1], wa[:, 0] - ca[0]))
+            dphi = np.diff(phi)
+            if not (np.all(dphi > 1e-6) or np.all(dphi < -1e-6)):
+                continue  # the crank must turn one way through the profiles (order); a slider does by choice
         for b in singles[i + 1 :]:
             wb = np.array([apply(x, b.link.circle) for x in g])
             coupler = wb - wa
@@ -379,19 +422,26 @@ def _root_pairs(
             if np.any(n < 0.05 * chain.size):
                 continue
             perp = np.column_stack([-coupler[:, 1], coupler[:, 0]]) / n[:, None]
-            ub = (wb - b.link.centre) / b.link.length
-            ua = (wa - ca) / a.link.length
-            s_b = np.sum(ub * perp, axis=1)  # transmission at the rocker
-            s_a = np.sum(ua * perp, axis=1)  # crank against coupler: away from the crank's dead centre
+            s_b = np.sum(_pull(b.link, wb) * perp, axis=1)  # transmission at the rocker
+            s_a = np.sum(_pull(a.link, wa) * perp, axis=1)  # crank against coupler: away from its dead centre
             ok = all(np.all(np.abs(s) >= limit) and (np.all(s > 0) or np.all(s < 0)) for s in (s_a, s_b))
             if not ok:
                 continue
             mu = math.degrees(float(np.arcsin(min(1.0, float(min(np.abs(s_a).min(), np.abs(s_b).min()))))))
-            lengths = [a.link.length, b.link.length, float(n[0])]
+            lengths = [link.length for link in (a.link, b.link) if link.kind == "RR"] + [float(n[0])]
             ratio = max(lengths) / min(lengths)
             out.append((a, b, mu - 10.0 * math.log(ratio)))
     out.sort(key=lambda t: -t[2])
     return out[:40]
+
+
+def _pull(link: BinaryLink, w: Array) -> Array:
+    """``(p, 2)`` the unit direction a ground link acts on its moving pivot at positions ``w``: along an RR
+    link, along the normal of a slider's guide."""
+    if link.kind == "PR":
+        assert link.direction is not None
+        return np.tile([-link.direction[1], link.direction[0]], (len(w), 1))
+    return (w - link.centre) / link.length
 
 
 def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) -> BinaryLink:
@@ -406,8 +456,7 @@ def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) 
     MechanizationError
         When no pivot pair on the ground and the body has a monotonic length.
     """
-    xmin, ymin, xmax, ymax = options.region(chain)
-    grid = np.array([(x, y) for x in np.linspace(xmin, xmax, 9) for y in np.linspace(ymin, ymax, 9)])
+    grid = options.region_of(chain.targets, chain.size).samples(REGION_SAMPLES)
     g = chain.body(body).displacements
     best, best_score = None, -math.inf
     for m in _moving_pivots(chain, body, options.candidates, options.link_offset):

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.errors import AssemblyError
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
@@ -122,7 +123,12 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
     max_steps
         Step budget of each trace (a passing design's path is the same as with the CLI's larger budget).
     """
-    mech = loaded_mechanism(design)
+    try:
+        mech = loaded_mechanism(design)
+    except AssemblyError as exc:
+        # the spec reader's assembly check: the links make the chain rigid but for a hair (a near-singular design)
+        reason = str(exc).split(": ", 2)[-1].split("; ")[0]
+        return Verification(False, "branch", f"branch defect: {reason}", 0, 0, design.drive)
     chain = design.chain
     ideal = design.ideal_values()
     names = list(mech.joint_names)
@@ -229,6 +235,17 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
                 f"{_show(mech, d, path.angles[k, d])}",
                 _culprit(design, mech, path),
             )
+        dv = np.diff(path.angles[:, d])
+        if np.any(dv * np.sign(v[j]) < -1e-12):
+            # a dead centre on the way: the drive turns back (the trace may then wander until its budget)
+            k = int(np.flatnonzero(dv * np.sign(v[j]) < -1e-12)[0])
+            return reject(
+                "order",
+                f"order defect: the drive {drive} turns back {where} at "
+                f"{_show(mech, d, path.angles[k, d])} (a dead centre)"
+                + (f"; the trace then {end}" if end != "reached target" else ""),
+                _culprit(design, mech, path),
+            )
         if end != "reached target":
             defect = "order" if "turning" in end else "branch"
             return reject(
@@ -236,13 +253,6 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
                 f"{defect} defect: the trace {where} stopped ({end}) before the drive "
                 f"{drive} reached {_show(mech, d, v[j])}",
                 _culprit(design, mech, path),
-            )
-        dv = np.diff(path.angles[:, d])
-        if np.any(dv * np.sign(v[j]) < -1e-12):
-            return reject(
-                "order",
-                f"order defect: the drive {drive} turns back {where}",
-                "drive",
             )
         st = state(path.angles[-1], j)
         structural = max((link.structural_error for link in design.links), default=0.0)
@@ -281,7 +291,8 @@ def _circuit_culprit(design: Design, mech: Mechanism, values: Array, j: int) -> 
 
 
 def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
-    """Sine of every RR link's transmission angle at joint displacements ``values`` (0: a dead centre).
+    """Sine of every RR link's (and PR slider's) transmission angle at joint displacements ``values`` (0: a dead
+    centre).
 
     The angle at the moving pivot between the link and the line to the point that, with the link, places the
     body: the body's chain joint ``via``, or the other root link's moving pivot.
@@ -293,11 +304,16 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     links = {link.name: link for link in design.links}
     out: dict[str, float] = {}
     for link in design.links:
-        if link.kind != "RR" or link.via is None:
+        if link.kind not in ("RR", "PR") or link.via is None:
             continue
         m = apply(disp[link.body], link.circle)
-        c = apply(disp[link.name], link.centre)
-        u = (m - c) / max(float(np.linalg.norm(m - c)), 1e-300)
+        if link.kind == "PR":  # the guide reacts along its normal
+            assert link.direction is not None
+            d = apply(np.array([0.0, 0.0, disp[link.anchor][2]]), link.direction)
+            u = np.array([-d[1], d[0]])
+        else:
+            c = apply(disp[link.name], link.centre)
+            u = (m - c) / max(float(np.linalg.norm(m - c)), 1e-300)
         if link.via in joints:
             jt = joints[link.via]
             if jt.kind == "P":

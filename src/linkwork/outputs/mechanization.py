@@ -3,14 +3,34 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from linkwork.outputs.staging import console, have_matplotlib
 
 if TYPE_CHECKING:
     from linkwork.mechanization import Mechanization, MechanizeOptions
+    from linkwork.mechanization.options import ProgressCallback
+    from linkwork.synthesis.problem import Problem
     from linkwork.synthesis.result import SynthesisResult
+
+
+def resolve_options(problem: Problem, flags: Mapping[str, Any] | None = None) -> MechanizeOptions:
+    """The mechanization options of the problem file, overridden by the command line's ``flags`` (file units;
+    ``None`` means not given).
+
+    Raises
+    ------
+    SpecError
+        Naming the problem file's key or the flag, and what was expected.
+    """
+    from linkwork.mechanization import options_from_values
+
+    source = str(problem.source) if problem.source is not None else None
+    options = options_from_values(problem.mechanize_options, source=source)
+    return options_from_values(flags or {}, base=options, flags=True)
 
 
 def mechanize_into(
@@ -19,23 +39,32 @@ def mechanize_into(
     *,
     options: MechanizeOptions | None = None,
     plots: bool = True,
+    progress: ProgressCallback | None = None,
+    html: bool = False,
 ) -> tuple[Mechanization, list[Path]]:
-    """Mechanize ``result`` and write ``mechanism.toml``, ``mechanization.json`` and the figures into ``out_dir``.
+    """Mechanize ``result`` and write ``mechanism.toml``, ``mechanization.json`` and the figures into ``out_dir``
+    (and ``mechanism.html``, the viewer of the mechanism over the target profiles, with ``html`` and one DOF).
+
+    ``options`` default to the problem file's (:func:`resolve_options`).
 
     Raises
     ------
     MechanizationError
-        When no design passes (one line: why).
+        When no design passes (one line: the closest design and what it violated).
     """
     from linkwork.mechanization import mechanize, write_mechanization
 
-    found = mechanize(result, options)
+    found = mechanize(result, options or resolve_options(result.problem), progress=progress)
     out_dir = Path(out_dir)
     written = write_mechanization(found, out_dir)
     if plots and have_matplotlib():
         from linkwork.viz.mechanism_plots import write_mechanism_figures
 
         written += write_mechanism_figures(found, out_dir)
+    if html and found.verification.paths:
+        from linkwork.viz.mechanism_viewer import write_mechanism_viewer
+
+        written.append(write_mechanism_viewer(found, out_dir / "mechanism.html"))
     return found, written
 
 
@@ -79,9 +108,48 @@ def print_mechanization(found: Mechanization) -> None:
             str(j + 1), f"{value:.6f}", f"{state.e_max:.4f}", f"{design.chain.joined_errors[j]:.4f}"
         )
     console.print(states)
+    if len(found.ranked) > 1:
+        ranking = Table(title="Designs found, by quality factor", title_justify="left", title_style="bold")
+        for column in ("rank", "quality", "min transmission (deg)", "link ratio", "stroke", "drive"):
+            ranking.add_column(column, justify="right")
+        for rank, r in enumerate(found.ranked, start=1):
+            q = r.quality
+            kind = next(s["type"] for s in r.design.joint_specs() if s["name"] == r.design.drive)
+            stroke = f"{math.degrees(q.stroke):.1f} deg" if kind == "R" else f"{q.stroke:.4g}"
+            ranking.add_row(
+                str(rank),
+                f"{q.factor:.4f}",
+                f"{math.degrees(q.min_transmission):.1f}",
+                f"{q.link_ratio:.2f}",
+                stroke,
+                r.design.drive,
+            )
+        console.print(ranking)
     if not check.traced:
         console.print(f"{check.reason} ({found.seconds:.1f} s)")
         return
     console.print(
         f"verified: no circuit, branch or order defect ({found.attempts} designs traced, {found.seconds:.1f} s)"
     )
+
+
+@contextmanager
+def progress_bar() -> Iterator[ProgressCallback]:
+    """A rich progress bar for a mechanization search, as a ``progress(done, total, message)`` callback."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn("[bold]mechanizing[/]"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TextColumn("{task.description}"),
+        console=console,
+        transient=True,
+    ) as bar:
+        task = bar.add_task("", total=None)
+
+        def update(done: int, total: int, message: str) -> None:
+            bar.update(task, completed=done, total=max(total, done), description=message)
+
+        yield update

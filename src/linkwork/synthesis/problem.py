@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -78,6 +79,11 @@ class Problem:
         A name per profile (file stem by default).
     source
         The problem file this came from, if any (for messages and relative paths).
+    mechanize
+        Whether ``linkwork synth`` also mechanizes the chain.
+    mechanize_options
+        The mechanization keys of the problem file, in file units (degrees), already checked; read them with
+        :func:`linkwork.mechanization.options_from_values`.
     units
         The length unit of the profile files (``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``, ``"um"``), carried
         into the DXF (``$INSUNITS``) and SVG (width and height) drawings; ``None``: unitless.
@@ -95,6 +101,7 @@ class Problem:
     names: tuple[str, ...] = field(default=())
     source: Path | None = None
     mechanize: bool = False
+    mechanize_options: Mapping[str, Any] = field(default_factory=dict)
     merge_on: MergeOn = "targets"
     rank_by: RankBy = "error"
     e_max_tolerance: float | None = None

@@ -54,6 +54,13 @@ def _draw(
     for k, link in enumerate(design.links):
         body = disp[link.body]
         m = apply(body, link.circle)
+        if link.kind == "PR":  # a slider: its guide, drawn about where the slider is
+            assert link.direction is not None
+            d = apply(np.array([0.0, 0.0, disp[link.anchor][2]]), link.direction)
+            reach = 0.08 * chain.size
+            ax.plot(*np.column_stack([m - reach * d, m + reach * d]), color="#2ca02c", lw=2.4, zorder=2)
+            ax.plot([m[0]], [m[1]], "s", ms=5, color="#2ca02c", zorder=4)
+            continue
         if link.kind == "RR":
             c = apply(disp[link.name], link.centre)
         else:
@@ -93,7 +100,7 @@ def _limits(found: Mechanization) -> tuple[Array, Array]:
     for state in found.verification.states:
         disp = chain_displacements(design, mech, state.values)
         for link in design.links:
-            side = link.name if link.kind == "RR" else f"{link.name}c"
+            side = link.name if link.kind in ("RR", "PR") else f"{link.name}c"
             pts.append(np.vstack([apply(disp[side], link.centre), apply(disp[link.body], link.circle)]))
     allp = np.vstack(pts)
     lo, hi = allp.min(axis=0), allp.max(axis=0)

@@ -13,6 +13,8 @@ LW.Scene = class {
     this.planar = data.planar;
     this.showLabels = true;
     this.onChange = null;
+    this.overlays = data.overlays || []; // fixed polylines (e.g. target profiles), drawn in the fixed view
+    this.mode = "centred";
     this.parts = data.parts.map((p) => {
       const c = parseInt(p.color.slice(1), 16);
       return {
@@ -36,6 +38,7 @@ LW.Scene = class {
 
   /** "centred": the view follows the linkage's centre; "fixed": one body stays still. */
   setMode(mode) {
+    this.mode = mode;
     this.bounds = this.allBounds[mode];
     this.resetView(this.lastView || "iso");
   }
@@ -176,6 +179,7 @@ LW.Scene = class {
       ctx.fill();
       ctx.stroke();
     }
+    if (this.overlays.length && this.mode === "fixed") this.drawOverlays(ctx, toCam, project, near);
     if (this.showLabels) this.drawLabels(ctx, poses, toCam, project, near);
     this.drawTriad(ctx, right, up, back, w, h);
     this.triangles = n;
@@ -203,6 +207,27 @@ LW.Scene = class {
       line(gx + t, gy - r, gx + t, gy + r, Math.abs(gx + t) < step * 1e-6);
       line(gx - r, gy + t, gx + r, gy + t, Math.abs(gy + t) < step * 1e-6);
     }
+  }
+
+  /** Dashed polylines fixed to the ground (the target profiles of a mechanized chain). */
+  drawOverlays(ctx, toCam, project, near) {
+    const c = new Float64Array(3);
+    ctx.lineWidth = 1.5;
+    ctx.setLineDash([6, 4]);
+    for (const o of this.overlays) {
+      ctx.strokeStyle = o.color;
+      ctx.beginPath();
+      let pen = false;
+      for (const p of o.points) {
+        toCam(p[0], p[1], p[2], c, 0);
+        if (c[2] < near) { pen = false; continue; }
+        const [x, y] = project(c, 0);
+        if (pen) ctx.lineTo(x, y); else ctx.moveTo(x, y);
+        pen = true;
+      }
+      ctx.stroke();
+    }
+    ctx.setLineDash([]);
   }
 
   drawLabels(ctx, poses, toCam, project, near) {

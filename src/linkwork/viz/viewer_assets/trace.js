@@ -18,6 +18,7 @@
   const drive = data.joints[data.drive];
 
   const scene = new LW.Scene($("scene"), data);
+  if (data.view === "fixed") { $("centred").checked = false; scene.setMode("fixed"); } // mechanism viewer
   const anglePlot = new LW.Plot($("plot-angles"), { ylabel: "hinge angle (deg)" });
   const sigmaPlot = new LW.Plot($("plot-sigma"), { ylabel: "singular value σᵢ", logy: true, floor: 1e-10 });
   const SIGMA_COLORS = ["#08306b", "#2171b5", "#4292c6", "#6baed6", "#41ab5d", "#fd8d3c", "#e6550d", "#a63603", "#756bb1", "#636363"];

@@ -1,0 +1,87 @@
+"""The mechanization flags shared by ``linkwork mechanize`` and ``linkwork synth`` (each is also a problem-file
+key of the same name; a flag overrides the key)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import typer
+
+PANEL = "Mechanization (each also a problem-file key)"
+
+Dof = Annotated[
+    int | None, typer.Option(rich_help_panel=PANEL, help="Degrees of freedom (number of actuators); key dof.")
+]
+Drive = Annotated[
+    str | None, typer.Option(rich_help_panel=PANEL, help="The driven joint (default: chosen); key drive.")
+]
+Root = Annotated[
+    str | None,
+    typer.Option(rich_help_panel=PANEL, help="The chain body guided first (default: tried in turn)."),
+]
+Anchors = Annotated[
+    str | None,
+    typer.Option(
+        rich_help_panel=PANEL, help="Dyads to 'ground', between bodies too ('any'), or 'auto'; key anchors."
+    ),
+]
+Actuator = Annotated[
+    str | None,
+    typer.Option(
+        rich_help_panel=PANEL, help="'revolute' (a crank) or 'prismatic' (a linear actuator); key actuator."
+    ),
+]
+BinaryLinks = Annotated[
+    str | None,
+    typer.Option(
+        help="'revolute' (RR dyads), 'prismatic' (PR sliders on guides) or 'both'; key binary_links."
+    ),
+]
+GroundRegion = Annotated[
+    str | None,
+    typer.Option(
+        help="Fixed pivots only in XMIN,YMIN,XMAX,YMAX, in a polygon X1,Y1;X2,Y2;X3,Y3;..., or 'inside' "
+        "every profile (profile units); key ground_region."
+    ),
+]
+LinkOffset = Annotated[
+    float | None,
+    typer.Option(
+        rich_help_panel=PANEL,
+        help="Moving pivots up to this many body lengths off the chain; key link_offset.",
+    ),
+]
+MaxLink = Annotated[
+    float | None,
+    typer.Option(
+        rich_help_panel=PANEL, help="Longest link, times the profiles' largest extent; key max_link."
+    ),
+]
+MinTransmission = Annotated[
+    float | None,
+    typer.Option(rich_help_panel=PANEL, help="Smallest transmission angle (degrees); key min_transmission."),
+]
+Attempts = Annotated[
+    int | None, typer.Option(rich_help_panel=PANEL, help="Designs traced at most per root and anchor choice.")
+]
+Designs = Annotated[
+    int | None,
+    typer.Option(
+        rich_help_panel=PANEL,
+        help="Passing designs to find and rank by quality factor (1: the first); key designs.",
+    ),
+]
+TimeLimit = Annotated[
+    float | None,
+    typer.Option(rich_help_panel=PANEL, help="Seconds after which the search stops; key time_limit."),
+]
+
+
+def flag_values(**flags: Any) -> dict[str, Any]:
+    """The flags given (not ``None``) as problem-file values; ``ground_region`` parsed from its text."""
+    from linkwork.mechanization.options import parse_region_flag
+
+    values = {key: value for key, value in flags.items() if value is not None}
+    if "ground_region" in values:
+        values["ground_region"] = parse_region_flag(values["ground_region"])
+    return values
