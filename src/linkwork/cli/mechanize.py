@@ -57,7 +57,6 @@ def mechanize(
     """Add binary links (RR dyads, linear actuators) to a synthesised chain until it has DOF degrees of freedom,
     verify that it moves through every profile in order without circuit, branch or order defects, and write
     mechanism.toml (for `linkwork trace`), mechanization.json, figures and an animation."""
-    from linkwork.mechanization.options import options_from_values
     from linkwork.outputs.mechanization import (
         mechanize_into,
         print_mechanization,
@@ -84,7 +83,6 @@ def mechanize(
     check_output_folder(out or folder)
     if dof is not None:
         check_range("--dof", dof, 1, MAX_DOF, "a whole number of degrees of freedom")
-    options_from_values(flags, source="command line")  # a bad flag is found before the synthesis runs again
     result = load_synthesis(folder, problem)
     options = resolve_options(result.problem, flags)
     target = out or folder
