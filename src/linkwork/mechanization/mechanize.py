@@ -99,7 +99,7 @@ class _Search:
                     f"then: {check.reason}",
                 )
         if self.progress is not None:
-            self.progress(self.attempts, self.total, f"{len(self.passed)} passed, {self.attempts} traced")
+            self.progress(self.attempts, self.total)
 
 
 def _design(
@@ -181,7 +181,7 @@ def mechanize(
     name
         The mechanism's name (default: from the problem file).
     progress
-        Called as ``progress(done, total, message)`` after every design traced (``total``: the most the search
+        Called as ``progress(done, total)`` (:class:`linkwork.progress.Progress`) after every design traced (``total``: the most the search
         will trace).
 
     Raises

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
 from linkwork.geometry.polygon import contains
+from linkwork.progress import Progress
 
 Array = NDArray[np.float64]
 
@@ -39,8 +40,9 @@ OPTION_KEYS = (
     "designs",
 )
 
-ProgressCallback = Callable[[int, int, str], None]
-"""``progress(done, total, message)``: designs traced so far, the most the search will trace, what it does."""
+ProgressCallback = Progress
+"""The one progress protocol (:class:`linkwork.progress.Progress`): ``progress(done, total)``, designs traced so far
+and the most the search will trace."""
 
 
 @dataclass(frozen=True)

@@ -135,7 +135,7 @@ def print_mechanization(found: Mechanization) -> None:
 
 @contextmanager
 def progress_bar() -> Iterator[ProgressCallback]:
-    """A rich progress bar for a mechanization search, as a ``progress(done, total, message)`` callback."""
+    """A rich progress bar for a mechanization search, as a ``progress(done, total)`` callback."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     with Progress(
@@ -143,13 +143,12 @@ def progress_bar() -> Iterator[ProgressCallback]:
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
-        TextColumn("{task.description}"),
         console=console,
         transient=True,
     ) as bar:
         task = bar.add_task("", total=None)
 
-        def update(done: int, total: int, message: str) -> None:
-            bar.update(task, completed=done, total=max(total, done), description=message)
+        def update(done: int, total: int | None) -> None:
+            bar.update(task, completed=done, total=None if total is None else max(total, done))
 
         yield update
