@@ -151,7 +151,7 @@ def test_max_condition_raw_is_the_largest_ratio_of_the_csv_singular_values(paper
 
 
 def test_no_plots_writes_no_figure(paper: Path) -> None:
-    names = sorted(p.name for p in paper.iterdir())
+    names = sorted(p.name for p in paper.iterdir() if p.name != ".linkwork-manifest.json")
     assert names == ["drawing.json", "mechanism.toml", "path.csv", "points.csv", "report.json"]
     assert not list(paper.glob("*.png"))
 
@@ -238,7 +238,7 @@ def bad_toml(tmp_path: Path) -> str:
 
 BAD_INPUT = {
     "unknown linkage": (lambda t: ["trace", "no-such-linkage"], "no-such-linkage"),
-    "unknown --set key": (lambda t: ["trace", "hedgepeth", "--set", "m=6"], "'m'"),
+    "unknown --set key": (lambda t: ["trace", "hedgepeth", "--set", "m=6"], '"m"'),
     "odd n": (lambda t: ["trace", "hedgepeth", "--set", "n=5"], "even"),
     "--until without =": (lambda t: ["trace", "hedgepeth", "--until", "A87"], "JOINT=VALUE"),
     "--until unknown joint": (lambda t: ["trace", "hedgepeth", "--until", "Z=30"], "'Z'"),

@@ -7,11 +7,19 @@ stays fast.
 from __future__ import annotations
 
 import logging
-from typing import Annotated
+import sys
+from collections.abc import Sequence
+from typing import Annotated, Any
 
 import typer
 
 from linkwork.cli import demo, export, help, linkages, mechanize, robustness, sweep, synth, trace
+from linkwork.cli.common import fail
+
+try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
+    from typer._click import exceptions as click_exceptions
+except ImportError:  # pragma: no cover - older typer uses click itself
+    from click import exceptions as click_exceptions  # type: ignore[no-redef]
 
 EXIT_CODES = (
     "Exit codes: 0 done as asked; 2 bad input (one line on stderr names the file, key or flag and what was "
@@ -19,11 +27,41 @@ EXIT_CODES = (
     "says why, and everything computed so far is written."
 )
 
+
+class OneLineErrors(help.Group):
+    """The command group, with click's usage errors (an unknown flag, a value of the wrong type) printed as the
+    one ``error:`` line and exit code 2 that every other bad input gets, instead of click's framed usage box."""
+
+    def main(
+        self,
+        args: Sequence[str] | None = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        windows_expand_args: bool = True,
+        **extra: Any,
+    ) -> Any:
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, False, windows_expand_args, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, False, windows_expand_args, **extra)
+        except click_exceptions.NoArgsIsHelpError as exc:
+            exc.show()  # no command or argument at all: the help is the answer
+            sys.exit(exc.exit_code)
+        except click_exceptions.ClickException as exc:
+            fail(exc.format_message(), code=2)
+            sys.exit(2)
+        except typer.Abort:
+            fail("aborted", code=1)
+            sys.exit(1)
+        sys.exit(code if isinstance(code, int) else 0)
+
+
 app = typer.Typer(
     name="linkwork",
     help="Kinematics of shape-changing mechanisms: trace closed-loop linkages, synthesise shape-changing chains.",
     epilog=EXIT_CODES,
-    cls=help.Group,
+    cls=OneLineErrors,
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,

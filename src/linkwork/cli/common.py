@@ -1,17 +1,27 @@
-"""What every command shares: turning linkwork errors into one clear line and exit code 2, and safe output."""
+"""What every command shares: turning linkwork errors into one clear line and exit code 2 or 3, quietly.
+
+A command decorated with :func:`friendly_errors` runs with numpy's floating-point warnings and Python's
+``RuntimeWarning``\\ s silenced, so that the one ``error:`` line is the only line on stderr when it fails.
+"""
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from functools import wraps
 from typing import Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
+from rich.text import Text
 
 from linkwork.errors import LinkworkError, RequestNotMetError
+from linkwork.io.toml_reader import escape_line, show
 
 err_console = Console(stderr=True)
+
+MAX_MESSAGE_CHARS = 2000
+"""An error line longer than this is cut (a hostile value can be megabytes long)."""
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -19,23 +29,40 @@ R = TypeVar("R")
 
 def fail(message: str, code: int = 2) -> typer.Exit:
     """Print ``error: message`` on one line to stderr and return the exit to raise (code 2: bad input; 3: the
-    request could not be met)."""
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    request could not be met). The message is printed as text, never as rich markup, with line breaks and
+    other control characters escaped."""
+    message = escape_line(message)
+    if len(message) > MAX_MESSAGE_CHARS:
+        message = message[: MAX_MESSAGE_CHARS - 3] + "..."
+    line = Text("error:", style="bold red")
+    line.append(" " + message)
+    err_console.print(line, highlight=False, soft_wrap=True)
     return typer.Exit(code=code)
 
 
 def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
     """Decorate a command so that a :class:`LinkworkError` becomes one line on stderr and exit code 2, or 3 for a
-    :class:`RequestNotMetError`."""
+    :class:`RequestNotMetError`; numeric warnings are silenced while it runs."""
 
     @wraps(func)
     def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+        import numpy as np
+
         try:
-            return func(*args, **kwargs)
+            with warnings.catch_warnings(), np.errstate(all="ignore"):
+                warnings.simplefilter("ignore", RuntimeWarning)
+                return func(*args, **kwargs)
         except RequestNotMetError as exc:
             raise fail(str(exc), code=3) from None
         except LinkworkError as exc:
             raise fail(str(exc)) from None
+        except RecursionError:
+            raise fail("the input is nested too deeply to be processed") from None
+        except OSError as exc:  # the file system refused (a read-only or full disk, a vanished folder)
+            where = f"{exc.filename}: " if exc.filename else ""
+            raise fail(f"{where}{exc.strerror or exc}", code=3) from None
+        except MemoryError:
+            raise fail("ran out of memory; the request is too large for this machine", code=3) from None
 
     return wrapper
 
@@ -46,7 +73,7 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
     for item in items or []:
         key, sep, raw = item.partition("=")
         if not sep or not key.strip():
-            raise fail(f"{flag} {item!r}: expected KEY=VALUE")
+            raise fail(f"{flag} {show(item)}: expected KEY=VALUE")
         value: Any
         try:
             value = int(raw)
@@ -57,3 +84,14 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
                 value = raw
         out[key.strip()] = value
     return out
+
+
+def check_range(
+    flag: str, value: float, low: float, high: float, what: str, *, open_low: bool = False
+) -> None:
+    """Refuse a flag's value outside ``[low, high]`` (``(low, high]`` with ``open_low``) or not finite, with a
+    message stating the limit."""
+    inside = (low < value if open_low else low <= value) and value <= high
+    if not inside:  # also catches NaN
+        sign = "<" if open_low else "<="
+        raise fail(f"{flag} {show(value)}: expected {what}, {low:g} {sign} {flag} <= {high:g}")

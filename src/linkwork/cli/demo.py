@@ -7,9 +7,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.text import Text
 
 from linkwork.cli.common import friendly_errors
-from linkwork.outputs.staging import console
+from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 
 @friendly_errors
@@ -19,7 +20,18 @@ def demo(
 ) -> None:
     """Deploy Hedgepeth's hexagon from the bundle to the flat hexagon (Figs. 12-13), follow Guest's frame
     through its bifurcations (Figs. 15-16), synthesise and mechanize a morphing wing; write everything with an
-    index.html into --out."""
+    index.html into --out.
+
+    Everything is written into a staging folder and moved into --out at the end: a demo interrupted (Ctrl-C,
+    SIGTERM) or failing leaves --out as it was, its previous complete result or nothing."""
+    check_output_folder(out)
+    with staged_output(out) as stage:
+        _build_demo(stage, no_plots)
+    console.print(f"\nopen {out / 'index.html'} to see every result")
+
+
+def _build_demo(out: Path, no_plots: bool) -> None:
+    """Run the four parts of the demo and write them, with index.html, into ``out`` (the staging folder)."""
     import numpy as np
 
     import linkwork as lw
@@ -29,7 +41,9 @@ def demo(
 
     sections: list[tuple[str, str, Path, list[str]]] = []
 
-    console.rule("[bold]1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)")
+    console.rule(
+        Text("1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)", style="bold")
+    )
     hexagon = lw.load("hedgepeth-rods", n=6)
     inner, outer = deployed_angles(6)
     path = lw.trace(hexagon, until=("A", inner), steps=200)
@@ -50,7 +64,11 @@ def demo(
         )
     )
 
-    console.rule("[bold]2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)")
+    console.rule(
+        Text(
+            "2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)", style="bold"
+        )
+    )
     try:
         frame = lw.load("guest-frame")
     except lw.SpecError:
@@ -72,7 +90,7 @@ def demo(
             )
         )
 
-    console.rule("[bold]3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)")
+    console.rule(Text("3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)", style="bold"))
     try:
         from linkwork.outputs.synthesis import run_synthesis_example
     except ImportError:  # pragma: no cover - synthesis not installed
@@ -93,7 +111,9 @@ def demo(
             )
         )
     if run_synthesis_example is not None:
-        console.rule("[bold]4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)")
+        console.rule(
+            Text("4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)", style="bold")
+        )
         import json
 
         folder = out / "mechanism-wing"
@@ -113,7 +133,6 @@ def demo(
         )
         sections.append(("Mechanized wing (one degree of freedom)", text, folder, figs_m))
     _write_index(out, sections)
-    console.print(f"\nopen {out / 'index.html'} to see every result")
 
 
 #: What each section's interactive viewer lets a reader do.

@@ -15,8 +15,11 @@ from typing import Annotated
 import typer
 
 from linkwork.cli import mechanize_flags as mf
-from linkwork.cli.common import friendly_errors
-from linkwork.outputs.staging import console, staged_output
+from linkwork.cli.common import check_range, friendly_errors
+from linkwork.outputs.staging import check_output_folder, console, staged_output
+
+MAX_DOF = 20
+"""The most degrees of freedom ``--dof`` may ask for (each one more actuator and a search over more dyads)."""
 
 
 @friendly_errors
@@ -77,6 +80,9 @@ def mechanize(
         designs=designs,
         time_limit=time_limit,
     )
+    check_output_folder(out or folder)
+    if dof is not None:
+        check_range("--dof", dof, 1, MAX_DOF, "a whole number of degrees of freedom")
     result = load_synthesis(folder, problem)
     options = resolve_options(result.problem, flags)
     target = out or folder

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.text import Text
 
 from linkwork.cli.common import fail, friendly_errors, parse_assignments
 from linkwork.outputs.staging import console
@@ -121,8 +122,10 @@ def robustness(
         raise SpecError("the nominal path has a single point; give --until or a longer budget")
     setup = prepare(mech, path, model, seed)
     console.print(
-        f"[bold]{mech.name}[/]: nominal path of {setup.u_path.shape[0]} points; {samples} samples "
-        f"(misfit length scale L = {setup.scale.length:.4g})"
+        Text(mech.name, style="bold"),
+        f"nominal path of {setup.u_path.shape[0]} points; {samples} samples "
+        f"(misfit length scale L = {setup.scale.length:.4g})",
+        sep=": ",
     )
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.text import Text
 
 from linkwork.cli.common import fail, friendly_errors
 from linkwork.outputs.staging import console
@@ -41,7 +42,7 @@ def sweep(
         raise fail(f"--workers {workers}: expected 0 or more")
     study = prepare_study(load_study(study_file))
     total = len(study.points())
-    console.print(f"[bold]{study.name}[/]: {study.kind} study of {total} grid point(s)")
+    console.print(Text(study.name, style="bold"), f"{study.kind} study of {total} grid point(s)", sep=": ")
     with Progress(
         TextColumn("grid points"),
         BarColumn(),

@@ -16,7 +16,7 @@ import typer
 from linkwork.cli import mechanize_flags as mf
 from linkwork.cli.common import friendly_errors
 from linkwork.errors import SpecError
-from linkwork.outputs.staging import console, have_matplotlib, staged_output
+from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
 
 
 @friendly_errors
@@ -85,6 +85,7 @@ def synth(
     from linkwork.outputs.synthesis import print_synthesis_summary, write_synthesis_outputs
     from linkwork.synthesis import synthesize
 
+    check_output_folder(out, ["chain.json", "target_profiles.csv", "outline.svg", "outline.dxf"])
     if search not in ("paper", "refined"):
         raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")
     from linkwork.data import problem_file
@@ -127,7 +128,7 @@ def synth(
 
     plots = not no_plots
     if plots and not have_matplotlib():
-        console.print("note: matplotlib is not installed (pip install 'linkwork\\[viz]'): no figures drawn")
+        console.print("note: matplotlib is not installed (pip install 'linkwork[viz]'): no figures drawn")
         plots = False
     with staged_output(out) as stage:
         written = write_synthesis_outputs(result, stage, plots=plots)

@@ -7,13 +7,23 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+from rich.text import Text
 
 from linkwork.cli.common import (
+    check_range,
     fail,
     friendly_errors,
     parse_assignments,
 )
-from linkwork.outputs.staging import console
+from linkwork.errors import RequestNotMetError
+from linkwork.io.toml_reader import show
+from linkwork.outputs.staging import check_output_folder, console
+
+MAX_STEP_DEG = 90.0
+"""The largest ``--max-step`` (degrees)."""
+
+MAX_TRACE_STEPS = 1_000_000
+"""The largest step budget ``--max-steps`` (and ``--steps``): a bound on time and memory."""
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -32,7 +42,7 @@ def _parse_until(text: str | None) -> tuple[str, float] | None:
     except ValueError:
         value = float("nan")
     if not sep or not name.strip() or not math.isfinite(value):
-        raise fail(f"--until {text!r}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
+        raise fail(f"--until {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
     return name.strip(), value
 
 
@@ -65,7 +75,7 @@ def _parse_couple(items: list[str] | None) -> list[list[str]]:
     for item in items or []:
         names = [x.strip() for x in item.split("=")]
         if len(names) < 2 or not all(names):
-            raise fail(f"--couple {item!r}: expected joints joined by '=', e.g. A=C=E")
+            raise fail(f"--couple {show(item)}: expected joints joined by '=', e.g. A=C=E")
         groups.append(names)
     return groups
 
@@ -142,9 +152,13 @@ def trace(
     """
     import numpy as np
 
-    from linkwork.errors import RequestNotMetError
     from linkwork.kinematics.tracer import trace as run_trace
 
+    check_output_folder(out, ["path.csv", "report.json"])
+    check_range("--max-step", max_step, 0.0, MAX_STEP_DEG, "a number of degrees", open_low=True)
+    check_range("--max-steps", max_steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
+    if steps is not None:
+        check_range("--steps", steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
     params = parse_assignments(set_, "--set")
     target = _parse_until(until)
     limits_file = _parse_limits(limit)
@@ -154,8 +168,6 @@ def trace(
     mech = loaded.mechanism
     if couple or fixed:
         mech = mech.with_couplings(_parse_couple(couple), fixed or [])
-    if max_step <= 0:
-        raise fail(f"--max-step {max_step}: expected a positive number of degrees")
     limits = _limits_in_api_units(mech, limits_file)
     until_rad = None
     if target is not None:
@@ -164,7 +176,9 @@ def trace(
         until_rad = (target[0], float(value))
 
     console.print(
-        f"[bold]{mech.name}[/]: {mech.n_joints} joints, {len(mech.loops)} loop(s), {mech.n_unknowns} unknowns"
+        Text(mech.name, style="bold"),
+        f"{mech.n_joints} joints, {len(mech.loops)} loop(s), {mech.n_unknowns} unknowns",
+        sep=": ",
     )
     if loaded.assembly is not None and loaded.assembly.residual_before > 1e-12:
         worst = float(np.degrees(np.max(np.abs(loaded.assembly.correction))))

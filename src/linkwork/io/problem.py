@@ -33,20 +33,17 @@ Example
 from __future__ import annotations
 
 import math
-import tomllib
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 
-from linkwork.errors import SpecError
 from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
+from linkwork.io.toml_reader import TomlReader, escape_line, key_path, read_toml, show
 from linkwork.mechanization.options import OPTION_KEYS, options_from_values
-from linkwork.synthesis.problem import MergeOn, Problem, ProfileKind, RankBy
+from linkwork.synthesis.problem import KINDS, Problem, ProfileKind
 
-KINDS = ("open", "closed", "fixed-end")
-"""The values of ``type``."""
+__all__ = ["KEYS", "KINDS", "REQUIRED", "load_problem"]
 
 KEYS = (
     "type",
@@ -73,148 +70,149 @@ KEYS = (
 REQUIRED = ("profiles", "piece_length", "design")
 """Keys without a default."""
 
-T = TypeVar("T")
 
+def _settings(reader: TomlReader, table: dict[str, Any]) -> dict[str, Any]:
+    """The keyword arguments of :class:`Problem` read from the file's keys, by type only: the ranges are the
+    rules of :class:`Problem` itself, so a file and a script get the same message.
 
-def _show(value: Any) -> str:
-    """A TOML-like rendering of a bad value for an error message."""
-    if isinstance(value, str):
-        return f'"{value}"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    return str(value)
-
-
-class _Keys:
-    """A problem file's table with typed, checked getters that raise :class:`SpecError` naming the key."""
-
-    def __init__(self, table: dict[str, Any], source: str) -> None:
-        self.table = table
-        self.source = source
-
-    def error(self, key: str, message: str) -> SpecError:
-        return SpecError(message, source=self.source, key=key)
-
-    def get(self, key: str, default: T, check: Callable[[Any], T | None], expected: str) -> T:
-        if key not in self.table:
-            if key in REQUIRED:
-                raise self.error(key, f"missing; expected {expected}")
-            return default
-        value = self.table[key]
-        checked = check(value)
-        if checked is None:
-            raise self.error(key, f"expected {expected}, got {_show(value)}")
-        return checked
-
-
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    return float(value) if math.isfinite(value) else None
-
-
-def _positive(value: Any) -> float | None:
-    number = _number(value)
-    return number if number is not None and number > 0.0 else None
-
-
-def _integer(minimum: int) -> Callable[[Any], int | None]:
-    def check(value: Any) -> int | None:
-        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            return None
-        return int(value)
-
-    return check
-
-
-def _boolean(value: Any) -> bool | None:
-    return value if isinstance(value, bool) else None
-
-
-def _string_list(value: Any) -> list[str] | None:
-    if not isinstance(value, list) or not all(isinstance(item, str) and item.strip() for item in value):
-        return None
-    return list(value)
-
-
-def _read_table(path: Path) -> dict[str, Any]:
-    if not path.exists():
-        raise SpecError("file not found; expected a problem file (TOML)", source=str(path))
-    if not path.is_file():
-        raise SpecError("is a folder; expected a problem file (TOML)", source=str(path))
-    try:
-        with path.open("rb") as handle:
-            return tomllib.load(handle)
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(f"not valid TOML ({exc})", source=str(path)) from None
-    except UnicodeDecodeError:
-        raise SpecError("not a UTF-8 text file; expected TOML", source=str(path)) from None
-    except OSError as exc:
-        raise SpecError(f"cannot be read ({exc.strerror})", source=str(path)) from None
-
-
-def _design(keys: _Keys) -> tuple[str | None, int | None]:
-    """``(design, segments)``: a design vector of M and C letters, or ``(None, q)`` for ``"auto"``."""
-    raw = keys.get(
-        "design",
-        "",
-        lambda v: v.strip() if isinstance(v, str) and v.strip() else None,
-        'a design vector of M and C letters such as "MCMC", or "auto"',
-    )
-    segments = keys.get("segments", None, _integer(1), "a whole number of segments >= 1")
-    if raw.lower() == "auto":
-        if segments is None:
-            raise keys.error("segments", 'missing; design = "auto" needs the number of segments q, e.g. 4')
-        return None, segments
-    design = raw.upper()
-    wrong = sorted({letter for letter in design if letter not in "MC"})
-    if wrong:
-        raise keys.error(
-            "design",
-            f'expected a design vector of M and C letters such as "MCMC", or "auto", got "{raw}" '
-            f"(letters {', '.join(wrong)} are not M or C)",
+    Adding a key is one entry here (and in :data:`KEYS`).
+    """
+    settings: dict[str, Any] = {}
+    settings["kind"] = reader.choice(table, "type", "", KINDS, default="open")
+    piece_length = reader.require(table, "piece_length", "", "a positive number")
+    if isinstance(piece_length, bool) or not isinstance(piece_length, int | float):
+        raise reader.error("piece_length", f"expected a positive number, got {show(piece_length)}")
+    settings["piece_length"] = piece_length
+    settings["min_pieces"] = _whole(reader, table, "min_pieces", 2, "a whole number of pieces >= 2")
+    settings["design"], settings["segments"] = _design(reader, table)
+    settings["starts"] = _whole(reader, table, "starts", 5, "a whole number of starts >= 1")
+    merge_below = table.get("merge_below", 0.0)
+    if isinstance(merge_below, bool) or not isinstance(merge_below, int | float):
+        raise reader.error(
+            "merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {show(merge_below)}"
         )
-    if segments is not None and segments != len(design):
-        raise keys.error(
-            "segments",
-            f'is {segments} but design "{design}" has {len(design)} segments; give one or the other',
+    settings["merge_below"] = math.radians(merge_below) if math.isfinite(merge_below) else math.inf
+    settings["seed"] = _whole(reader, table, "seed", 0, "a whole number >= 0")
+    settings["mechanize"] = reader.boolean(table, "mechanize", "", default=False)
+    if "description" in table and not isinstance(table["description"], str):
+        raise reader.error("description", f"expected a string, got {show(table['description'])}")
+    settings["merge_on"] = _one_of(reader, table, "merge_on", ("targets", "chain"))
+    settings["rank_by"] = _one_of(reader, table, "rank_by", ("error", "joints"))
+    tolerance = table.get("e_max_tolerance")
+    if tolerance is not None and (isinstance(tolerance, bool) or not isinstance(tolerance, int | float)):
+        raise reader.error(
+            "e_max_tolerance", f"expected a positive number (profile units), got {show(tolerance)}"
         )
-    return design, len(design)
+    settings["e_max_tolerance"] = tolerance
+    settings["initial_segment_matrix"] = _initial_segment_matrix(reader, table)
+    units = table.get("units")
+    if units is not None and (not isinstance(units, str) or units not in LENGTH_UNITS):
+        raise reader.error("units", f"expected one of {', '.join(LENGTH_UNITS)}, got {show(units)}")
+    settings["units"] = units
+    options = {key: table[key] for key in OPTION_KEYS if key in table}
+    options_from_values(options, source=reader.source)  # checked here: a mistake is found before synthesis
+    settings["mechanize_options"] = options
+    return settings
 
 
-def _initial_segment_matrix(keys: _Keys, profiles: int) -> np.ndarray | None:
+def _one_of(reader: TomlReader, table: dict[str, Any], key: str, choices: tuple[str, ...]) -> str:
+    """One of ``choices`` (the first is the default), in the words of :class:`Problem`'s rule."""
+    value = table.get(key, choices[0])
+    if not isinstance(value, str) or value not in choices:
+        quoted = ", ".join(f'"{c}"' for c in choices)
+        raise reader.error(key, f"expected one of {quoted}, got {show(value)}")
+    return value
+
+
+def _initial_segment_matrix(reader: TomlReader, table: dict[str, Any]) -> np.ndarray | None:
     """``initial_segment_matrix``: as printed in the paper (Eq. 11), one row of whole numbers per profile;
-    returned transposed, ``(q, p)``, as the API holds segment matrices."""
-    raw = keys.get(
-        "initial_segment_matrix",
-        None,
-        lambda v: (
-            v
-            if isinstance(v, list)
-            and v
-            and all(
-                isinstance(row, list)
-                and row
-                and all(isinstance(m, int) and not isinstance(m, bool) for m in row)
-                for row in v
-            )
-            else None
-        ),
-        "a list of rows of whole numbers, one row per profile (the paper's Eq. 11)",
-    )
+    returned transposed, ``(q, p)``, as the API holds segment matrices (the rows are checked against the
+    profiles and the design by :class:`Problem`)."""
+    key = "initial_segment_matrix"
+    raw = table.get(key)
     if raw is None:
         return None
-    if len(raw) != profiles or len({len(row) for row in raw}) != 1:
-        raise keys.error(
-            "initial_segment_matrix",
-            f"has {len(raw)} rows of lengths {sorted({len(row) for row in raw})}; expected {profiles} rows "
+    expected = "a list of rows of whole numbers, one row per profile (the paper's Eq. 11)"
+    rows_ok = isinstance(raw, list) and raw and all(isinstance(row, list) and row for row in raw)
+    whole = rows_ok and all(
+        isinstance(m, int) and not isinstance(m, bool) and 0 <= m <= 10**6 for row in raw for m in row
+    )
+    if not whole:
+        raise reader.error(key, f"expected {expected}, got {show(raw)}")
+    profiles = table.get("profiles")
+    count = len(profiles) if isinstance(profiles, list) else len(raw)
+    if len(raw) != count or len({len(row) for row in raw}) != 1:
+        raise reader.error(
+            key,
+            f"has {len(raw)} rows of lengths {sorted({len(row) for row in raw})}; expected {count} rows "
             "(one per profile) of equal length (one entry per segment)",
         )
     return np.asarray(raw, dtype=np.int64).T
+
+
+def _whole(reader: TomlReader, table: dict[str, Any], key: str, default: int, expected: str) -> Any:
+    """An integer-typed key (its range is checked by :class:`Problem`)."""
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise reader.error(key, f"expected {expected}, got {show(value)}")
+    return value
+
+
+def _design(reader: TomlReader, table: dict[str, Any]) -> tuple[str | None, int | None]:
+    """``(design, segments)``: a design vector of M and C letters, or ``(None, q)`` for ``"auto"``."""
+    expected = 'a design vector of M and C letters such as "MCMC", or "auto"'
+    raw = reader.require(table, "design", "", expected)
+    if not isinstance(raw, str) or not raw.strip():
+        raise reader.error("design", f"expected {expected}, got {show(raw)}")
+    segments = table.get("segments")
+    if segments is not None and (isinstance(segments, bool) or not isinstance(segments, int)):
+        raise reader.error("segments", f"expected a whole number of segments >= 1, got {show(segments)}")
+    if segments is not None and segments < 1:
+        raise reader.error("segments", f"expected a whole number of segments >= 1, got {show(segments)}")
+    if raw.strip().lower() == "auto":
+        return None, segments
+    design = raw.strip().upper()
+    return design, len(design) if segments is None and set(design) <= set("MC") else segments
+
+
+def _profile_files(reader: TomlReader, table: dict[str, Any]) -> list[str]:
+    """The ``profiles`` list of file names."""
+    expected = "a list of at least 2 profile files"
+    files = reader.require(table, "profiles", "", expected)
+    if not isinstance(files, list):
+        raise reader.error("profiles", f"expected {expected}, got {show(files)}")
+    files = reader.string_list(table, "profiles", "", expected=expected, default=None)
+    if len(files) < 2:
+        raise reader.error("profiles", f"lists {len(files)} profile(s); expected at least 2 profiles")
+    return files
+
+
+def _names(reader: TomlReader, table: dict[str, Any], files: list[str]) -> list[str]:
+    """``names``, or the profile files' stems."""
+    expected = f"a list of {len(files)} non-empty names"
+    return reader.string_list(table, "names", "", expected=expected, default=[Path(f).stem for f in files])
+
+
+def _load_profiles(reader: TomlReader, folder: Path, files: list[str], kind: ProfileKind) -> list[Any]:
+    """Each profile file (relative to ``folder``) as a polyline; a closed problem's must return to its start."""
+    profiles = []
+    for index, name in enumerate(files):
+        file = folder / name
+        key = key_path("profiles", index)
+        if not file.is_file():
+            raise reader.error(key, f'file "{escape_line(str(file))}" not found; expected a profile file')
+        points = load_profile(file)
+        if kind == "closed":
+            gap = float(np.hypot(*(points[-1] - points[0])))
+            size = float(np.hypot(*np.ptp(points, axis=0)))
+            if gap > COINCIDENT * size:
+                raise reader.error(
+                    key,
+                    f'{show(name)} does not return to its first point (gap {gap:.6g}); type "closed" expects '
+                    "the curve to end where it starts (repeat the first point at the end)",
+                )
+        profiles.append(points)
+    return profiles
 
 
 def load_problem(path: str | Path) -> Problem:
@@ -235,104 +233,19 @@ def load_problem(path: str | Path) -> Problem:
     ------
     SpecError
         ``file: key: what was expected`` for an unknown key, a missing required key, a value of the wrong type
-        or range, a profile file that is missing, or a closed problem whose profile does not return to its
-        start.
+        or range (the rules of :class:`Problem`), a profile file that is missing, or a closed problem whose
+        profile does not return to its start. Profiles are counted from 0 (``profiles[0]`` is the first).
         An unreadable or malformed profile file is reported naming that file.
     """
     path = Path(path)
-    source = str(path)
-    table = _read_table(path)
-    keys = _Keys(table, source)
-    for key in table:
-        if key not in KEYS:
-            raise keys.error(key, f"unknown key; expected one of {', '.join(KEYS)}")
-
-    kind: ProfileKind = keys.get(
-        "type", "open", lambda v: v if v in KINDS else None, "one of open, closed, fixed-end"
-    )
-    files: list[str] = keys.get("profiles", [], _string_list, "a list of at least 2 profile files")
-    if len(files) < 2:
-        raise keys.error("profiles", f"lists {len(files)} file(s); expected at least 2 profile files")
-    piece_length = keys.get("piece_length", 0.0, _positive, "a positive number")
-    min_pieces = keys.get(
-        "min_pieces", 2, _integer(2), "a whole number of pieces >= 2 (a C-segment needs an interior point)"
-    )
-    design, segments = _design(keys)
-    starts = keys.get("starts", 5, _integer(1), "a whole number of starts >= 1")
-    merge_below_deg = keys.get(
-        "merge_below",
-        0.0,
-        lambda v: v if (n := _number(v)) is not None and 0.0 <= n < 180.0 else None,
-        "an angle in degrees, 0 <= merge_below < 180",
-    )
-    seed = keys.get("seed", 0, _integer(0), "a whole number >= 0")
-    mechanize = keys.get("mechanize", False, _boolean, "true or false")
-    mechanize_options = {key: table[key] for key in OPTION_KEYS if key in table}
-    options_from_values(mechanize_options, source=source)  # checked here: a mistake is found before synthesis
-    merge_on: MergeOn = keys.get(
-        "merge_on", "targets", lambda v: v if v in ("targets", "chain") else None, 'one of "targets", "chain"'
-    )
-    rank_by: RankBy = keys.get(
-        "rank_by", "error", lambda v: v if v in ("error", "joints") else None, 'one of "error", "joints"'
-    )
-    e_max_tolerance = keys.get("e_max_tolerance", None, _positive, "a positive number (profile units)")
-    if rank_by == "joints" and e_max_tolerance is None:
-        raise keys.error("e_max_tolerance", 'missing; rank_by = "joints" needs the largest acceptable E_max')
-    initial_sm = _initial_segment_matrix(keys, len(files))
-    if initial_sm is not None and design is None:
-        raise keys.error("initial_segment_matrix", 'needs a design vector, not design = "auto"')
-    if initial_sm is not None and design is not None and initial_sm.shape[0] != len(design):
-        raise keys.error(
-            "initial_segment_matrix",
-            f'has {initial_sm.shape[0]} entries per row but design "{design}" has {len(design)} segments',
-        )
-    units: str | None = keys.get(
-        "units", None, lambda v: v if v in LENGTH_UNITS else None, f"one of {', '.join(LENGTH_UNITS)}"
-    )
-    keys.get("description", "", lambda v: v if isinstance(v, str) else None, "a string")
-    stems = [Path(name).stem for name in files]
-    names = keys.get("names", stems, _string_list, f"a list of {len(files)} non-empty names")
-    if len(names) != len(files):
-        raise keys.error(
-            "names", f"lists {len(names)} names for {len(files)} profiles; expected one per profile"
-        )
-    if len(set(names)) != len(names):
-        raise keys.error("names", "repeats a name; expected a different name for every profile")
-
-    profiles = []
-    for index, name in enumerate(files, start=1):
-        file = path.parent / name
-        if not file.is_file():
-            raise keys.error(f"profiles[{index}]", f'file "{file}" not found; expected a profile file')
-        points = load_profile(file)
-        if kind == "closed":
-            gap = float(np.hypot(*(points[-1] - points[0])))
-            size = float(np.hypot(*np.ptp(points, axis=0)))
-            if gap > COINCIDENT * size:
-                raise keys.error(
-                    f"profiles[{index}]",
-                    f'"{name}" does not return to its first point (gap {gap:.6g}); type "closed" expects the '
-                    "curve to end where it starts (repeat the first point at the end)",
-                )
-        profiles.append(points)
-
-    return Problem(
-        profiles=tuple(profiles),
-        kind=kind,
-        piece_length=piece_length,
-        min_pieces=min_pieces,
-        design=design,
-        segments=segments,
-        starts=starts,
-        merge_below=math.radians(float(merge_below_deg)),
-        seed=seed,
-        names=tuple(names),
-        source=path,
-        mechanize=mechanize,
-        mechanize_options=mechanize_options,
-        merge_on=merge_on,
-        rank_by=rank_by,
-        e_max_tolerance=e_max_tolerance,
-        initial_segment_matrix=initial_sm,
-        units=units,
-    )
+    table = read_toml(path, "a problem file (TOML)")
+    reader = TomlReader(str(path))
+    reader.check_keys(table, "", KEYS)
+    files = _profile_files(reader, table)
+    settings = _settings(reader, table)
+    names = _names(reader, table, files)
+    # The rules of the problem, checked before the profile files are read (placeholder polylines of length 0
+    # pass every profile rule), so that a bad setting is reported first.
+    Problem(profiles=(np.zeros((2, 2)),) * len(files), names=tuple(names), source=path, **settings)
+    profiles = _load_profiles(reader, path.parent, files, settings["kind"])
+    return Problem(profiles=tuple(profiles), names=tuple(names), source=path, **settings)

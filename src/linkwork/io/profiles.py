@@ -10,40 +10,74 @@ Curved geometry (SVG arcs and Bézier curves, DXF bulges and splines) is flatten
 largest distance from the true curve (the sagitta) is at most ``tolerance`` times the size of the drawing, the
 diagonal of the bounding box of the shape's defining points (vertices and control points). The default,
 :data:`FLATTEN_TOLERANCE`, is ``1e-4``: a curve one unit across is followed to within 0.0001. Every
-vertex of the flattened polyline lies on the true curve (to rounding).
+vertex of the flattened polyline lies on the true curve (to rounding). The checks and the flattening live in
+:mod:`linkwork.io.curves`.
 """
 
 from __future__ import annotations
 
-import itertools
-import math
+import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from linkwork.errors import SpecError
+from linkwork.io.curves import (
+    COINCIDENT,
+    FLATTEN_TOLERANCE,
+    MAX_BULGE,
+    MAX_COORDINATE,
+    MAX_FLATTENED_POINTS,
+    Points,
+    _bulge_polyline,
+    _flatten,
+    _size,
+    _spline_points,
+    check_profile,
+    find_self_crossing,
+    is_closed,
+)
+from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
+from linkwork.io.toml_reader import escape_line
 
 if TYPE_CHECKING:
     from linkwork.synthesis.result import JoinedProfile, SynthesisResult
 
-FLATTEN_TOLERANCE = 1e-4
-"""Largest distance of a flattened piece from the true curve, as a fraction of the drawing's size."""
-
-COINCIDENT = 1e-9
-"""Two consecutive points closer than this fraction of the curve's size count as one repeated point."""
-
-_MAX_DEPTH = 24  # recursion limit of the adaptive flattening: 2**24 pieces per curve segment at most
-
-Points = NDArray[np.float64]
+__all__ = [
+    "COINCIDENT",
+    "FLATTEN_TOLERANCE",
+    "FORMATS",
+    "LENGTH_UNITS",
+    "MAX_BULGE",
+    "MAX_COORDINATE",
+    "MAX_FLATTENED_POINTS",
+    "MAX_PROFILE_BYTES",
+    "ProfileFormat",
+    "check_profile",
+    "final_chain",
+    "find_self_crossing",
+    "is_closed",
+    "load_profile",
+    "new_dxf",
+    "read_profile_csv",
+    "read_profile_dat",
+    "read_profile_dxf",
+    "read_profile_svg",
+    "register_format",
+    "save_profile",
+    "write_outline_dxf",
+    "write_outline_svg",
+    "write_profile_csv",
+    "write_profile_dat",
+    "write_profile_dxf",
+    "write_profile_svg",
+]
 
 _CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier control points
-
-
-# ---------------------------------------------------------------------------------------------------- checks
 
 
 #: Length units a problem file may name (``units = "mm"``): DXF ``$INSUNITS`` code, and the SVG unit and factor
@@ -56,236 +90,6 @@ LENGTH_UNITS: dict[str, tuple[int, str, float]] = {
     "in": (1, "in", 1.0),
     "ft": (2, "in", 12.0),
 }
-
-
-def _size(points: Points) -> float:
-    """The diagonal of the bounding box of ``points`` (1 for a degenerate box: tolerances stay positive)."""
-    if len(points) == 0:
-        return 1.0
-    diagonal = float(np.hypot(*(points.max(axis=0) - points.min(axis=0))))
-    return diagonal if diagonal > 0.0 else 1.0
-
-
-def _fmt_point(point: Sequence[float] | Points) -> str:
-    return f"({float(point[0]):.6g}, {float(point[1]):.6g})"
-
-
-def is_closed(points: ArrayLike) -> bool:
-    """True when the polyline returns to its first point (to :data:`COINCIDENT` of its size).
-
-    Parameters
-    ----------
-    points
-        A polyline of shape ``(N, 2)``.
-    """
-    pts = np.asarray(points, dtype=float)
-    if len(pts) < 3:
-        return False
-    return bool(np.hypot(*(pts[-1] - pts[0])) <= COINCIDENT * _size(pts))
-
-
-def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
-    """The first pair of pieces of a polyline that meet other than at their shared point, or None.
-
-    Piece ``i`` joins points ``i`` and ``i + 1``. Neighbouring pieces may share their common point but must
-    not fold back onto each other; no other two pieces may touch. For a closed polyline (last point equal
-    to the first) the first and last pieces share the closing point, which is not a crossing.
-
-    Parameters
-    ----------
-    points
-        A polyline of shape ``(N, 2)`` with distinct consecutive points.
-
-    Returns
-    -------
-    tuple of int or None
-        ``(i, j)`` with ``i < j``, the indices of two offending pieces, or ``None`` for a simple curve.
-    """
-    pts = np.asarray(points, dtype=float)
-    n_pieces = len(pts) - 1
-    if n_pieces < 2:
-        return None
-    closed = is_closed(pts)
-    length_tol = COINCIDENT * _size(pts)
-    a, b = pts[:-1], pts[1:]
-    direction = b - a
-    piece_length = np.hypot(direction[:, 0], direction[:, 1])
-
-    # Neighbours fold back when they are antiparallel and collinear (a turn of 180 degrees).
-    pairs = [(i, i + 1) for i in range(n_pieces - 1)]
-    if closed and n_pieces > 2:
-        pairs.append((0, n_pieces - 1))
-    for i, j in pairs:
-        cross = direction[i, 0] * direction[j, 1] - direction[i, 1] * direction[j, 0]
-        dot = direction[i] @ direction[j]
-        if abs(cross) <= length_tol * max(piece_length[i], piece_length[j]) and dot < 0.0:
-            return (i, j)
-
-    lo = np.minimum(a, b) - length_tol
-    hi = np.maximum(a, b) + length_tol
-
-    # Sweep along x: after sorting pieces by their left end, piece k can only meet the pieces that start
-    # before it ends, a contiguous run found by searchsorted; the run is short for any curve but a tangle.
-    order = np.argsort(lo[:, 0], kind="stable")
-    run_end = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
-    counts = np.maximum(run_end - np.arange(n_pieces) - 1, 0)
-    offsets = np.cumsum(counts) - counts
-    total = int(counts.sum())
-    batch = 1_000_000
-    for first in range(0, total, batch):
-        flat = np.arange(first, min(first + batch, total))
-        k = np.searchsorted(offsets, flat, side="right") - 1
-        first_piece, other_piece = order[k], order[k + 1 + flat - offsets[k]]
-        i, j = np.minimum(first_piece, other_piece), np.maximum(first_piece, other_piece)
-        keep = (j >= i + 2) & np.all(lo[i] <= hi[j], axis=1) & np.all(lo[j] <= hi[i], axis=1)
-        if closed:
-            keep &= ~((i == 0) & (j == n_pieces - 1))
-        i, j = i[keep], j[keep]
-        hit = _pieces_meet(a[i], b[i], a[j], b[j], length_tol)
-        if hit.any():
-            pick = np.lexsort((j[hit], i[hit]))[0]
-            return (int(i[hit][pick]), int(j[hit][pick]))
-    return None
-
-
-def _pieces_meet(a: Points, b: Points, c: Points, d: Points, length_tol: float) -> NDArray[np.bool_]:
-    """Whether pieces ``a-b`` and ``c-d`` (rows of ``(K, 2)`` arrays) touch; their bounding boxes overlap.
-
-    Each piece's end points must lie on opposite sides of (or on) the other piece's line; "on" means within
-    ``length_tol``. Collinear pieces pass both tests, and their overlapping boxes then mean they overlap.
-    """
-
-    def orient(p: Points, q: Points, r: Points) -> Points:
-        return (q[:, 0] - p[:, 0]) * (r[:, 1] - p[:, 1]) - (q[:, 1] - p[:, 1]) * (r[:, 0] - p[:, 0])
-
-    zero_ab = length_tol * np.hypot(*(b - a).T)
-    zero_cd = length_tol * np.hypot(*(d - c).T)
-    d1, d2 = orient(a, b, c), orient(a, b, d)
-    d3, d4 = orient(c, d, a), orient(c, d, b)
-    straddle_cd = ((d1 <= zero_ab) & (d2 >= -zero_ab)) | ((d1 >= -zero_ab) & (d2 <= zero_ab))
-    straddle_ab = ((d3 <= zero_cd) & (d4 >= -zero_cd)) | ((d3 >= -zero_cd) & (d4 <= zero_cd))
-    return np.asarray(straddle_ab & straddle_cd)
-
-
-def _meeting_point(points: Points, i: int, j: int) -> Points:
-    """Where pieces ``i`` and ``j`` of a polyline meet (their lines' intersection, or a shared end point)."""
-    a, b, c, d = points[i], points[i + 1], points[j], points[j + 1]
-    u, v = b - a, d - c
-    det = u[0] * v[1] - u[1] * v[0]
-    if abs(det) > 1e-300:
-        t = ((c[0] - a[0]) * v[1] - (c[1] - a[1]) * v[0]) / det
-        return a + min(max(t, 0.0), 1.0) * u
-    return c if np.dot(c - a, c - b) <= 0.0 else a
-
-
-def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points:
-    """Check that ``points`` is a usable design profile and return it as a float array of shape ``(N, 2)``.
-
-    A usable profile has at least two points, every coordinate finite, no point repeating the one before it,
-    and does not cross itself (a closed curve may return to its first point).
-
-    Parameters
-    ----------
-    points
-        The polyline, shape ``(N, 2)``.
-    source
-        The file it came from, named in the error message.
-
-    Raises
-    ------
-    SpecError
-        Naming ``source``, what is wrong (1-based point numbers) and what was expected.
-    """
-    where = str(source) if source is not None else None
-    pts = np.asarray(points, dtype=float)
-    if pts.ndim != 2 or pts.shape[1] != 2:
-        if pts.size == 0:
-            raise SpecError("no points; expected a curve of at least 2 points (x, y)", source=where)
-        raise SpecError(f"expected points of shape (N, 2), got shape {pts.shape}", source=where)
-    if len(pts) == 0:
-        raise SpecError("no points; expected a curve of at least 2 points (x, y)", source=where)
-    if len(pts) == 1:
-        raise SpecError(
-            f"a single point {_fmt_point(pts[0])}; expected a curve of at least 2 points", source=where
-        )
-    bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
-    if len(bad):
-        raise SpecError(
-            f"point {bad[0] + 1} is {_fmt_point(pts[bad[0]])}; expected finite numbers", source=where
-        )
-    step = np.hypot(*np.diff(pts, axis=0).T)
-    repeated = np.flatnonzero(step <= COINCIDENT * _size(pts))
-    if len(repeated):
-        i = int(repeated[0])
-        raise SpecError(
-            f"points {i + 1} and {i + 2} repeat {_fmt_point(pts[i])}; expected distinct consecutive points",
-            source=where,
-        )
-    crossing = find_self_crossing(pts)
-    if crossing is not None:
-        i, j = crossing
-        raise SpecError(
-            f"the curve crosses itself: piece {i + 1}-{i + 2} meets piece {j + 1}-{j + 2} at "
-            f"{_fmt_point(_meeting_point(pts, i, j))}; expected a curve that does not overlap itself",
-            source=where,
-        )
-    return pts
-
-
-# ------------------------------------------------------------------------------------------- flattening
-
-
-def _flatten(
-    curve: Callable[[float], tuple[float, float]],
-    tolerance: float,
-    depth: int = 0,
-    t0: float = 0.0,
-    t1: float = 1.0,
-    p0: tuple[float, float] | None = None,
-    p1: tuple[float, float] | None = None,
-) -> list[tuple[float, float]]:
-    """Points of ``curve`` on ``(t0, t1]`` such that no chord strays more than ``tolerance`` from the curve.
-
-    The chord is checked against the curve at a quarter, half and three quarters of its parameter range, and
-    the first two levels always subdivide, so an S-shaped piece whose middle happens to lie on its chord is
-    still followed.
-    """
-    p0 = curve(t0) if p0 is None else p0
-    p1 = curve(t1) if p1 is None else p1
-    if depth >= 2 and depth < _MAX_DEPTH:
-        chord = np.subtract(p1, p0)
-        chord_length = float(np.hypot(*chord))
-        worst = 0.0
-        for s in (0.25, 0.5, 0.75):
-            q = np.subtract(curve(t0 + s * (t1 - t0)), p0)
-            if chord_length > 0.0:
-                along = min(max(float(q @ chord) / chord_length**2, 0.0), 1.0)
-                worst = max(worst, float(np.hypot(*(q - along * chord))))
-            else:
-                worst = max(worst, float(np.hypot(*q)))
-        if worst <= tolerance:
-            return [p1]
-    elif depth >= _MAX_DEPTH:
-        return [p1]
-    tm = 0.5 * (t0 + t1)
-    pm = curve(tm)
-    return _flatten(curve, tolerance, depth + 1, t0, tm, p0, pm) + _flatten(
-        curve, tolerance, depth + 1, tm, t1, pm, p1
-    )
-
-
-def _arc_points(
-    center: tuple[float, float], radius: float, start: float, sweep: float, tolerance: float
-) -> list[tuple[float, float]]:
-    """Points on a circular arc after its start, at equal angles, with sagitta at most ``tolerance``."""
-    if radius <= tolerance:
-        count = 1
-    else:
-        # sagitta r (1 - cos(dphi / 2)) <= tolerance
-        dphi = 2.0 * math.acos(max(-1.0, 1.0 - tolerance / radius))
-        count = max(1, math.ceil(abs(sweep) / dphi))
-    angles = start + sweep * np.arange(1, count + 1) / count
-    return [(center[0] + radius * math.cos(a), center[1] + radius * math.sin(a)) for a in angles]
 
 
 # ---------------------------------------------------------------------------------------------------- CSV
@@ -364,7 +168,8 @@ def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 def write_profile_dat(path: str | Path, points: ArrayLike, name: str | None = None) -> None:
     """Write a profile in Selig format: ``name`` (the file stem by default), then ``x y`` lines."""
     pts = np.asarray(points, dtype=float)
-    title = name if name is not None else Path(path).stem
+    # The title is the first line of a Selig file: line breaks in a name would start the coordinates early.
+    title = " ".join((name if name is not None else Path(path).stem).split()) or "profile"
     lines = [title] + [f"{x: .12g} {y: .12g}" for x, y in pts]
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
@@ -477,7 +282,16 @@ def _svg_document(
 
 
 def _xml_escape(text: str) -> str:
-    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
+    """``text`` as XML character data or attribute value: markup characters escaped, characters XML 1.0 does
+    not allow (control characters but tab, line feed and carriage return) replaced by U+FFFD."""
+    text = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]", "\ufffd", text)
+    return (
+        text.replace("&", "&amp;")
+        .replace("<", "&lt;")
+        .replace(">", "&gt;")
+        .replace('"', "&quot;")
+        .replace("'", "&apos;")
+    )
 
 
 # ---------------------------------------------------------------------------------------------------- DXF
@@ -509,10 +323,7 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     entity = entities[0]
     kind = entity.dxftype()
     if kind == "SPLINE":
-        spline = entity.construction_tool()
-        control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
-        absolute = tolerance * _size(control)
-        return np.array([(v.x, v.y) for v in spline.flattening(absolute, segments=8)], dtype=float)
+        return _spline_points(entity, tolerance, path)
     if kind == "LWPOLYLINE":
         vertices = [(float(x), float(y), float(bulge)) for x, y, bulge in entity.get_points("xyb")]
         closed = bool(entity.closed)
@@ -527,28 +338,6 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
         ]
         closed = bool(entity.is_closed)
     return _bulge_polyline(vertices, closed, tolerance)
-
-
-def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, tolerance: float) -> Points:
-    """Flatten polyline vertices ``(x, y, bulge)`` whose bulge turns the piece after a vertex into an arc."""
-    from ezdxf.math import bulge_to_arc
-
-    if not vertices:
-        return np.empty((0, 2))
-    absolute = tolerance * _size(np.array([v[:2] for v in vertices], dtype=float))
-    chain = [*vertices, vertices[0]] if closed else vertices
-    points = [chain[0][:2]]
-    for (x0, y0, bulge), (x1, y1, _) in itertools.pairwise(chain):
-        if bulge == 0.0 or (x0, y0) == (x1, y1):
-            points.append((x1, y1))
-            continue
-        center, _start, _end, radius = bulge_to_arc((x0, y0), (x1, y1), bulge)
-        sweep = 4.0 * math.atan(bulge)  # included angle; positive bulge turns counter-clockwise
-        begin = math.atan2(y0 - center.y, x0 - center.x)
-        arc = _arc_points((center.x, center.y), radius, begin, sweep, absolute)
-        arc[-1] = (x1, y1)  # land exactly on the next vertex
-        points += arc
-    return np.array(points, dtype=float)
 
 
 def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:
@@ -627,8 +416,9 @@ def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
     radius = 0.006 * _size(np.vstack([t.points for t in result.targets]))
     document = new_dxf(result.problem.units)
     space = document.modelspace()
+    layers = _dxf_layer_names([t.name or f"profile {j + 1}" for j, t in enumerate(result.targets)])
     for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
-        name = _dxf_layer_name(target.name or f"profile {j + 1}")
+        name = layers[j]
         colour = j % 6 + 1  # AutoCAD colour index 1..6
         for suffix in ("target", "chain", "joints"):
             document.layers.add(f"{name}-{suffix}", color=8 if suffix == "target" else colour)
@@ -655,8 +445,26 @@ def _svg_d(points: Points) -> str:
 
 
 def _dxf_layer_name(name: str) -> str:
-    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) become underscores."""
-    return "".join("_" if ch in _DXF_FORBIDDEN else ch for ch in name) or "profile"
+    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) and control characters become
+    underscores, leading and trailing spaces go."""
+    cleaned = "".join("_" if ch in _DXF_FORBIDDEN or ord(ch) < 32 or ord(ch) == 127 else ch for ch in name)
+    return cleaned.strip()[:200] or "profile"
+
+
+def _dxf_layer_names(names: Sequence[str]) -> list[str]:
+    """One distinct layer name per profile: DXF layer names ignore case, and :func:`_dxf_layer_name` can map two
+    names onto one, so a repeat gets ``-2``, ``-3``, ... appended."""
+    out: list[str] = []
+    taken: set[str] = set()
+    for name in names:
+        base = candidate = _dxf_layer_name(name)
+        number = 1
+        while candidate.casefold() in taken:
+            number += 1
+            candidate = f"{base}-{number}"
+        taken.add(candidate.casefold())
+        out.append(candidate)
+    return out
 
 
 _DXF_FORBIDDEN = frozenset('<>/\\":;?*|=`')
@@ -751,7 +559,23 @@ def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> P
     path = Path(path)
     fmt = _format_for(path)
     _check_readable(path)
-    return check_profile(fmt.read(path, tolerance), source=path)
+    if path.stat().st_size > MAX_PROFILE_BYTES:
+        raise SpecError(
+            f"is {path.stat().st_size} bytes, larger than the limit of {MAX_PROFILE_BYTES}; expected a profile",
+            source=str(path),
+        )
+    try:
+        points = fmt.read(path, tolerance)
+    except SpecError as exc:
+        if exc.source is None:
+            raise SpecError(str(exc), source=str(path), key=exc.key) from None
+        raise
+    except Exception as exc:  # a hostile file can make a third-party parser fail in many ways
+        raise SpecError(
+            f"could not be read as a {fmt.name} curve ({type(exc).__name__}: {escape_line(str(exc))[:200]})",
+            source=str(path),
+        ) from None
+    return check_profile(points, source=path)
 
 
 def save_profile(path: str | Path, points: ArrayLike) -> None:

@@ -34,12 +34,10 @@ Example
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import math
 import pkgutil
 import re
-import tomllib
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -51,6 +49,7 @@ import numpy as np
 from linkwork.errors import AssemblyError, SpecError
 from linkwork.geometry import line_twist
 from linkwork.geometry.names import default_joint_name
+from linkwork.io.toml_reader import MAX_NAME_CHARS, TomlReader, closest, key_path, read_toml, show
 from linkwork.kinematics.chains import Assembly, from_dh, from_rods
 from linkwork.kinematics.mechanism import Array, Mechanism
 from linkwork.kinematics.normalization import near_mobility
@@ -74,6 +73,9 @@ JOINT_KEYS = {
 }
 ROD_KEYS = ("phi", "omega", "psi", "v")
 MECHANISM_JOINT_KEYS = ("name", "type", "bodies", "point", "direction", "value")
+
+MAX_JOINTS = 500
+"""The most joints a spec file may declare (a bound on the work of assembling and tracing)."""
 
 MIN_LOOP_JOINTS = 4
 """A closed loop needs at least this many joints to move (a loop of three is a rigid triangle)."""
@@ -100,7 +102,7 @@ _ELSEWHERE = {
 }
 
 #: Joint names end up in CSV headers and in flags such as ``--until A=30`` and ``--couple A=C``.
-_JOINT_NAME = re.compile(r"[^\s=,\"']+")
+_JOINT_NAME = re.compile(r"[^\s=,\"'\x00-\x1f\x7f]+")
 
 
 @dataclass(frozen=True)
@@ -166,7 +168,11 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     table = _read_toml(path)
     reader = _Reader(source)
     reader.check_keys(table, "", TOP_KEYS)
-    name = reader.string(table, "name", "", default=path.stem)
+    name = reader.string(table, "name", "", default=path.stem, limit=MAX_NAME_CHARS)
+    if re.search(r"[\x00-\x08\x0a-\x1f\x7f\u2028\u2029]", name):  # a tab is fine (and valid XML)
+        raise reader.error(
+            "name", f"expected a name without line breaks or control characters, got {_show(name)}"
+        )
     reader.string(table, "description", "", default="")  # free text for the reader
     unit = reader.choice(table, "angles", "", ANGLE_UNITS, default="deg")
     reader.degrees = unit == "deg"
@@ -266,181 +272,19 @@ def _import_builtins() -> None:
 
 def _read_toml(path: Path) -> dict[str, Any]:
     """The parsed file; a syntax error becomes a SpecError naming its line."""
-    what = "expected a linkage spec file (TOML)"
-    if not path.exists():
-        raise SpecError(f"file not found; {what}", source=str(path))
-    if not path.is_file():
-        raise SpecError(f"is a folder; {what}", source=str(path))
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except UnicodeDecodeError:
-        raise SpecError(f"not a UTF-8 text file; {what}", source=str(path)) from None
-    except OSError as exc:
-        raise SpecError(f"cannot be read ({exc.strerror}); {what}", source=str(path)) from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        message = str(exc)
-        match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)
-        if match:
-            where = f"line {match.group(1)}, column {match.group(2)}"
-            message = message[: match.start()]
-        else:
-            where = f"line {text.count(chr(10)) + 1} (end of file)"
-            message = message.replace(" (at end of document)", "")
-        raise SpecError(f"invalid TOML: {message}", source=str(path), key=where) from None
+    return read_toml(path, "a linkage spec file (TOML)")
 
 
-def _show(value: Any) -> str:
-    """A short TOML-like rendering of a bad value for an error message (one line)."""
-    if isinstance(value, str):
-        shown = value if len(value) <= 40 else value[:37] + "..."
-        return '"' + shown.replace("\n", "\\n") + '"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        text = "[" + ", ".join(_show(item) for item in value) + "]"
-        return text if len(text) <= 60 else f"a list of {len(value)}"
-    return str(value)
+_show = show
+_closest = closest
+_key = key_path
 
 
-def _closest(word: str, choices: Sequence[str], cutoff: float = 0.6) -> str | None:
-    """The choice closest to a mistyped ``word`` (ignoring case), or ``None`` when none is close."""
-    lowered = {choice.lower(): choice for choice in choices}
-    if word.lower() in lowered:
-        return lowered[word.lower()]
-    close = difflib.get_close_matches(word.lower(), list(lowered), n=1, cutoff=cutoff)
-    return lowered[close[0]] if close else None
-
-
-def _key(path: str, key: str | int) -> str:
-    """Join a key path: ``loop`` and ``joints`` give ``loop.joints``, then 2 gives ``loop.joints[2]``."""
-    if isinstance(key, int):
-        return f"{path}[{key}]"
-    return f"{path}.{key}" if path else key
-
-
-class _Reader:
-    """Typed getters over the parsed tables that raise one-line :class:`SpecError`\\ s naming file and key."""
+class _Reader(TomlReader):
+    """The spec file's reader: :class:`TomlReader` plus joints, joint names and couplings."""
 
     def __init__(self, source: str) -> None:
-        self.source = source
-        self.degrees = True
-
-    def error(self, key: str, message: str) -> SpecError:
-        return SpecError(message, source=self.source, key=key or None)
-
-    def table(self, value: Any, path: str, allowed: Sequence[str], form: str | None = None) -> dict[str, Any]:
-        """``value`` checked to be a table with only ``allowed`` keys."""
-        if not isinstance(value, dict):
-            raise self.error(path, f"expected a table{f' {form}' if form else ''}, got {_show(value)}")
-        self.check_keys(value, path, allowed)
-        return value
-
-    def check_keys(self, table: Mapping[str, Any], path: str, allowed: Sequence[str]) -> None:
-        for key in table:
-            if key in allowed:
-                continue
-            close = _closest(key, allowed)
-            hint = f'did you mean "{close}"? ' if close else ""
-            elsewhere = _ELSEWHERE.get(key)
-            where = f' ("{key}" belongs in {elsewhere})' if elsewhere and not close else ""
-            raise self.error(
-                _key(path, key), f"unknown key; {hint}expected one of {', '.join(allowed)}{where}"
-            )
-
-    def require(self, table: Mapping[str, Any], key: str, path: str, expected: str) -> Any:
-        if key not in table:
-            raise self.error(_key(path, key), f"missing; expected {expected}")
-        return table[key]
-
-    def string(self, table: Mapping[str, Any], key: str, path: str, *, default: str) -> str:
-        if key not in table:
-            return default
-        value = table[key]
-        if not isinstance(value, str) or not value.strip():
-            raise self.error(_key(path, key), f"expected a non-empty string, got {_show(value)}")
-        return value
-
-    def choice(
-        self, table: Mapping[str, Any], key: str, path: str, choices: Sequence[str], *, default: str
-    ) -> str:
-        if key not in table:
-            return default
-        value = table[key]
-        if not isinstance(value, str) or value not in choices:
-            quoted = " or ".join(f'"{c}"' for c in choices)
-            if len(choices) > 2:
-                quoted = "one of " + ", ".join(f'"{c}"' for c in choices)
-            close = _closest(value, choices, cutoff=0.5) if isinstance(value, str) else None
-            hint = f' (did you mean "{close}"?)' if close else ""
-            raise self.error(_key(path, key), f"expected {quoted}, got {_show(value)}{hint}")
-        return value
-
-    def boolean(self, table: Mapping[str, Any], key: str, path: str, *, default: bool) -> bool:
-        if key not in table:
-            return default
-        value = table[key]
-        if not isinstance(value, bool):
-            raise self.error(_key(path, key), f"expected true or false, got {_show(value)}")
-        return value
-
-    def number(
-        self,
-        table: Mapping[str, Any],
-        key: str,
-        path: str,
-        *,
-        default: float | None = None,
-        angle: bool = False,
-        required: str | None = None,
-    ) -> float:
-        """A finite number (an angle is converted to radians when the file is in degrees)."""
-        if key not in table:
-            if default is None:
-                raise self.error(_key(path, key), f"missing; expected {required or 'a number'}")
-            return default
-        value = self.scalar(table[key], _key(path, key))
-        return math.radians(value) if angle and self.degrees else value
-
-    def scalar(self, value: Any, key: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.error(key, f"expected a number, got {_show(value)}")
-        if not math.isfinite(value):
-            raise self.error(key, f"expected a finite number, got {_show(value)}")
-        return float(value)
-
-    def vector(
-        self,
-        table: Mapping[str, Any],
-        key: str,
-        path: str,
-        *,
-        sizes: Sequence[int] = (3,),
-        nonzero: bool = False,
-        default: Sequence[float] | None = None,
-    ) -> Array:
-        """A list of finite numbers of one of the allowed ``sizes``."""
-        full = _key(path, key)
-        shapes = " or ".join(f"[{', '.join('xyz'[:n])}]" for n in sizes)
-        counts = " or ".join(str(n) for n in sizes)
-        if key not in table:
-            if default is None:
-                raise self.error(full, f"missing; expected a list of {counts} numbers {shapes}")
-            return np.asarray(default, dtype=float)
-        value = table[key]
-        if not isinstance(value, list):
-            raise self.error(full, f"expected a list of {counts} numbers {shapes}, got {_show(value)}")
-        if len(value) not in sizes:
-            raise self.error(
-                full, f"expected a list of {counts} numbers {shapes}, got a list of {len(value)}"
-            )
-        out = np.array([self.scalar(item, _key(full, i)) for i, item in enumerate(value)])
-        if nonzero and not np.linalg.norm(out) > 0.0:
-            raise self.error(full, f"expected a non-zero direction vector, got {_show(value)}")
-        return out
+        super().__init__(source, elsewhere=_ELSEWHERE)
 
     def joint_list(self, section: Mapping[str, Any], path: str) -> list[Any]:
         """The ``[[path.joints]]`` array of tables."""
@@ -449,6 +293,8 @@ class _Reader:
             raise self.error(
                 _key(path, "joints"), f"expected an array of tables [[{path}.joints]], got {_show(joints)}"
             )
+        if len(joints) > MAX_JOINTS:
+            raise self.error(_key(path, "joints"), f"expected at most {MAX_JOINTS} joints, got {len(joints)}")
         return joints
 
     def joint_names(self, joints: Sequence[Mapping[str, Any]], path: str) -> list[str]:
@@ -458,6 +304,10 @@ class _Reader:
         for i, joint in enumerate(joints):
             key = _key(_key(path, i), "name")
             name = joint.get("name", default_joint_name(i))
+            if isinstance(name, str) and len(name) > MAX_NAME_CHARS:
+                raise self.error(
+                    key, f"expected a joint name of at most {MAX_NAME_CHARS} characters, got {len(name)}"
+                )
             if not isinstance(name, str) or not _JOINT_NAME.fullmatch(name):
                 raise self.error(
                     key, f"expected a joint name without spaces, quotes, '=' or ',', got {_show(name)}"

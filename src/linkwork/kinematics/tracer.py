@@ -257,7 +257,8 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], reason: str,
     revolute = mech.joint_types[j] == "R"
 
     def show(x: float) -> str:
-        return f"{np.degrees(x):.2f} deg" if revolute else f"{x:.6g}"
+        deg = float(np.degrees(x))
+        return (f"{deg:.2f} deg" if abs(deg) < 1e6 else f"{deg:.6g} deg") if revolute else f"{x:.6g}"
 
     lo, hi = float(np.min(angles[:, j])), float(np.max(angles[:, j]))
     span = f"[{np.degrees(lo):.2f}, {np.degrees(hi):.2f}] deg" if revolute else f"[{lo:.6g}, {hi:.6g}]"

@@ -36,6 +36,10 @@ def dh_loop_residual(thetas: ArrayLike, links: Sequence[Link]) -> Array:
     return log_se3(g)
 
 
+ASSEMBLY_BUDGET = 4000
+"""The most closure-residual evaluations :func:`solve_start` spends looking for an assembly."""
+
+
 def solve_start(
     name: str,
     links: Sequence[Link],
@@ -53,7 +57,10 @@ def solve_start(
     """
     rng = np.random.default_rng(20050301)
     best = np.inf
+    spent, started = 0, 0
     for _ in range(tries):
+        if spent >= ASSEMBLY_BUDGET:
+            break  # a stated bound on the search: a loop that does not close is reported in seconds
         x0 = rng.uniform(-np.pi, np.pi, n_unknowns)
         fit = least_squares(
             lambda x: dh_loop_residual(expand(theta, x), links),
@@ -62,7 +69,9 @@ def solve_start(
             xtol=1e-15,
             ftol=1e-15,
             gtol=1e-15,
+            max_nfev=100,
         )
+        spent, started = spent + fit.nfev, started + 1
         residual = float(np.linalg.norm(fit.fun))
         best = min(best, residual)
         if residual < tolerance:
@@ -70,7 +79,8 @@ def solve_start(
             return np.pi - np.mod(np.pi - thetas, 2.0 * np.pi)  # into (-pi, pi]
     raise AssemblyError(
         f"{name}: no assembly found with joint A at {np.degrees(theta):.6g} deg (smallest closure residual "
-        f"{best:.3g} over {tries} starts); try another start angle theta",
+        f"{best:.3g} over {started} starts, a budget of {ASSEMBLY_BUDGET} residual evaluations); try another "
+        "start angle theta",
         residual=best,
     )
 

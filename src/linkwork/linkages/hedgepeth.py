@@ -16,7 +16,7 @@ from linkwork.errors import SpecError
 from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.chains import from_rods
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.linkages.registry import LinkageEntry, Param, register
+from linkwork.linkages.registry import MAX_RODS, LinkageEntry, Param, register
 
 
 def hedgepeth_angles(n: int) -> dict[str, float]:
@@ -82,6 +82,14 @@ register(
         build=lambda n: hedgepeth(int(n)),
         summary="Hedgepeth's hoop from Sec. 3's equations as printed (Gan & Pellegrino 2006); for n >= 6 it does "
         "not open flat: see hedgepeth-rods",
-        params={"n": Param(6, "int", "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry")},
+        params={
+            "n": Param(
+                6,
+                "int",
+                "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry",
+                low=4,
+                high=MAX_RODS,
+            )
+        },
     )
 )

@@ -35,7 +35,7 @@ from linkwork.errors import SpecError
 from linkwork.geometry import line_twist
 from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.linkages.registry import LinkageEntry, Param, register
+from linkwork.linkages.registry import MAX_RODS, LinkageEntry, Param, register
 
 Array = NDArray[np.float64]
 
@@ -122,6 +122,14 @@ register(
         name="hedgepeth-rods",
         build=lambda n: hedgepeth_rods(int(n)),
         summary="Hedgepeth's hoop built from mitred triangular rods: bundle to flat n-gon (physical model)",
-        params={"n": Param(6, "int", "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry")},
+        params={
+            "n": Param(
+                6,
+                "int",
+                "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry",
+                low=4,
+                high=MAX_RODS,
+            )
+        },
     )
 )

@@ -6,6 +6,7 @@ Parameters are given to constructors in API units (radians); ``unit = "deg"`` ma
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -13,16 +14,33 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import SpecError
+from linkwork.io.toml_reader import show
 from linkwork.kinematics.mechanism import Mechanism
+
+MAX_RODS = 100
+"""The largest ``n`` of a built-in hoop (Hedgepeth's n rods)."""
+
+#: The range of a parameter in file units, by unit, unless the parameter states its own: lengths within
+#: +-1e6, angles within +-720 degrees, whole numbers from 0 to 1000.
+DEFAULT_BOUNDS = {"length": (-1e6, 1e6), "deg": (-720.0, 720.0), "int": (0, 1000)}
 
 
 @dataclass(frozen=True)
 class Param:
-    """One parameter of a built-in linkage: default (API units), unit (``"deg"``, ``"length"``, ``"int"``), help."""
+    """One parameter of a built-in linkage: default (API units), unit (``"deg"``, ``"length"``, ``"int"``), help,
+    and the range ``[low, high]`` a given value must be in (file units; :data:`DEFAULT_BOUNDS` when ``None``)."""
 
     default: float | int
     unit: str
     help: str
+    low: float | None = None
+    high: float | None = None
+
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """``(low, high)`` in file units (degrees for angles)."""
+        low, high = DEFAULT_BOUNDS[self.unit]
+        return (low if self.low is None else self.low, high if self.high is None else self.high)
 
 
 @dataclass(frozen=True)
@@ -35,28 +53,38 @@ class LinkageEntry:
     params: Mapping[str, Param] = field(default_factory=dict)
 
     def make(self, **given: Any) -> Mechanism:
-        """Build with ``given`` parameters in FILE units (degrees for angles), checking names and types."""
+        """Build with ``given`` parameters in FILE units (degrees for angles), checking names, types and ranges.
+
+        This is the one place a built-in's ``--set`` values are validated: each must be a finite number within
+        its parameter's :attr:`Param.bounds` (a whole number for ``"int"``); the message states the range.
+        """
         unknown = sorted(set(given) - set(self.params))
         if unknown:
             expected = ", ".join(self.params) or "no parameters"
-            raise SpecError(f"{self.name}: unknown parameter {unknown[0]!r}; expected {expected}")
+            raise SpecError(
+                f"{self.name}: unknown parameter {show(unknown[0])}; expected {expected}", key="--set"
+            )
         kwargs: dict[str, Any] = {}
         for key, param in self.params.items():
-            if key not in given:
-                kwargs[key] = param.default
-                continue
-            value = given[key]
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise SpecError(f"{self.name}: parameter {key!r} expected a number, got {value!r}")
-            if param.unit == "int":
-                if float(value) != int(value):
-                    raise SpecError(f"{self.name}: parameter {key!r} expected a whole number, got {value!r}")
-                kwargs[key] = int(value)
-            elif param.unit == "deg":
-                kwargs[key] = float(np.radians(value))
-            else:
-                kwargs[key] = float(value)
+            kwargs[key] = param.default if key not in given else self._checked(key, param, given[key])
         return self.build(**kwargs)
+
+    def _checked(self, key: str, param: Param, value: Any) -> float | int:
+        """``value`` (file units) checked against ``param`` and converted to API units."""
+        low, high = param.bounds
+        unit = " deg" if param.unit == "deg" else ""
+        what = "a whole number" if param.unit == "int" else "a finite number"
+        expected = f"expected {what} from {low:g} to {high:g}{unit}"
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise SpecError(f"{self.name}: parameter {key} {expected}, got {show(value)}", key="--set")
+        number = float(value) if isinstance(value, float) or abs(value) < 10**300 else math.inf
+        if not (math.isfinite(number) and low <= number <= high):
+            raise SpecError(f"{self.name}: parameter {key} {expected}, got {show(value)}", key="--set")
+        if param.unit == "int":
+            if number != int(number):
+                raise SpecError(f"{self.name}: parameter {key} {expected}, got {show(value)}", key="--set")
+            return int(number)
+        return math.radians(number) if param.unit == "deg" else number
 
     def file_defaults(self) -> dict[str, float | int]:
         """Defaults in file units (degrees for angles)."""

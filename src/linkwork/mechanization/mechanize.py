@@ -203,8 +203,11 @@ def mechanize(
         chain = build_chain(result)
         source = result.problem.source
         label = name or (f"{source.parent.name} mechanized" if source is not None else "mechanized chain")
-    if chain.count < 2:
-        raise MechanizationError("mechanize: needs at least two profiles to move between")
+    if chain.count < 3:
+        raise MechanizationError(
+            f"mechanize: needs at least three profiles, got {chain.count}: rigid-body guidance places each pivot "
+            "through three or more positions of a body (Sec. 7)"
+        )
     # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
     # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
     modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)

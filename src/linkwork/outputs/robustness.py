@@ -115,7 +115,7 @@ def run_and_write_robustness(
 
                 figures = write_robustness_figures(result, summary, stage)
             else:
-                console.print("figures skipped: install the plotting extra, pip install 'linkwork\\[viz]'")
+                console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
     return result, [Path(out) / f.name for f in figures]
 
 

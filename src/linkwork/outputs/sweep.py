@@ -79,7 +79,7 @@ def write_sweep_outputs(
                 )
                 write_robustness_figures(res, summary, folder)
         elif plots:
-            console.print("figures skipped: install the plotting extra, pip install 'linkwork\\[viz]'")
+            console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
     return [Path(out) / f.name for f in figures]
 
 

@@ -10,10 +10,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from rich.text import Text
 
 from linkwork.data import example
 from linkwork.errors import SpecError
-from linkwork.outputs.staging import console, have_matplotlib
+from linkwork.io.toml_reader import MAX_FILE_BYTES, escape_line, show
+from linkwork.outputs.staging import console, have_matplotlib, staged_output
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -73,14 +75,13 @@ def run_synthesis_example(
     problem_file = example(name, file)
     problem = load_problem(problem_file)
     result = synthesize(problem)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copytree(problem_file.parent, out_dir / "problem", dirs_exist_ok=True)
-    write_synthesis_outputs(result, out_dir, plots=plots and have_matplotlib())
-    if problem.mechanize:
-        from linkwork.outputs.mechanization import mechanize_into
+    with staged_output(Path(out_dir)) as stage:
+        shutil.copytree(problem_file.parent, stage / "problem")
+        write_synthesis_outputs(result, stage, plots=plots and have_matplotlib())
+        if problem.mechanize:
+            from linkwork.outputs.mechanization import mechanize_into
 
-        mechanize_into(result, out_dir, plots=plots and have_matplotlib())
+            mechanize_into(result, stage, plots=plots and have_matplotlib())
     return result
 
 
@@ -103,20 +104,44 @@ def load_synthesis(folder: Path, problem: Path | None = None) -> SynthesisResult
         raise SpecError(
             f"{folder}: no problem file at {problem}; pass the problem the chain came from with --problem"
         )
-    saved = json.loads(chain_file.read_text(encoding="utf-8"))
+    design, e_max = _read_chain_json(chain_file)
     result = synthesize(load_problem(problem))
-    same = saved.get("design") == result.design and math.isclose(
-        float(saved.get("joined", {}).get("e_max", math.nan)),
-        result.joined_e_max,
-        rel_tol=1e-9,
-        abs_tol=1e-12,
-    )
+    same = design == result.design and math.isclose(e_max, result.joined_e_max, rel_tol=1e-9, abs_tol=1e-12)
     if not same:
         raise SpecError(
-            f"{chain_file}: the chain (design {saved.get('design')}) is not what {problem} gives now "
+            f"{chain_file}: the chain (design {show(design)}) is not what {problem} gives now "
             f"(design {result.design}); run `linkwork synth` again"
         )
     return result
+
+
+def _read_chain_json(chain_file: Path) -> tuple[str, float]:
+    """``(design, joined E_max)`` of a ``chain.json``; anything else than the contract is a :class:`SpecError`."""
+    expected = "expected the chain.json that `linkwork synth` writes"
+    if chain_file.stat().st_size > MAX_FILE_BYTES:
+        raise SpecError(f"larger than {MAX_FILE_BYTES} bytes; {expected}", source=str(chain_file))
+    try:
+        saved = json.loads(chain_file.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SpecError(f"not a UTF-8 text file; {expected}", source=str(chain_file)) from None
+    except (ValueError, RecursionError) as exc:
+        raise SpecError(
+            f"not valid JSON ({escape_line(str(exc))}); {expected}", source=str(chain_file)
+        ) from None
+    if not isinstance(saved, dict):
+        raise SpecError(f"holds {show(saved)}, not an object; {expected}", source=str(chain_file))
+    design = saved.get("design")
+    if not isinstance(design, str):
+        raise SpecError(
+            f"expected a design vector string, got {show(design)}", source=str(chain_file), key="design"
+        )
+    joined = saved.get("joined")
+    if not isinstance(joined, dict):
+        raise SpecError(f"expected an object, got {show(joined)}", source=str(chain_file), key="joined")
+    e_max = joined.get("e_max")
+    if isinstance(e_max, bool) or not isinstance(e_max, int | float):
+        raise SpecError(f"expected a number, got {show(e_max)}", source=str(chain_file), key="joined.e_max")
+    return design, float(e_max)
 
 
 def _table(title: str) -> Table:
@@ -155,7 +180,8 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
     problem = result.problem
     searched = "given" if problem.design else f"best of every design vector of {problem.segments} segments"
     console.print(
-        f"[bold]design[/] {result.design} ({searched}); {problem.kind} profiles, piece length "
+        Text("design", style="bold"),
+        f"{result.design} ({searched}); {problem.kind} profiles, piece length "
         f"{problem.piece_length:g}, at least {problem.min_pieces} pieces per segment; "
         f"{result.stats.starts} starts, {result.stats.seconds:.2f} s",
         highlight=False,

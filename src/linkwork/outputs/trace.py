@@ -47,7 +47,7 @@ def write_trace_outputs(
                     motion = animate_path(path, stage / "motion.gif")
                     figures += [f for f in (motion.gif, motion.mp4) if f is not None]
             else:
-                console.print("figures skipped: install the plotting extra, pip install 'linkwork\\[viz]'")
+                console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
         if html:
             from linkwork.viz.viewer import write_trace_viewer
 

@@ -15,7 +15,6 @@ Every grid is the full product of its lists, in the order written (the last para
 from __future__ import annotations
 
 import itertools
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import SpecError
+from linkwork.io.toml_reader import TomlReader, read_toml, show
 
 SYNTHESIS_KEYS = ("piece_length", "segments", "design", "min_pieces", "starts", "merge_below")
 TOP_KEYS = ("name", "description", "linkage", "spec", "problem", "trace", "grid", "robustness")
@@ -85,12 +85,13 @@ class Study:
         return out
 
 
+MAX_GRID_POINTS = 100_000
+"""The most grid points a study may have (the product of every parameter's number of values)."""
+
+
 def _check_keys(table: dict[str, Any], allowed: tuple[str, ...], where: str, source: str) -> None:
-    for key in table:
-        if key not in allowed:
-            raise SpecError(
-                f"unknown key; expected one of {', '.join(allowed)}", source=source, key=f"{where}{key}"
-            )
+    """Refuse an unknown key, with a did-you-mean hint (the one TOML reader's rule)."""
+    TomlReader(source).check_keys(table, where.rstrip("."), allowed)
 
 
 def _grid_values(value: Any, key: str, source: str) -> list[Any]:
@@ -106,9 +107,15 @@ def _grid_values(value: Any, key: str, source: str) -> list[Any]:
             raise SpecError(
                 "expected { from = A, to = B, count = N } with numbers", source=source, key=f"grid.{key}"
             ) from None
-        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_GRID_POINTS:
             raise SpecError(
-                f"count must be a whole number >= 1, got {count!r}", source=source, key=f"grid.{key}"
+                f"count must be a whole number from 1 to {MAX_GRID_POINTS}, got {show(count)}",
+                source=source,
+                key=f"grid.{key}",
+            )
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise SpecError(
+                f"expected finite from and to, got {lo} and {hi}", source=source, key=f"grid.{key}"
             )
         return [float(x) for x in np.linspace(lo, hi, count)]
     return [value]
@@ -149,14 +156,7 @@ def load_study(path: str | Path) -> Study:
     """Read and check a study file; paths in it are relative to it."""
     path = Path(path)
     source = str(path)
-    try:
-        table = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SpecError("no such study file", source=source) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecError(f"cannot read: {exc}", source=source) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(f"not valid TOML: {exc}", source=source) from None
+    table = read_toml(path, "a study file (TOML)")
     _check_keys(table, TOP_KEYS, "", source)
     given = [k for k in ("linkage", "spec", "problem") if k in table]
     if len(given) != 1:
@@ -165,6 +165,11 @@ def load_study(path: str | Path) -> Study:
     if not isinstance(grid_table, dict):
         raise SpecError("expected a table of parameters", source=source, key="grid")
     grid = {key: _grid_values(value, key, source) for key, value in grid_table.items()}
+    total = int(np.prod([len(values) for values in grid.values()], dtype=float)) if grid else 1
+    if total > MAX_GRID_POINTS:
+        raise SpecError(
+            f"has {total} grid points; expected at most {MAX_GRID_POINTS}", source=source, key="grid"
+        )
     name = str(table.get("name", path.stem))
     if given[0] == "problem":
         _check_keys(grid, SYNTHESIS_KEYS, "grid.", source)

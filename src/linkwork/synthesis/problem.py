@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -10,9 +11,29 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.errors import SpecError
+from linkwork.io.toml_reader import MAX_NAME_CHARS, show
+
 ProfileKind = Literal["open", "closed", "fixed-end"]
 RankBy = Literal["error", "joints"]
 MergeOn = Literal["targets", "chain"]
+
+KINDS: tuple[ProfileKind, ...] = ("open", "closed", "fixed-end")
+"""The values of ``kind`` (``type`` in a problem file)."""
+
+MAX_STARTS = 1000
+"""The most initial segment matrices one design vector's search may start from."""
+
+MAX_AUTO_SEGMENTS = 10
+"""The most segments ``q`` of an exhaustive search (``design = "auto"`` tries all ``2**q`` design vectors)."""
+
+MAX_SEARCHES = 20_000
+"""The most segment-matrix searches one synthesis may run: design vectors tried (``2**segments`` for
+``design = "auto"``, else 1) times ``starts``."""
+
+MAX_PIECES = 2000
+"""The most pieces ``m_j = ceil(C_j / s_d)`` of a target profile (Eq. 3): ``piece_length`` must be at least
+the longest profile's arc length divided by this."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +108,188 @@ class Problem:
     initial_segment_matrix: NDArray[np.int64] | None = None
     units: str | None = None
 
+    def __post_init__(self) -> None:
+        """Check every rule of a problem; a broken one is a :class:`SpecError` naming the problem file's key
+        with the same words as the file reader."""
+        for key, message in _broken_rules(self):
+            raise SpecError(message, source=None if self.source is None else str(self.source), key=key)
+
     @property
     def count(self) -> int:
         """``p``, the number of design profiles."""
         return len(self.profiles)
+
+
+def _real(value: Any) -> bool:
+    """A number (``True`` and ``False`` are not)."""
+    return isinstance(value, int | float | np.integer | np.floating) and not isinstance(
+        value, bool | np.bool_
+    )
+
+
+def _whole(value: Any, minimum: int, maximum: int | None = None) -> bool:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        return False
+    return bool(minimum <= value and (maximum is None or value <= maximum))
+
+
+def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
+    """``(key, message)`` of the first broken rule of ``problem`` (empty when it is sound); keys and units are
+    those of the problem file (degrees for ``merge_below``), profiles are counted from 0."""
+    p = problem
+    if p.kind not in KINDS:
+        return [("type", f'expected one of "open", "closed", "fixed-end", got {show(p.kind)}')]
+    if len(p.profiles) < 2:
+        return [("profiles", f"lists {len(p.profiles)} profile(s); expected at least 2 profiles")]
+    if not (_real(p.piece_length) and math.isfinite(p.piece_length) and p.piece_length > 0):
+        return [("piece_length", f"expected a positive number, got {show(p.piece_length)}")]
+    if not _whole(p.min_pieces, 2):
+        return [
+            (
+                "min_pieces",
+                "expected a whole number of pieces >= 2 (a C-segment needs an interior point), "
+                f"got {show(p.min_pieces)}",
+            )
+        ]
+    broken = _design_rules(p)
+    if broken:
+        return broken
+    if not _whole(p.starts, 1, MAX_STARTS):
+        return [
+            (
+                "starts",
+                f"expected a whole number of starts, 1 <= starts <= {MAX_STARTS}, got {show(p.starts)}",
+            )
+        ]
+    auto = p.design is None or (isinstance(p.design, str) and p.design.strip().lower() == "auto")
+    searches = (2 ** int(p.segments or 1) if auto else 1) * int(p.starts)
+    if searches > MAX_SEARCHES:
+        return [
+            (
+                "starts",
+                f'design "auto" with segments = {p.segments} and starts = {p.starts} is {searches} searches of the '
+                f"segment matrix; expected at most {MAX_SEARCHES} (fewer segments or starts)",
+            )
+        ]
+    merge = p.merge_below
+    if not (_real(merge) and 0.0 <= merge < math.pi):
+        shown = f"{math.degrees(merge):g}" if _real(merge) else show(merge)
+        return [("merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {shown}")]
+    if not _whole(p.seed, 0):
+        return [("seed", f"expected a whole number >= 0, got {show(p.seed)}")]
+    return _ranking_rules(p) or _name_rules(p) or _profile_rules(p)
+
+
+def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
+    """``merge_on``, ``rank_by`` with its ``e_max_tolerance``, and an initial segment matrix's design."""
+    from linkwork.io.profiles import LENGTH_UNITS
+
+    if p.units is not None and (not isinstance(p.units, str) or p.units not in LENGTH_UNITS):
+        return [("units", f"expected one of {', '.join(LENGTH_UNITS)}, got {show(p.units)}")]
+    if p.merge_on not in ("targets", "chain"):
+        return [("merge_on", f'expected one of "targets", "chain", got {show(p.merge_on)}')]
+    if p.rank_by not in ("error", "joints"):
+        return [("rank_by", f'expected one of "error", "joints", got {show(p.rank_by)}')]
+    tol = p.e_max_tolerance
+    if tol is not None and not (_real(tol) and math.isfinite(tol) and tol > 0):
+        return [("e_max_tolerance", f"expected a positive number (profile units), got {show(tol)}")]
+    if p.rank_by == "joints" and tol is None:
+        return [("e_max_tolerance", 'missing; rank_by = "joints" needs the largest acceptable E_max')]
+    sm = p.initial_segment_matrix
+    if sm is not None:
+        design = (p.design or "").strip()
+        if not design or design.lower() == "auto":
+            return [("initial_segment_matrix", 'needs a design vector, not design = "auto"')]
+        rows = np.asarray(sm).shape[0] if np.asarray(sm).ndim == 2 else -1
+        if rows != len(design):
+            return [
+                (
+                    "initial_segment_matrix",
+                    f'has {rows} entries per row but design "{design.upper()}" has {len(design)} segments',
+                )
+            ]
+    return []
+
+
+def _design_rules(p: Problem) -> list[tuple[str, str]]:
+    """The design vector and the number of segments."""
+    expected = 'a design vector of M and C letters such as "MCMC", or "auto"'
+    auto = p.design is None or (isinstance(p.design, str) and p.design.strip().lower() == "auto")
+    if auto:
+        if p.segments is None:
+            return [("segments", 'missing; design = "auto" needs the number of segments q, e.g. 4')]
+        if not _whole(p.segments, 1, MAX_AUTO_SEGMENTS):
+            return [
+                (
+                    "segments",
+                    f"expected a whole number of segments, 1 <= segments <= {MAX_AUTO_SEGMENTS} for design "
+                    f'"auto" (an exhaustive search over 2**segments design vectors), got {show(p.segments)}',
+                )
+            ]
+        return []
+    if not isinstance(p.design, str) or not p.design.strip():
+        return [("design", f"expected {expected}, got {show(p.design)}")]
+    design = p.design.strip().upper()
+    wrong = sorted({letter for letter in design if letter not in "MC"})
+    if wrong:
+        letters = show(", ".join(wrong))[1:-1]
+        return [("design", f"expected {expected}, got {show(p.design)} (letters {letters} are not M or C)")]
+    if p.segments is not None and p.segments != len(design):
+        return [
+            (
+                "segments",
+                f'is {show(p.segments)} but design "{design}" has {len(design)} segments; give one or the other',
+            )
+        ]
+    return []
+
+
+def _name_rules(p: Problem) -> list[tuple[str, str]]:
+    """One distinct, non-empty name per profile (or none: numbered names are used)."""
+    if not p.names:
+        return []
+    if not all(isinstance(n, str) and n.strip() for n in p.names):
+        return [("names", f"expected a list of {len(p.profiles)} non-empty names")]
+    if len(p.names) != len(p.profiles):
+        return [
+            (
+                "names",
+                f"lists {len(p.names)} names for {len(p.profiles)} profiles; expected one per profile",
+            )
+        ]
+    for index, name in enumerate(p.names):
+        if len(name) > MAX_NAME_CHARS:
+            return [(f"names[{index}]", f"expected at most {MAX_NAME_CHARS} characters, got {len(name)}")]
+        if any(ord(ch) < 32 or ord(ch) == 127 or ch in "\u2028\u2029" for ch in name):
+            return [
+                (
+                    f"names[{index}]",
+                    f"expected a name without line breaks or control characters, got {show(name)}",
+                )
+            ]
+    if len(set(p.names)) != len(p.names):
+        return [("names", "repeats a name; expected a different name for every profile")]
+    return []
+
+
+def _profile_rules(p: Problem) -> list[tuple[str, str]]:
+    """Each profile a finite ``(N, 2)`` polyline, short enough in pieces for :data:`MAX_PIECES`."""
+    length = 0.0
+    for index, profile in enumerate(p.profiles):
+        points = np.asarray(profile)
+        key = f"profiles[{index}]"
+        if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 2:
+            return [(key, f"expected a polyline of shape (N, 2) with N >= 2, got shape {points.shape}")]
+        if not np.all(np.isfinite(points)):
+            return [(key, "has a non-finite coordinate; expected finite numbers")]
+        with np.errstate(over="ignore", invalid="ignore"):
+            length = max(length, float(np.sum(np.hypot(*np.diff(points, axis=0).T))))
+    if not length / float(p.piece_length) <= MAX_PIECES:
+        return [
+            (
+                "piece_length",
+                f"expected at least 1/{MAX_PIECES} of the longest profile's arc length ({length:.6g}), "
+                f"i.e. piece_length >= {length / MAX_PIECES:.6g}, got {show(p.piece_length)}",
+            )
+        ]
+    return []

@@ -33,33 +33,6 @@ from linkwork.synthesis.targets import target_profiles
 SearchMethod = Literal["paper", "refined"]
 
 
-def _check_problem(problem: Problem) -> None:
-    src = None if problem.source is None else str(problem.source)
-    if problem.count < 1:
-        raise SpecError("a synthesis problem needs at least one profile", source=src, key="profiles")
-    if problem.kind not in ("open", "closed", "fixed-end"):
-        raise SpecError(
-            f"type must be open, closed or fixed-end, got {problem.kind!r}", source=src, key="type"
-        )
-    if problem.starts < 1:
-        raise SpecError(f"starts must be at least 1, got {problem.starts}", source=src, key="starts")
-    if not (problem.merge_below >= 0.0 and math.isfinite(problem.merge_below)):
-        raise SpecError(f"merge_below must be >= 0, got {problem.merge_below}", source=src, key="merge_below")
-    if problem.design is None and problem.segments is None:
-        raise SpecError("give a design vector or the number of segments", source=src, key="design")
-    if problem.merge_on not in ("targets", "chain"):
-        raise SpecError(f"merge_on must be 'targets' or 'chain', got {problem.merge_on!r}", key="merge_on")
-    if problem.rank_by not in ("error", "joints"):
-        raise SpecError(f"rank_by must be 'error' or 'joints', got {problem.rank_by!r}", key="rank_by")
-    tol = problem.e_max_tolerance
-    if tol is not None and not (tol > 0.0 and math.isfinite(tol)):
-        raise SpecError(f"e_max_tolerance must be a positive number, got {tol}", key="e_max_tolerance")
-    if problem.rank_by == "joints" and tol is None:
-        raise SpecError(
-            'rank_by = "joints" needs e_max_tolerance, the largest acceptable E_max', key="rank_by"
-        )
-
-
 def _check_initial(problem: Problem, designs: list[str], pieces: list[int]) -> None:
     """The given initial segment matrix fits the (single) design vector and the target profiles."""
     sm = problem.initial_segment_matrix
@@ -177,7 +150,6 @@ def synthesize(
     if search not in ("paper", "refined"):
         raise SpecError(f"search must be 'paper' or 'refined', got {search!r}", key="search")
     t0 = time.perf_counter()
-    _check_problem(problem)
     targets = target_profiles(problem)
     pieces = [t.pieces for t in targets]
     if problem.design is not None and problem.design.strip().lower() != "auto":

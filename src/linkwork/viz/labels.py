@@ -1,8 +1,16 @@
-"""Numbers as figures print them: no ``-0``, no round-off shown as a value (``-4.97e-15`` is 0)."""
+"""Text in figures: numbers as figures print them (no ``-0``, no round-off shown as a value: ``-4.97e-15`` is 0),
+and names a user wrote drawn as written.
+
+matplotlib reads a text between two ``$`` as mathtext, and a name such as ``$x^$`` then fails to draw (a
+traceback instead of a figure). :func:`plain` escapes every ``$`` so that names are always drawn as written.
+"""
 
 from __future__ import annotations
 
 import math
+import re
+
+__all__ = ["number", "plain", "subscript"]
 
 
 def number(value: float, fmt: str = ".4g", *, scale: float = 1.0) -> str:
@@ -16,3 +24,16 @@ def number(value: float, fmt: str = ".4g", *, scale: float = 1.0) -> str:
     if text.startswith("-") and stripped == "":
         text = text[1:]
     return text
+
+
+def plain(text: str) -> str:
+    """``text`` drawn literally by matplotlib: each ``$`` escaped as ``\\$`` (mathtext never starts)."""
+    return text.replace("$", r"\$")
+
+
+def subscript(symbol: str, name: str) -> str:
+    """``symbol`` with ``name`` as a subscript in mathtext (``$\\theta_{A}$``) when ``name`` is letters and digits
+    (nothing mathtext could read as a command), else ``symbol`` and the plain name."""
+    if re.fullmatch(r"[A-Za-z0-9]{1,12}", name):
+        return rf"${symbol}_{{{name}}}$"
+    return f"${symbol}$ " + plain(name)

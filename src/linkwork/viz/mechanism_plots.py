@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.mechanization.chain import apply
+from linkwork.viz.labels import plain
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -128,7 +129,8 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
             f"{number(math.degrees(state.drive_value), '.2f')} deg" if revolute else number(state.drive_value)
         )
         ax.set_title(
-            f"profile {j + 1}: {design.drive} = {value}\nE_max = {state.e_max:.3g} (profile unit)", fontsize=9
+            f"profile {j + 1}: {plain(str(design.drive))} = {value}\nE_max = {state.e_max:.3g} (profile unit)",
+            fontsize=9,
         )
         ax.set_aspect("equal")
         ax.set_xlim(lo[0], hi[0])
@@ -138,7 +140,7 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
         if j == 0:
             ax.set_ylabel("y (profile unit)")
             ax.legend(fontsize=7, loc="best")
-    fig.suptitle(f"{design.name}: DOF {check.dof}, drive {design.drive}", fontsize=10)
+    fig.suptitle(f"{plain(design.name)}: DOF {check.dof}, drive {plain(str(design.drive))}", fontsize=10)
     return fig
 
 

@@ -18,6 +18,7 @@ from linkwork.errors import LinkworkError
 from linkwork.geometry.fit import kabsch
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
+from linkwork.viz.labels import plain, subscript
 from linkwork.viz.solids import Mesh, body_meshes, hinge_pins, place
 
 Array = NDArray[np.float64]
@@ -191,8 +192,8 @@ def drive_label(path: Trace, i: int, joint: int | None = None) -> str:
     from linkwork.viz.labels import number
 
     if mech.joint_types[d] == "P":
-        return f"{name} = {number(value, '.3g')}"
-    return rf"$\theta_{{{name}}}$ = {number(np.degrees(value), '.1f')}°"
+        return f"{plain(name)} = {number(value, '.3g')}"
+    return f"{subscript(chr(92) + 'theta', name)} = {number(np.degrees(value), '.1f')}°"
 
 
 def deployment_sequence(
@@ -251,7 +252,7 @@ def deployment_sequence(
         set_limits(ax, low, high, view)
         ax.set_title(f"({chr(ord('a') + k)}) " + drive_label(path, int(i)), fontsize=9, pad=-2)
     if title:
-        fig.suptitle(title, fontsize=10)
+        fig.suptitle(plain(title), fontsize=10)
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.93 if title else 0.97, wspace=0.0, hspace=0.08)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=dpi)

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.synthesis.result import JoinedProfile, SynthesisResult
+from linkwork.viz.labels import plain
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -44,7 +45,7 @@ def _colour(j: int) -> str:
 
 
 def _name(result: SynthesisResult, j: int) -> str:
-    return result.targets[j].name or f"profile {j + 1}"
+    return plain(result.targets[j].name) or f"profile {j + 1}"
 
 
 def _segment_piece(result: SynthesisResult, e: int, j: int) -> Array:

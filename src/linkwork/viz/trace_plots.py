@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from linkwork.kinematics.trace_result import Trace
+from linkwork.viz.labels import plain
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -77,14 +78,14 @@ def angles_figure(path: Trace) -> Figure:
                 color=colors[j % len(colors)],
                 lw=2.2 - 0.3 * (j % len(styles)) if br.id == 0 else 0.8,
                 alpha=1.0 if br.id == 0 else 0.45,
-                label=f"θ{name}" if br.id == 0 else None,
+                label=f"θ{plain(name)}" if br.id == 0 else None,
             )
     for b in path.bifurcations:
         a = display_degrees(path, b.angles)
         ax.plot(np.full(len(a) - 1, a[d]), np.delete(a, d), "ko", ms=4)
-    ax.set_xlabel(f"θ{path.drive} (deg, wrapped to [-180, 180))")
+    ax.set_xlabel(f"θ{plain(str(path.drive))} (deg, wrapped to [-180, 180))")
     ax.set_ylabel("hinge angle (deg, wrapped to [-180, 180))")
-    title = f"{mech.name}: hinge angles"
+    title = f"{plain(mech.name)}: hinge angles"
     if len(path.branches) > 1:
         title += f" ({len(path.branches)} branches, {len(path.bifurcations)} bifurcation points ●)"
     ax.set_title(title, fontsize=10)
@@ -124,7 +125,7 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
     unit = "°" if mech.joint_types[d] == "R" else ""
     span = float(np.ptp(x)) if len(x) else 1.0
     low, high = (number(v, scale=max(span, 1.0)) for v in (x[0], x[-1]))
-    axes[1].set_xlabel(f"step (θ{path.drive} from {low}{unit} to {high}{unit})")
+    axes[1].set_xlabel(f"step (θ{plain(str(path.drive))} from {low}{unit} to {high}{unit})")
     axes[1].set_ylim(1e-17, None)
     for ax in axes:
         ax.set_ylabel("singular value (1 and length per rad)")
@@ -134,7 +135,7 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
             axes[0].axvline(b.step, color="k", lw=0.8, ls="--")
             axes[1].axvline(b.step, color="k", lw=0.8, ls="--")
     axes[1].legend(fontsize=8, ncol=2)
-    fig.suptitle(f"{mech.name}: singular values of the Jacobian along branch {branch}", fontsize=10)
+    fig.suptitle(f"{plain(mech.name)}: singular values of the Jacobian along branch {branch}", fontsize=10)
     return fig
 
 

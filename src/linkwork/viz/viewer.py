@@ -82,9 +82,7 @@ def _page(template: str, title: str, data: dict[str, Any], scripts: list[str]) -
     """Fill an HTML template: ``{{TITLE}}``, ``{{CSS}}``, ``{{DATA}}`` and ``{{JS}}``, in one pass."""
     from linkwork import __version__
 
-    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
-    # Inside <script>, only "</" can end the element early; "<\/" is the same string to JSON.
-    payload = payload.replace("</", "<\\/")
+    payload = script_json(data)
     values = {
         "TITLE": _escape(title),
         "CSS": _asset("viewer.css"),
@@ -95,8 +93,27 @@ def _page(template: str, title: str, data: dict[str, Any], scripts: list[str]) -
     return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], _asset(template))
 
 
+#: Characters of JSON text that must not appear raw inside an HTML <script> element: "<" and ">" could open
+#: "</script>" or "<!--" (which changes how the element ends), "&" for symmetry with HTML escaping, and U+2028
+#: / U+2029, which older JavaScript parsers treat as line breaks. Each is written as its JSON \\u escape, so the
+#: data parse back to the same strings.
+_SCRIPT_UNSAFE = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+
+
+def script_json(data: Any) -> str:
+    """``data`` as JSON text safe to embed inside ``<script type="application/json">`` (no NaN or inf)."""
+    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
+    return re.sub("[<>&\u2028\u2029]", lambda m: _SCRIPT_UNSAFE[m.group(0)], payload)
+
+
 def _escape(text: str) -> str:
-    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
+    return (
+        text.replace("&", "&amp;")
+        .replace("<", "&lt;")
+        .replace(">", "&gt;")
+        .replace('"', "&quot;")
+        .replace("'", "&#x27;")
+    )
 
 
 def _write(file: str | Path, text: str) -> Path:

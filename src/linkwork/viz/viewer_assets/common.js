@@ -240,9 +240,38 @@ LW.Plot = class {
   }
 };
 
+/** A table row of cells; each cell is text (set as textContent, never parsed as HTML) or a DOM node. The first
+ * cell may start with a colour swatch {color, dash}. Returns the row's cells. */
+LW.row = function (tbody, texts, swatch) {
+  const tr = document.createElement("tr");
+  texts.forEach((t, i) => {
+    const td = document.createElement("td");
+    if (i === 0 && swatch) {
+      const sw = document.createElement("i");
+      sw.className = "swatch" + (["", " dash", " dot", " dash"][(swatch.dash || 0) % 4]);
+      sw.style.borderTopColor = swatch.color;
+      td.appendChild(sw);
+    }
+    if (t instanceof Node) td.appendChild(t);
+    else td.appendChild(document.createTextNode(String(t)));
+    tr.appendChild(td);
+  });
+  tbody.appendChild(tr);
+  return Array.from(tr.children);
+};
+
+/** Replace an element's content by a bold lead and plain text after it (both as text, never HTML). */
+LW.lead = function (el, bold, rest) {
+  el.textContent = "";
+  const b = document.createElement("b");
+  b.textContent = bold;
+  el.appendChild(b);
+  el.appendChild(document.createTextNode(rest));
+};
+
 /** Fill a legend element with [{label, color, dash}] items. */
 LW.legend = function (el, items) {
-  el.innerHTML = "";
+  el.textContent = "";
   for (const it of items) {
     const span = document.createElement("span");
     const sw = document.createElement("i");

@@ -156,15 +156,16 @@
   // ------------------------------------------------------------------ panels and plots
   const segBody = $("segments").querySelector("tbody");
   const segCells = data.segments.map((seg, e) => {
-    const tr = document.createElement("tr");
-    tr.innerHTML = `<td><i class="swatch" style="border-top-color:${segColor(e)}"></i>${e + 1} ${seg.kind}${seg.kind === "C" && seg.radius !== null ? ` (r ${LW.sci(seg.radius)})` : ""}</td><td></td><td></td><td></td>`;
-    segBody.appendChild(tr);
-    return [tr.children[1], tr.children[2], tr.children[3]];
+    const label = `${e + 1} ${seg.kind}${seg.kind === "C" && seg.radius !== null ? ` (r ${LW.sci(seg.radius)})` : ""}`;
+    const row = LW.row(segBody, [label, "", "", ""], { color: segColor(e), dash: 0 });
+    return [row[1], row[2], row[3]];
   });
   $("segment-note").textContent = "M: rigid segment (a link). C: constant-curvature segment, its length changes between profiles. Error: largest distance to the target points (Eq. 21).";
   const errRows = [["E_max after segmentation", data.e_max], ["E_mean after segmentation", data.e_mean], ["E_max of the joined chain", data.joined_e_max]];
   if (data.compound) errRows.push(["E_max with compound segments", data.compound.e_max]);
-  $("errors").querySelector("tbody").innerHTML = errRows.map(([k, v]) => `<tr><td>${k}</td><td>${LW.sci(v)}</td></tr>`).join("");
+  const errBody = $("errors").querySelector("tbody");
+  errBody.textContent = "";
+  errRows.forEach(([k, v]) => LW.row(errBody, [k, LW.sci(v)]));
   if (data.compound) {
     const m = data.compound.merged.map((i) => i + 1);
     $("compound-note").textContent = (m.length ? `Compound segments: joint${m.length > 1 ? "s" : ""} ${m.join(", ")} merged (range of motion below ${LW.fmt(data.compound.merge_below, 1)}°). ` : `No joint moves less than ${LW.fmt(data.compound.merge_below, 1)}°: nothing merged. `) + data.compound.notes.join(" ");
@@ -193,7 +194,7 @@
     $("slider").value = String(k);
     const t = data.targets[k];
     const c = chain()[k];
-    $("profile-info").innerHTML = `<b>${t.name}</b> (${k + 1} of ${p}): arc length ${LW.sci(t.arc_length)}, ${t.pieces} pieces.`;
+    LW.lead($("profile-info"), t.name, ` (${k + 1} of ${p}): arc length ${LW.sci(t.arc_length)}, ${t.pieces} pieces.`);
     data.segments.forEach((seg, e) => {
       segCells[e][0].textContent = String(seg.pieces[k]);
       segCells[e][1].textContent = LW.sci(seg.lengths[k]);

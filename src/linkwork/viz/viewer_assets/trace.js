@@ -48,8 +48,7 @@
 
   const bifBody = $("bif-table").querySelector("tbody");
   data.bifurcations.forEach((b) => {
-    const tr = document.createElement("tr");
-    tr.innerHTML = `<td>${b.id}</td><td>${b.branch}</td><td>${b.step}</td><td>${b.rank}</td><td></td>`;
+    const row = LW.row(bifBody, [b.id, b.branch, b.step, b.rank, ""]);
     const go = document.createElement("button");
     go.className = "jump";
     go.textContent = "go";
@@ -57,17 +56,13 @@
     const first = b.visits.find((v) => data.branches[v[0]].id === b.branch) || b.visits[0];
     if (first) go.addEventListener("click", () => setBranch(first[0], first[1]));
     else go.disabled = true;
-    tr.lastChild.appendChild(go);
-    bifBody.appendChild(tr);
+    row[4].appendChild(go);
   });
 
   const readBody = $("readout").querySelector("tbody");
   const cells = data.joints.map((j) => {
-    const tr = document.createElement("tr");
-    const dash = ["", " dash", " dot", " dash"][j.dash % 4];
-    tr.innerHTML = `<td><i class="swatch${dash}" style="border-top-color:${j.color}"></i>${j.name}</td><td></td><td></td>`;
-    readBody.appendChild(tr);
-    return [tr.children[1], tr.children[2]];
+    const row = LW.row(readBody, [j.name, "", ""], { color: j.color, dash: j.dash });
+    return [row[1], row[2]];
   });
 
   LW.legend($("legend-angles"), data.joints.map((j) => ({ label: j.name + (j.type === "R" ? "" : " (length)"), color: j.color, dash: j.dash })));
@@ -175,14 +170,14 @@
   /** At a bifurcation point: offer every other branch through it. */
   function showHere() {
     const here = $("here");
-    here.innerHTML = "";
+    here.textContent = "";
     for (const b of data.bifurcations) {
       const mine = b.visits.some(([bi, row]) => bi === state.branch && row === state.point);
       if (!mine) continue;
       const box = document.createElement("div");
       box.className = "here";
       const p = document.createElement("p");
-      p.innerHTML = `<b>Bifurcation point ${b.id}</b>: rank ${b.rank}, ${b.tangents} branch tangents. Continue on:`;
+      LW.lead(p, `Bifurcation point ${b.id}`, `: rank ${b.rank}, ${b.tangents} branch tangents. Continue on:`);
       box.appendChild(p);
       for (const [bi, row] of b.visits) {
         if (bi === state.branch && row === state.point) continue;
