@@ -185,7 +185,7 @@ def test_synth_beside_its_inputs_never_overwrites_an_input_svg(home: Path) -> No
     ("line", "fragment"),
     [
         ("starts = 1000000000", "1 <= starts <= 1000, got 1000000000"),
-        ('design = "auto"\nsegments = 50', "1 <= segments <= 10"),
+        ('design = "auto"\nsegments = 50', "1 <= segments <= 14"),
         ("piece_length = 1e-9", "piece_length >= "),
         (
             'names = ["a\\nb", "c"]',

@@ -272,13 +272,13 @@ def test_one_reader_for_both_file_kinds_hints_at_a_mistyped_key(folder: Path, tm
 
 
 def test_the_search_is_bounded_by_a_stated_budget(folder: Path) -> None:
-    """design "auto" with 10 segments tries 2**10 = 1024 design vectors: 100 starts each is 102400 searches."""
-    text = GOOD.replace('design = "mcm"', 'design = "auto"\nsegments = 10').replace(
+    """design "auto" with 12 segments tries 2**12 = 4096 design vectors: 100 starts each is 409600 searches."""
+    text = GOOD.replace('design = "mcm"', 'design = "auto"\nsegments = 12').replace(
         "starts = 2", "starts = 100"
     )
     with pytest.raises(SpecError) as info:
         load_problem(write(folder, text))
     assert str(info.value).endswith(
-        'starts: design "auto" with segments = 10 and starts = 100 is 102400 searches of the segment matrix; '
-        "expected at most 20000 (fewer segments or starts)"
+        'starts: design "auto" with segments = 12 and starts = 100 is 409600 searches of the segment matrix; '
+        "expected at most 100000 (fewer segments or starts)"
     )
