@@ -14,6 +14,7 @@ import subprocess
 import sys
 import time
 import types
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -86,7 +87,7 @@ def test_a_cold_cache_traces_in_python_and_compiles_in_the_background(
     monkeypatch.setattr(jit, "_compile_under_way", lambda: False)
     monkeypatch.setattr(jit, "_touch_lock", lambda: None)
     monkeypatch.setitem(jit._state, "spawned", False)
-    monkeypatch.setattr(subprocess, "Popen", lambda cmd, **kw: started.append((cmd, kw["env"])))
+    monkeypatch.setattr(subprocess, "run", lambda cmd, **kw: started.append((cmd, kw["env"])))
     with caplog.at_level(logging.INFO, logger="linkwork.jit"):
         kernels = jit.march_kernels()
         jit.march_kernels()  # a second trace in the same process starts no second compile
@@ -94,12 +95,26 @@ def test_a_cold_cache_traces_in_python_and_compiles_in_the_background(
     assert kernels.march is jit.plain_march_kernels().march
     assert len(started) == 1
     cmd, env = started[0]
-    assert cmd == [sys.executable, "-c", jit.BACKGROUND_COMMAND] and env["LINKWORK_JIT"] == "compiled"
+    assert cmd == [sys.executable, "-c", jit.LAUNCHER, sys.executable, jit.BACKGROUND_COMMAND]
+    assert env["LINKWORK_JIT"] == "compiled"
     assert "compiling kernels, first run only" in caplog.text
     # Once the compile has finished, the next call of an entry point runs compiled code.
     monkeypatch.setattr(jit, "kernels_cached", lambda: True)
     monkeypatch.setattr(jit.SwitchingKernels, "CHECK_SECONDS", 0.0)
     assert kernels.evaluate is march.evaluate
+
+
+def test_the_launcher_starts_a_detached_process_and_returns_at_once(tmp_path: Path) -> None:
+    marker = tmp_path / "ran"
+    child = f"import pathlib, time; time.sleep(0.5); pathlib.Path({str(marker)!r}).write_text('yes')"
+    begin = time.perf_counter()
+    subprocess.run([sys.executable, "-c", jit.LAUNCHER, sys.executable, child], check=True, timeout=30)
+    assert not marker.exists()  # the launcher did not wait for its child
+    for _ in range(200):  # the detached child finishes on its own (up to 20 s on a loaded machine)
+        if marker.exists():
+            break
+        time.sleep(0.1)
+    assert marker.read_text() == "yes", f"launched {time.perf_counter() - begin:.1f} s ago"
 
 
 def test_compile_time_is_not_trace_time(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -234,6 +234,14 @@ def _lock_path() -> Path | None:
         return None
 
 
+LAUNCHER = (
+    "import subprocess, sys; "
+    "subprocess.Popen([sys.argv[1], '-c', sys.argv[2]], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, "
+    "stderr=subprocess.DEVNULL, start_new_session=True)"
+)
+"""The launcher's source: start ``python -c BACKGROUND_COMMAND`` in a new session, detached, and exit."""
+
+
 def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
     """Start (at most once per process, and not while another process is at it) a detached Python process
     running :func:`compile_in_background`, which fills the cache; returns whether one was started."""
@@ -248,13 +256,16 @@ def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
         "compiling kernels, first run only: in the background for next time; this run uses the Python kernels"
     )
     env = dict(os.environ, LINKWORK_JIT="compiled")
-    (runner or subprocess.Popen)(
-        [sys.executable, "-c", BACKGROUND_COMMAND],
+    # A short-lived launcher starts the detached compile and exits at once, and we wait for the launcher: this
+    # process then holds no handle on a still-running child (whose Popen would warn when collected).
+    (runner or subprocess.run)(
+        [sys.executable, "-c", LAUNCHER, sys.executable, BACKGROUND_COMMAND],
         env=env,
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
-        start_new_session=True,
+        timeout=60,
+        check=False,
     )
     return True
 
