@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from linkwork.mechanization.chain import apply
 from linkwork.viz.labels import plain
+from linkwork.viz.palette import TAB10
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -41,7 +42,7 @@ def _draw(
         t = chain.targets[profile]
         ax.plot(t[:, 0], t[:, 1], color="0.65", lw=3.0, zorder=1, label="target profile")
     pts = chain.points(disp, profile)
-    ax.plot(pts[:, 0], pts[:, 1], color="#1f77b4", lw=1.6, zorder=3, label="chain")
+    ax.plot(pts[:, 0], pts[:, 1], color=TAB10[0], lw=1.6, zorder=3, label="chain")
     joints = np.array(
         [
             apply(disp[jt.bodies[1]] if jt.bodies[1] != "ground" else np.zeros(3), jt.point)
@@ -50,7 +51,7 @@ def _draw(
         ]
     ).reshape(-1, 2)
     if len(joints):
-        ax.plot(joints[:, 0], joints[:, 1], "o", ms=4, mfc="white", mec="#1f77b4", zorder=4)
+        ax.plot(joints[:, 0], joints[:, 1], "o", ms=4, mfc="white", mec=TAB10[0], zorder=4)
     for k, link in enumerate(design.links):
         body = disp[link.body]
         m = apply(body, link.circle)
@@ -68,7 +69,7 @@ def _draw(
         colour = "#d62728" if link.kind == "RR" else "#2ca02c"
         outline = apply(body, chain.body(link.body).outline)
         near = outline[int(np.argmin(np.linalg.norm(outline - m, axis=1)))]
-        ax.plot([near[0], m[0]], [near[1], m[1]], color="#1f77b4", lw=0.8, ls=":", zorder=2)  # bracket
+        ax.plot([near[0], m[0]], [near[1], m[1]], color=TAB10[0], lw=0.8, ls=":", zorder=2)  # bracket
         ax.plot(
             [c[0], m[0]],
             [c[1], m[1]],

@@ -13,11 +13,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from linkwork.viz.palette import TAB10
+
 if TYPE_CHECKING:
     from linkwork.mechanization import Mechanization
 
 #: Colours of the target profiles drawn over the chain (profile 1 first).
-TARGET_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f")
+TARGET_COLORS = TAB10
 
 
 def chain_bounds(points: np.ndarray, pad: float = 0.08) -> dict[str, Any]:

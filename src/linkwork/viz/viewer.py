@@ -25,17 +25,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.kinematics.closure import body_poses
+from linkwork.viz.palette import TAB10
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Bifurcation, Trace
     from linkwork.synthesis.result import SynthesisResult
 
-#: Joint colours of the plots and labels (matplotlib's tab10, so the viewer matches the PNG figures).
-JOINT_COLORS = (
-    "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
-    "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf",
-)  # fmt: skip
+#: Joint colours of the plots and labels (the one palette, so the viewer matches the PNG figures).
+JOINT_COLORS = TAB10
 
 #: Points per viewer above which each branch is thinned evenly (ends and bifurcation points always kept).
 MAX_POINTS = 20000
@@ -495,6 +493,7 @@ def synthesis_viewer_data(result: SynthesisResult, *, title: str | None = None) 
     compound = result.compound
     return {
         "kind": "synthesis",
+        "joint_colors": list(TAB10),
         "title": title or f"Shape-change synthesis: design {result.design}",
         "profile_kind": result.problem.kind,
         "design": result.design,

@@ -7,7 +7,7 @@
   const p = data.targets.length, q = data.segments.length;
   const SEG_COLORS = ["#1f5f9e", "#d9782d", "#2e8b57", "#b03a48", "#7553a8", "#8c6d31", "#c2519b", "#4a7d8c"];
   const segColor = (e) => SEG_COLORS[e % SEG_COLORS.length];
-  const JOINT_COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+  const JOINT_COLORS = data.joint_colors;  // the one palette (linkwork.viz.palette.TAB10)
   const jointColor = (i) => JOINT_COLORS[i % JOINT_COLORS.length];
   const state = { profile: 0, playing: false, renders: 0 };
   const canvas = $("scene");
