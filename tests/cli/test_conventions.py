@@ -86,6 +86,7 @@ def test_a_cold_kernel_cache_is_announced_on_stderr(tmp_path: Path, monkeypatch:
 
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
     monkeypatch.setattr(jit, "kernels_cached", lambda: False)
+    monkeypatch.setitem(jit._state, "ready", False)
     monkeypatch.setattr(jit, "_warm_up", lambda: None)  # the kernels are compiled in this process already
     result = runner.invoke(
         app, ["trace", "bennett", "--until", "A=70", "--no-plots", "-o", str(tmp_path / "t")]

@@ -84,6 +84,7 @@ def test_a_cold_cache_traces_in_python_and_compiles_in_the_background(
     started: list[tuple[list[str], dict[str, str]]] = []
     monkeypatch.setenv("LINKWORK_JIT", "auto")
     monkeypatch.setattr(jit, "kernels_cached", lambda: False)
+    monkeypatch.setitem(jit._state, "ready", False)
     monkeypatch.setattr(jit, "_compile_under_way", lambda: False)
     monkeypatch.setattr(jit, "_touch_lock", lambda: None)
     monkeypatch.setitem(jit._state, "spawned", False)
@@ -120,6 +121,7 @@ def test_the_launcher_starts_a_detached_process_and_returns_at_once(tmp_path: Pa
 def test_compile_time_is_not_trace_time(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
     monkeypatch.setattr(jit, "kernels_cached", lambda: False)
+    monkeypatch.setitem(jit._state, "ready", False)
     monkeypatch.setattr(jit, "_warm_up", lambda: time.sleep(0.5))  # a stand-in compile of a known length
     begin = time.perf_counter()
     tr = lw.trace(lw.load("bennett"), until=("A", np.radians(70.0)))
