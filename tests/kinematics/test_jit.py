@@ -147,3 +147,14 @@ def test_an_unknown_mode_is_reported_and_auto_used(
     with caplog.at_level(logging.WARNING, logger="linkwork.jit"):
         assert jit.mode() == "auto"
     assert "LINKWORK_JIT=fast" in caplog.text
+
+
+def test_the_normalised_ratio_is_the_same_with_the_python_jacobian(monkeypatch: pytest.MonkeyPatch) -> None:
+    from linkwork.kinematics import normalization
+
+    tr = lw.trace(lw.load("bennett"), until=("A", np.radians(70.0)))
+    monkeypatch.setenv("LINKWORK_JIT", "compiled")
+    compiled = normalization.condition_ratios(tr.mechanism, tr.angles, tr.rank)
+    monkeypatch.setenv("LINKWORK_JIT", "python")
+    plain = normalization.condition_ratios(tr.mechanism, tr.angles, tr.rank)
+    np.testing.assert_allclose(plain, compiled, rtol=1e-12, atol=0.0)

@@ -195,7 +195,7 @@ def compile_seconds() -> float:
 
 def _warm_up() -> None:
     """Run every entry point with the argument types a trace uses: adaptive traces of a Bennett linkage with a
-    target, without one and up to a joint limit, and a paper-mode trace."""
+    target (and its normalised condition ratio), without one and up to a joint limit, and a paper-mode trace."""
     import math
 
     from linkwork.io.spec import resolve_spec
@@ -203,7 +203,7 @@ def _warm_up() -> None:
 
     mech = resolve_spec("bennett", {}).mechanism
     a, start = mech.joint_names[0], float(mech.offsets[0])
-    trace(mech, until=(a, start + 0.3))
+    trace(mech, until=(a, start + 0.3)).condition()  # the normalised ratio's Jacobian kernel too
     trace(mech, until=(a, start + 0.3), steps=4)
     trace(mech, max_steps=8, max_step=math.radians(5.0))
     trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()

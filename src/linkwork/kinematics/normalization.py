@@ -27,8 +27,10 @@ values are unchanged. Scaling every length by ``s`` scales ``v_c`` and ``L`` ali
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -71,8 +73,30 @@ def hinge_centre(axes: ArrayLike, joint_types: Sequence[str]) -> tuple[Array, fl
     return c[0], float(L[0])
 
 
+@functools.cache
+def _plain_closure_jacobian() -> Callable[..., None]:
+    """The closure-Jacobian kernel run as plain Python (the same statements; see :mod:`linkwork.kinematics.jit`)."""
+    from linkwork.kinematics import jit
+
+    compiled: Any = closure_jacobian
+    twin: Callable[..., None] = jit.python_twin({"closure_jacobian": compiled}).closure_jacobian
+    return twin
+
+
+def _jacobian_kernel() -> Callable[..., None]:
+    """The compiled kernel when it is ready (or compiling is asked for); its plain-Python twin while numba's cache is
+    cold, so that a first run does not compile it in the foreground (the background compile fills the cache)."""
+    from linkwork.kinematics import jit
+
+    chosen = jit.mode()
+    compiled: Any = closure_jacobian
+    if chosen == "python" or (chosen != "compiled" and not jit.is_cached(compiled)):
+        return _plain_closure_jacobian()
+    return closure_jacobian
+
+
 def _full_jacobians(mech: Mechanism, q: Array) -> Array:
-    """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)`` (compiled kernel)."""
+    """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)``."""
     joints, signs, ptr = mech.loop_arrays()
     n = mech.n_joints
     E = 6 * len(mech.loops)
@@ -81,10 +105,9 @@ def _full_jacobians(mech: Mechanism, q: Array) -> Array:
     rows = np.arange(6, dtype=np.int64)
     groups = np.arange(n, dtype=np.int64)
     twists = np.ascontiguousarray(mech.twists)
+    kernel = _jacobian_kernel()
     for k, qk in enumerate(q):
-        closure_jacobian(
-            twists, np.ascontiguousarray(qk), joints, signs, ptr, rows, groups, n, residual, out[k]
-        )
+        kernel(twists, np.ascontiguousarray(qk), joints, signs, ptr, rows, groups, n, residual, out[k])
     return out
 
 
