@@ -6,8 +6,9 @@ A command decorated with :func:`friendly_errors` runs with numpy's floating-poin
 
 from __future__ import annotations
 
+import contextlib
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from functools import wraps
 from typing import Any, ParamSpec, TypeVar
 
@@ -17,6 +18,7 @@ from rich.text import Text
 
 from linkwork.errors import LinkworkError, RequestNotMetError
 from linkwork.io.toml_reader import escape_line, show
+from linkwork.progress import Progress
 
 err_console = Console(stderr=True)
 
@@ -95,3 +97,35 @@ def check_range(
     if not inside:  # also catches NaN
         sign = "<" if open_low else "<="
         raise fail(f"{flag} {show(value)}: expected {what}, {low:g} {sign} {flag} <= {high:g}")
+
+
+@contextlib.contextmanager
+def progress_bar(label: str, total: int | None, *, fraction: bool = False) -> Iterator[Progress]:
+    """A rich progress bar on a terminal (nothing otherwise), handed out as a ``progress(done, total)`` callback.
+
+    The bar counts ``total`` units labelled ``label``. The callback's ``done`` is shown as it is, or, with
+    ``fraction``, as the fraction ``done / total`` of the bar (a computation that counts other units, such as
+    chunks of samples).
+    """
+    from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn
+    from rich.progress import Progress as Bar
+
+    from linkwork.outputs.staging import console
+
+    with Bar(
+        TextColumn(label),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    ) as bar:
+        task = bar.add_task("", total=total)
+
+        def update(done: int, of: int | None) -> None:
+            if fraction and total is not None:
+                done = min(total, round(total * done / max(of or 1, 1)))
+            bar.update(task, completed=done)
+
+        yield update

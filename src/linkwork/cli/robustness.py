@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.text import Text
 
-from linkwork.cli.common import fail, friendly_errors, parse_assignments
+from linkwork.cli.common import fail, friendly_errors, parse_assignments, progress_bar
 from linkwork.outputs.staging import console
 
 
@@ -127,28 +127,13 @@ def robustness(
         f"(misfit length scale L = {setup.scale.length:.4g})",
         sep=": ",
     )
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
     from linkwork.outputs.robustness import (
         print_robustness_summary,
         robustness_dict,
         run_and_write_robustness,
     )
 
-    with Progress(
-        TextColumn("samples"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    ) as bar:
-        task = bar.add_task("", total=samples)
-
-        def report(done: int, total: int | None) -> None:
-            bar.update(task, completed=min(samples, round(samples * done / max(total or 1, 1))))
-
+    with progress_bar("samples", samples, fraction=True) as report:
         result, figures = run_and_write_robustness(
             setup,
             samples,

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.text import Text
 
-from linkwork.cli.common import fail, friendly_errors
+from linkwork.cli.common import fail, friendly_errors, progress_bar
 from linkwork.outputs.staging import console
 
 
@@ -31,7 +31,6 @@ def sweep(
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
 ) -> None:
     """Run every grid point of a study: sweep.parquet, sweep.csv and plots in --out."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from linkwork.errors import RequestNotMetError
     from linkwork.outputs.sweep import print_sweep_summary, write_sweep_outputs
@@ -43,21 +42,12 @@ def sweep(
     study = prepare_study(load_study(study_file))
     total = len(study.points())
     console.print(Text(study.name, style="bold"), f"{study.kind} study of {total} grid point(s)", sep=": ")
-    with Progress(
-        TextColumn("grid points"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    ) as bar:
-        task = bar.add_task("", total=total)
+    with progress_bar("grid points", total) as report:
         results = run_sweep(
             study,
             scheduler=scheduler,
             workers=workers,
-            progress=lambda done, _total: bar.update(task, completed=done),
+            progress=report,
         )
     figures = write_sweep_outputs(study, results, out, plots=not no_plots)
     rows = [row for row, _ in results]

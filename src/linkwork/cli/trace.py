@@ -14,6 +14,7 @@ from linkwork.cli.common import (
     fail,
     friendly_errors,
     parse_assignments,
+    progress_bar,
 )
 from linkwork.errors import RequestNotMetError
 from linkwork.io.toml_reader import show
@@ -226,21 +227,6 @@ def _limits_in_api_units(
 
 
 def _run_with_progress(run: Callable[..., Trace], mech: Mechanism, total: int, **options: Any) -> Trace:
-    """``run(mech, **options, progress=...)`` with a progress bar on a terminal (none otherwise)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    with Progress(
-        TextColumn("tracing"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    ) as progress:
-        task = progress.add_task("", total=total)
-
-        def report(done: int, _budget: int | None) -> None:
-            progress.update(task, completed=done)  # steps so far, against the paper steps or the budget
-
+    """``run(mech, **options, progress=...)`` with a progress bar of the steps on a terminal (none otherwise)."""
+    with progress_bar("tracing", total) as report:  # steps so far, against the paper steps or the budget
         return run(mech, **options, progress=report)
