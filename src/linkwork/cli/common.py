@@ -7,6 +7,7 @@ A command decorated with :func:`friendly_errors` runs with numpy's floating-poin
 from __future__ import annotations
 
 import contextlib
+import math
 import warnings
 from collections.abc import Callable, Iterator
 from functools import wraps
@@ -129,3 +130,28 @@ def progress_bar(label: str, total: int | None, *, fraction: bool = False) -> It
             bar.update(task, completed=done)
 
         yield update
+
+
+def parse_until(text: str | None) -> tuple[str, float] | None:
+    """``--until JOINT=VALUE`` (VALUE in degrees, or a length for a prismatic joint), or None without the flag."""
+    if text is None:
+        return None
+    name, sep, raw = text.partition("=")
+    try:
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not sep or not name.strip() or not math.isfinite(value):
+        raise fail(f"--until {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
+    return name.strip(), value
+
+
+def parse_couple(items: list[str] | None) -> list[list[str]]:
+    """``--couple A=C=E`` (repeatable): groups of joints forced equal."""
+    groups = []
+    for item in items or []:
+        names = [x.strip() for x in item.split("=")]
+        if len(names) < 2 or not all(names):
+            raise fail(f"--couple {show(item)}: expected joints joined by '=', e.g. A=C=E")
+        groups.append(names)
+    return groups

@@ -2,28 +2,21 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.text import Text
 
-from linkwork.cli.common import fail, friendly_errors, parse_assignments, progress_bar
+from linkwork.cli.common import (
+    fail,
+    friendly_errors,
+    parse_assignments,
+    parse_couple,
+    parse_until,
+    progress_bar,
+)
 from linkwork.outputs.staging import console
-
-
-def _parse_until(text: str | None) -> tuple[str, float] | None:
-    if text is None:
-        return None
-    name, sep, raw = text.partition("=")
-    try:
-        value = float(raw)
-    except ValueError:
-        value = float("nan")
-    if not sep or not name.strip() or not math.isfinite(value):
-        raise fail(f"--until {text!r}: expected JOINT=VALUE with VALUE in degrees, e.g. A=120")
-    return name.strip(), value
 
 
 @friendly_errors
@@ -100,13 +93,11 @@ def robustness(
     if steps is not None and until is None:
         raise fail("--steps needs --until JOINT=VALUE")
     params = parse_assignments(set_, "--set")
-    target = _parse_until(until)
+    target = parse_until(until)
     loaded = resolve_spec(spec, params)
     mech = loaded.mechanism
     if couple or fixed:
-        from linkwork.cli.trace import _parse_couple
-
-        mech = mech.with_couplings(_parse_couple(couple), fixed or [])
+        mech = mech.with_couplings(parse_couple(couple), fixed or [])
     model = ImperfectionModel(
         position_tol=hinge_position_tol,
         direction_tol=float(np.radians(hinge_direction_tol)),

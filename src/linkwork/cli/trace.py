@@ -14,10 +14,11 @@ from linkwork.cli.common import (
     fail,
     friendly_errors,
     parse_assignments,
+    parse_couple,
+    parse_until,
     progress_bar,
 )
 from linkwork.errors import RequestNotMetError
-from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console
 
 MAX_STEP_DEG = 90.0
@@ -32,19 +33,6 @@ if TYPE_CHECKING:
     from linkwork.io.spec import LoadedSpec
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Trace
-
-
-def _parse_until(text: str | None) -> tuple[str, float] | None:
-    if text is None:
-        return None
-    name, sep, raw = text.partition("=")
-    try:
-        value = float(raw)
-    except ValueError:
-        value = float("nan")
-    if not sep or not name.strip() or not math.isfinite(value):
-        raise fail(f"--until {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
-    return name.strip(), value
 
 
 def _parse_limits(items: list[str] | None) -> dict[str, tuple[float, float]]:
@@ -69,16 +57,6 @@ def _parse_limits(items: list[str] | None) -> dict[str, tuple[float, float]]:
             )
         out[name.strip()] = (lo, hi)
     return out
-
-
-def _parse_couple(items: list[str] | None) -> list[list[str]]:
-    groups = []
-    for item in items or []:
-        names = [x.strip() for x in item.split("=")]
-        if len(names) < 2 or not all(names):
-            raise fail(f"--couple {show(item)}: expected joints joined by '=', e.g. A=C=E")
-        groups.append(names)
-    return groups
 
 
 @friendly_errors
@@ -161,14 +139,14 @@ def trace(
     if steps is not None:
         check_range("--steps", steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
     params = parse_assignments(set_, "--set")
-    target = _parse_until(until)
+    target = parse_until(until)
     limits_file = _parse_limits(limit)
     if not (math.isfinite(closure_tol) and closure_tol > 0):
         raise fail(f"--closure-tol {closure_tol}: expected a positive number")
     loaded = _load(spec, params, closure_tol)
     mech = loaded.mechanism
     if couple or fixed:
-        mech = mech.with_couplings(_parse_couple(couple), fixed or [])
+        mech = mech.with_couplings(parse_couple(couple), fixed or [])
     limits = _limits_in_api_units(mech, limits_file)
     until_rad = None
     if target is not None:
