@@ -1,7 +1,8 @@
-"""Compiled (numba) kernels of the tracing hot loop: closure residual and Jacobian in O(n) per loop.
+"""Compiled (numba) kernels of the tracing hot loop: closure residual and Jacobian in O(n) per loop, and the
+Cholesky solve of the correctors' normal equations.
 
-These do, one joint at a time and without temporaries, what :mod:`linkwork.kinematics.closure` does with numpy;
-tests check that both agree. Arrays are laid out as in :class:`linkwork.kinematics.mechanism.Mechanism`:
+The closure kernels do, one joint at a time and without temporaries, what :mod:`linkwork.kinematics.closure`
+does with numpy; tests check that both agree. Arrays are laid out as in :class:`linkwork.kinematics.mechanism.Mechanism`:
 ``twists (n, 6)`` as ``(omega, v)``; loops flattened into ``loop_joint``, ``loop_sign`` and ``loop_ptr``;
 ``groups (n,)`` maps each joint to its unknown (``-1`` = fixed); ``rows`` are the twist rows kept per loop.
 """
@@ -118,23 +119,46 @@ def closure_jacobian(
 ) -> None:
     """Closure residual ``(E,)`` and reduced Jacobian ``(E, m)`` at displacements ``q``, written in place.
 
+    :func:`closure_pass` without a weight, with work arrays of its own (the hot loop of tracing).
+    """
+    col, lg = np.empty(6), np.empty(6)
+    closure_pass(
+        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, None, residual, jac,
+        (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))),
+        (np.empty(3), np.empty(3), np.empty(3), np.empty(3), col, lg, lg),  # no weight: no weighted copy
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
+def closure_pass(
+    twists: np.ndarray,
+    q: np.ndarray,
+    loop_joint: np.ndarray,
+    loop_sign: np.ndarray,
+    loop_ptr: np.ndarray,
+    rows: np.ndarray,
+    groups: np.ndarray,
+    weight: np.ndarray | None,
+    residual: np.ndarray,
+    jac: np.ndarray,
+    matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
+    vectors: tuple[np.ndarray, ...],
+) -> None:
+    """Closure residual ``W log(P)`` ``(E,)`` and its Jacobian ``(E, m)`` in the unknowns, written in place.
+
     One pass per loop: running product ``g = [Rg, pg]``, each column ``s Ad(g) xi`` (Eq. (21)), then the factor
     ``exp(s xi q)`` applied to ``g``; the residual is ``log(g)`` at the end (Eq. (23), twist form). Columns of
-    coupled joints add up (``J C``); fixed joints contribute no column.
+    coupled joints add up (``J C``); fixed joints contribute no column. ``weight`` ``W (6, 6)`` maps every
+    6-vector before its ``rows`` are kept; ``None`` means none (and numba compiles the weighting out).
+
+    Work arrays: ``matrices`` three ``(3, 3)``, ``vectors`` four ``(3,)`` then three ``(6,)``. Inlined into its
+    callers (numba passes every array as a dozen scalars: a call per evaluation would cost a quarter of it).
     """
     nrows = rows.shape[0]
     jac[:, :] = 0.0
-    Rg = np.empty((3, 3))
-    pg = np.empty(3)
-    Re = np.empty((3, 3))
-    pe = np.empty(3)
-    Rn = np.empty((3, 3))
-    w = np.empty(3)
-    v = np.empty(3)
-    col = np.empty(6)
-    lg = np.empty(6)
-    n_loops = loop_ptr.shape[0] - 1
-    for k in range(n_loops):
+    Rg, Re, Rn = matrices
+    pg, pe, w, v, col, lg, kept = vectors
+    for k in range(loop_ptr.shape[0] - 1):
         for i in range(3):
             for c in range(3):
                 Rg[i, c] = 1.0 if i == c else 0.0
@@ -147,27 +171,55 @@ def closure_jacobian(
                 v[i] = s * twists[j, 3 + i]
             g = groups[j]
             if g >= 0:
-                # Ad(g) xi = (Rg w, Rg v + pg x (Rg w))
-                for i in range(3):
-                    col[i] = Rg[i, 0] * w[0] + Rg[i, 1] * w[1] + Rg[i, 2] * w[2]
-                    col[3 + i] = Rg[i, 0] * v[0] + Rg[i, 1] * v[1] + Rg[i, 2] * v[2]
-                col[3] += pg[1] * col[2] - pg[2] * col[1]
-                col[4] += pg[2] * col[0] - pg[0] * col[2]
-                col[5] += pg[0] * col[1] - pg[1] * col[0]
-                for r in range(nrows):
-                    jac[k * nrows + r, g] += col[rows[r]]
+                adjoint_column(Rg, pg, w, v, col)
+                if weight is not None:
+                    weigh_rows(weight, rows, col, kept)
+                    for r in range(nrows):
+                        jac[k * nrows + r, g] += kept[rows[r]]
+                else:
+                    for r in range(nrows):
+                        jac[k * nrows + r, g] += col[rows[r]]
             exp_unit_twist(w, v, q[j], Re, pe)
-            for i in range(3):
-                for c in range(3):
-                    Rn[i, c] = Rg[i, 0] * Re[0, c] + Rg[i, 1] * Re[1, c] + Rg[i, 2] * Re[2, c]
-            for i in range(3):
-                pg[i] += Rg[i, 0] * pe[0] + Rg[i, 1] * pe[1] + Rg[i, 2] * pe[2]
-            for i in range(3):
-                for c in range(3):
-                    Rg[i, c] = Rn[i, c]
+            compose(Rg, pg, Re, pe, Rn)
         log_rigid(Rg, pg, lg)
+        if weight is not None:
+            weigh_rows(weight, rows, lg, kept)
         for r in range(nrows):
-            residual[k * nrows + r] = lg[rows[r]]
+            residual[k * nrows + r] = lg[rows[r]] if weight is None else kept[rows[r]]
+
+
+@njit(cache=True, inline="always")
+def adjoint_column(Rg: np.ndarray, pg: np.ndarray, w: np.ndarray, v: np.ndarray, col: np.ndarray) -> None:
+    """``col = Ad(g) xi = (Rg w, Rg v + pg x (Rg w))``: the twist ``xi = (w, v)`` carried to the base frame."""
+    for i in range(3):
+        col[i] = Rg[i, 0] * w[0] + Rg[i, 1] * w[1] + Rg[i, 2] * w[2]
+        col[3 + i] = Rg[i, 0] * v[0] + Rg[i, 1] * v[1] + Rg[i, 2] * v[2]
+    col[3] += pg[1] * col[2] - pg[2] * col[1]
+    col[4] += pg[2] * col[0] - pg[0] * col[2]
+    col[5] += pg[0] * col[1] - pg[1] * col[0]
+
+
+@njit(cache=True, inline="always")
+def compose(Rg: np.ndarray, pg: np.ndarray, Re: np.ndarray, pe: np.ndarray, Rn: np.ndarray) -> None:
+    """``g <- g e`` in place for rigid motions ``g = [Rg, pg]`` and ``e = [Re, pe]`` (``Rn`` is work space)."""
+    for i in range(3):
+        for c in range(3):
+            Rn[i, c] = Rg[i, 0] * Re[0, c] + Rg[i, 1] * Re[1, c] + Rg[i, 2] * Re[2, c]
+    for i in range(3):
+        pg[i] += Rg[i, 0] * pe[0] + Rg[i, 1] * pe[1] + Rg[i, 2] * pe[2]
+    for i in range(3):
+        for c in range(3):
+            Rg[i, c] = Rn[i, c]
+
+
+@njit(cache=True, inline="always")
+def weigh_rows(weight: np.ndarray, rows: np.ndarray, vector: np.ndarray, out: np.ndarray) -> None:
+    """``out[i] = (W vector)[i]`` for the kept rows ``i`` in ``rows`` (the other entries are left alone)."""
+    for r in range(rows.shape[0]):
+        acc = 0.0
+        for c in range(6):
+            acc += weight[rows[r], c] * vector[c]
+        out[rows[r]] = acc
 
 
 @njit(cache=True)
@@ -176,3 +228,43 @@ def expand(u: np.ndarray, groups: np.ndarray, q: np.ndarray) -> None:
     for j in range(groups.shape[0]):
         g = groups[j]
         q[j] = u[g] if g >= 0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def cholesky_in_place(A: np.ndarray, floor: float, fallback: float) -> bool:
+    """Cholesky factor ``A = L L^T`` of a symmetric positive (semi)definite ``A``, written into its lower triangle
+    (the lower triangle of ``A`` is all that is read).
+
+    A pivot at or below ``floor`` is replaced by ``fallback`` when that is positive (a singular matrix then still
+    gives a finite solve); otherwise the factorisation stops and returns False.
+    """
+    for a in range(A.shape[0]):
+        for c in range(a + 1):
+            acc = A[a, c]
+            for k in range(c):
+                acc -= A[a, k] * A[c, k]
+            if a != c:
+                A[a, c] = acc / A[c, c]
+            elif acc <= floor:
+                if fallback <= 0.0:
+                    return False
+                A[a, a] = fallback
+            else:
+                A[a, a] = np.sqrt(acc)
+    return True
+
+
+@njit(cache=True, inline="always")
+def cholesky_solve(L: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
+    """``x`` solving ``L L^T x = b`` by two triangular solves, ``L`` the lower triangle of a Cholesky factor."""
+    n = b.shape[0]
+    for a in range(n):
+        acc = b[a]
+        for k in range(a):
+            acc -= L[a, k] * x[k]
+        x[a] = acc / L[a, a]
+    for a in range(n - 1, -1, -1):
+        acc = x[a]
+        for k in range(a + 1, n):
+            acc -= L[k, a] * x[k]
+        x[a] = acc / L[a, a]

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from linkwork.kinematics.kernels import closure_jacobian, expand
+from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_jacobian, expand
 
 BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING, NO_PROGRESS = 0, 1, 2, 3, 4, 5, 6, 7
 TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
@@ -118,29 +118,10 @@ def least_squares_step(jac, res, held, u):
     dmax = 0.0
     for i in range(k):
         dmax = max(dmax, A[i, i])
-    L = np.zeros((k, k))
-    for i in range(k):
-        for j in range(i + 1):
-            acc = A[i, j]
-            for p in range(j):
-                acc -= L[i, p] * L[j, p]
-            if i == j:
-                if acc <= 1e-10 * dmax:
-                    return False
-                L[i, i] = np.sqrt(acc)
-            else:
-                L[i, j] = acc / L[j, j]
+    if not cholesky_in_place(A, 1e-10 * dmax, 0.0):
+        return False
     y = np.empty(k)
-    for i in range(k):
-        acc = b[i]
-        for p in range(i):
-            acc -= L[i, p] * y[p]
-        y[i] = acc / L[i, i]
-    for i in range(k - 1, -1, -1):
-        acc = y[i]
-        for p in range(i + 1, k):
-            acc -= L[p, i] * y[p]
-        y[i] = acc / L[i, i]
+    cholesky_solve(A, b, y)
     for i in range(k):
         u[idx[i]] -= y[i]
     return True

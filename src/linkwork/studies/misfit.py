@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from linkwork.kinematics.kernels import exp_unit_twist, expand, log_rigid
+from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand
 
 
 @njit(cache=True)
@@ -31,87 +31,23 @@ def weighted_closure(
     residual: np.ndarray,
     jac: np.ndarray,
 ) -> None:
-    """Weighted closure residual ``T log(P)`` (kept rows, per loop) and its Jacobian in the unknowns, in place.
-
-    As :func:`linkwork.kinematics.kernels.closure_jacobian` (columns ``s Ad(g) xi``, Eq. (21)), with every
-    6-vector mapped by ``T`` before the rows are kept.
-    """
-    scratch = np.empty((5, 3, 3))
-    vectors = np.empty((5, 6))
-    _weighted_closure(
-        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, residual, jac, scratch, vectors
+    """Weighted closure residual ``T log(P)`` (kept rows, per loop) and its Jacobian in the unknowns, in place:
+    :func:`linkwork.kinematics.kernels.closure_pass` (columns ``s Ad(g) xi``, Eq. (21)) with the weight ``T``."""
+    matrices, vectors = work_arrays()
+    closure_pass(
+        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, residual, jac, matrices, vectors
     )
 
 
 @njit(cache=True)
-def _weighted_closure(
-    twists: np.ndarray,
-    q: np.ndarray,
-    loop_joint: np.ndarray,
-    loop_sign: np.ndarray,
-    loop_ptr: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
-    T: np.ndarray,
-    residual: np.ndarray,
-    jac: np.ndarray,
-    scratch: np.ndarray,
-    vectors: np.ndarray,
-) -> None:
-    """:func:`weighted_closure` with its work arrays given (``scratch (5, 3, 3)``, ``vectors (5, 6)``)."""
-    nrows = rows.shape[0]
-    jac[:, :] = 0.0
-    Rg = scratch[0]
-    Re = scratch[1]
-    Rn = scratch[2]
-    pg = vectors[0, :3]
-    pe = vectors[0, 3:]
-    w = vectors[1, :3]
-    v = vectors[1, 3:]
-    col = vectors[2]
-    lg = vectors[3]
-    for k in range(loop_ptr.shape[0] - 1):
-        for i in range(3):
-            for c in range(3):
-                Rg[i, c] = 1.0 if i == c else 0.0
-            pg[i] = 0.0
-        for idx in range(loop_ptr[k], loop_ptr[k + 1]):
-            j = loop_joint[idx]
-            s = float(loop_sign[idx])
-            for i in range(3):
-                w[i] = s * twists[j, i]
-                v[i] = s * twists[j, 3 + i]
-            g = groups[j]
-            if g >= 0:
-                for i in range(3):
-                    col[i] = Rg[i, 0] * w[0] + Rg[i, 1] * w[1] + Rg[i, 2] * w[2]
-                    col[3 + i] = Rg[i, 0] * v[0] + Rg[i, 1] * v[1] + Rg[i, 2] * v[2]
-                col[3] += pg[1] * col[2] - pg[2] * col[1]
-                col[4] += pg[2] * col[0] - pg[0] * col[2]
-                col[5] += pg[0] * col[1] - pg[1] * col[0]
-                for r in range(nrows):
-                    acc = 0.0
-                    for c in range(6):
-                        acc += T[rows[r], c] * col[c]
-                    jac[k * nrows + r, g] += acc
-            exp_unit_twist(w, v, q[j], Re, pe)
-            for i in range(3):
-                for c in range(3):
-                    Rn[i, c] = Rg[i, 0] * Re[0, c] + Rg[i, 1] * Re[1, c] + Rg[i, 2] * Re[2, c]
-            for i in range(3):
-                pg[i] += Rg[i, 0] * pe[0] + Rg[i, 1] * pe[1] + Rg[i, 2] * pe[2]
-            for i in range(3):
-                for c in range(3):
-                    Rg[i, c] = Rn[i, c]
-        log_rigid(Rg, pg, lg)
-        for r in range(nrows):
-            acc = 0.0
-            for c in range(6):
-                acc += T[rows[r], c] * lg[c]
-            residual[k * nrows + r] = acc
+def work_arrays() -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, ...]]:
+    """The work arrays of :func:`linkwork.kinematics.kernels.closure_pass`, allocated once per misfit solve."""
+    matrices = (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)))
+    vectors = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(6), np.empty(6), np.empty(6))
+    return matrices, vectors
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _solve_normal(Jy: np.ndarray, r: np.ndarray, dy: np.ndarray, A: np.ndarray, b: np.ndarray) -> None:
     """Gauss-Newton step ``dy``: ``(A + mu I) dy = -Jy^T r`` with ``A = Jy^T Jy`` by Cholesky (``A``, ``b`` are
     work arrays); ``mu`` a tiny regularisation that keeps singular points finite."""
@@ -133,26 +69,51 @@ def _solve_normal(Jy: np.ndarray, r: np.ndarray, dy: np.ndarray, A: np.ndarray, 
     mu = 1e-14 * top + 1e-300
     for a in range(m):
         A[a, a] += mu
-    # Cholesky A = L L^T in place (lower triangle), then two triangular solves.
-    for a in range(m):
-        for c in range(a + 1):
-            acc = A[a, c]
-            for k in range(c):
-                acc -= A[a, k] * A[c, k]
-            if a == c:
-                A[a, a] = np.sqrt(acc) if acc > 0.0 else 1e-150
-            else:
-                A[a, c] = acc / A[c, c]
-    for a in range(m):
-        acc = b[a]
-        for k in range(a):
-            acc -= A[a, k] * dy[k]
-        dy[a] = acc / A[a, a]
-    for a in range(m - 1, -1, -1):
-        acc = dy[a]
-        for k in range(a + 1, m):
-            acc -= A[k, a] * dy[k]
-        dy[a] = acc / A[a, a]
+    cholesky_in_place(A, 0.0, 1e-150)  # a zero pivot (a singular point) kept finite
+    cholesky_solve(A, b, dy)
+
+
+@njit(cache=True, inline="always")
+def _on_plane(u_path: np.ndarray, normal: np.ndarray, k: int, y: np.ndarray, u: np.ndarray) -> None:
+    """``u = u_k + Q_k y``: the unknowns at offset ``y`` in the plane normal to the nominal path at point ``k``."""
+    for a in range(u.shape[0]):
+        acc = u_path[k, a]
+        for c in range(y.shape[0]):
+            acc += normal[k, a, c] * y[c]
+        u[a] = acc
+
+
+@njit(cache=True, inline="always")
+def _warm_start(u_path: np.ndarray, normal: np.ndarray, k: int, u: np.ndarray, y: np.ndarray) -> None:
+    """``y = Q_k^T (u - u_{k-1})``: the previous point's offset from the path, carried into point ``k``'s plane."""
+    for c in range(y.shape[0]):
+        acc = 0.0
+        for a in range(u.shape[0]):
+            acc += normal[k, a, c] * (u[a] - u_path[k - 1, a])
+        y[c] = acc
+
+
+@njit(cache=True, inline="always")
+def _in_plane(J: np.ndarray, normal: np.ndarray, k: int, Jy: np.ndarray) -> None:
+    """``Jy = J Q_k``: the Jacobian in the plane's coordinates."""
+    for e in range(J.shape[0]):
+        for c in range(Jy.shape[1]):
+            acc = 0.0
+            for a in range(J.shape[1]):
+                acc += J[e, a] * normal[k, a, c]
+            Jy[e, c] = acc
+
+
+@njit(cache=True, inline="always")
+def _predicted_gain(Jy: np.ndarray, dy: np.ndarray) -> float:
+    """``|Jy dy|^2``: how much the step lowers ``|r|^2``, to first order."""
+    gain = 0.0
+    for e in range(Jy.shape[0]):
+        acc = 0.0
+        for c in range(dy.shape[0]):
+            acc += Jy[e, c] * dy[c]
+        gain += acc * acc
+    return gain
 
 
 @njit(cache=True)
@@ -183,8 +144,7 @@ def misfit_along_path(
     J = np.empty((E, m))
     Jy = np.empty((E, p))
     dy = np.empty(p)
-    scratch = np.empty((5, 3, 3))
-    vectors = np.empty((5, 6))
+    matrices, vectors = work_arrays()
     A = np.empty((p, p))
     b = np.empty(p)
     y = np.zeros(p)
@@ -192,24 +152,13 @@ def misfit_along_path(
     u = np.empty(m)
     for k in range(K):
         if k > 0:
-            # Warm start: the previous point's offset from the path, carried into this point's normal plane.
-            for c in range(p):
-                acc = 0.0
-                for a in range(m):
-                    acc += normal[k, a, c] * (u[a] - u_path[k - 1, a])
-                y[c] = acc
+            _warm_start(u_path, normal, k, u, y)
         best = np.inf
         halvings = 0
         for _ in range(max_iter):
-            for a in range(m):
-                acc = u_path[k, a]
-                for c in range(p):
-                    acc += normal[k, a, c] * y[c]
-                u[a] = acc
+            _on_plane(u_path, normal, k, y, u)
             expand(u, groups, q)
-            _weighted_closure(
-                twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, scratch, vectors
-            )
+            closure_pass(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, matrices, vectors)
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
@@ -220,26 +169,14 @@ def misfit_along_path(
             converged = best - norm <= 1e-10 * norm
             best = norm
             halvings = 0
-            for c in range(p):
-                y_old[c] = y[c]
+            y_old[:] = y
             if converged or norm == 0.0:
                 break
-            for e in range(E):
-                for c in range(p):
-                    acc = 0.0
-                    for a in range(m):
-                        acc += J[e, a] * normal[k, a, c]
-                    Jy[e, c] = acc
+            _in_plane(J, normal, k, Jy)
             _solve_normal(Jy, r, dy, A, b)
             # The step lowers |r|^2 by |Jy dy|^2 to first order: when that is below 1e-8 |r|^2 the misfit is
             # known to 1e-8 relative already, and a further evaluation would not change it.
-            gain = 0.0
-            for e in range(E):
-                acc = 0.0
-                for c in range(p):
-                    acc += Jy[e, c] * dy[c]
-                gain += acc * acc
-            if gain <= 1e-8 * norm * norm:
+            if _predicted_gain(Jy, dy) <= 1e-8 * norm * norm:
                 break
             step = 0.0
             for c in range(p):
@@ -247,11 +184,7 @@ def misfit_along_path(
                 step = max(step, abs(dy[c]))
             if step < 1e-15:
                 break
-        for a in range(m):
-            acc = u_path[k, a]
-            for c in range(p):
-                acc += normal[k, a, c] * y_old[c]
-            u[a] = acc
+        _on_plane(u_path, normal, k, y_old, u)
         out[k] = best
 
 
