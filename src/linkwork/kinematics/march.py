@@ -300,8 +300,7 @@ def march(
     ``(count, code, h)``: rows written, the stop code and the last step length.
     """
     m = u0.shape[0]
-    E = loop_ptr.shape[0] - 1
-    E *= rows.shape[0]
+    E = (loop_ptr.shape[0] - 1) * rows.shape[0]
     q = np.empty(groups.shape[0])
     res = np.empty(E)
     jac = np.empty((E, m))
@@ -311,15 +310,11 @@ def march(
     sig = np.empty(out_sigma.shape[1])
     u_try = np.empty(m)
     h = h0
+    # ---- the start: row 0, its tangent oriented along t0
     r0 = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
     tau = tangent_and_test(jac, t, basis, r_path, t_new, sig)
     t[:] = t_new
-    out_u[0, :] = u
-    out_t[0, :] = t
-    out_sigma[0, :] = sig
-    out_res[0] = r0
-    out_tau[0] = tau
-    out_s[0] = 0.0
+    write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, 0, u, t, sig, r0, tau, 0.0)
     s_total = 0.0
     basis_try = basis.copy()
     far = wrapped_distance(u0, u_home, periodic)
@@ -330,7 +325,7 @@ def march(
         step, landing, held = predict(u, t, h, paper, drive, target, has_target, count == 1, u_try)
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
-        # ---- corrector (Sec. 4.2, Eq. (28))
+        # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         ok, iters, r = correct(
             twists, loop_joint, loop_sign, loop_ptr, rows, groups, u_try, held, tol, exact, roundoff, truncate,
             max_iter, q, res, jac,
@@ -340,10 +335,8 @@ def march(
             basis_try[:, :] = basis
             tau_new = tangent_and_test(jac, t, basis_try, r_path, t_new, sig)
             turn, dist, ahead = step_geometry(u, t, u_try, t_new)
-            jumped = dist > 2.0 * step + 1e-300
-            pulled_back = ahead < advance * step
-            if not paper and not landing and (turn < cos_turn or jumped or pulled_back) and h > hmin:
-                ok = False
+            if not paper and not landing and h > hmin:
+                ok = step_acceptable(turn, dist, ahead, step, cos_turn, advance)
         if not ok:
             if paper:
                 return count, FAILED, h
@@ -353,36 +346,69 @@ def march(
             continue
         # ---- accept the step
         s_total += dist
-        for a in range(m):
-            u[a] = u_try[a]
-            t[a] = t_new[a]
+        u[:] = u_try
+        t[:] = t_new
         basis[:, :] = basis_try
-        out_u[count, :] = u
-        out_t[count, :] = t
-        out_sigma[count, :] = sig
-        out_res[count] = r
-        out_tau[count] = tau_new
-        out_s[count] = s_total
+        write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, count, u, t, sig, r, tau_new, s_total)
         recent[count % recent.shape[0]] = dist
         count += 1
+        # ---- events that end the march
         if not paper and count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
             return count, NO_PROGRESS, h
-        if landing:
-            return count, TARGET, h
-        for a in range(m):
-            if u[a] < lo[a] or u[a] > hi[a]:
-                return count, LIMIT, h
-        if detect and tau_new * out_tau[count - 2] < 0.0:
-            return count, SIGN_CHANGE, h
+        code = step_event(u, landing, lo, hi, detect, tau_new * out_tau[count - 2])
+        if code >= 0:
+            return count, code, h
         if check_closed:
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
             far = max(far, d)
             if far > 4.0 * hmax and d < 1.5 * abs(h):
-                snap_home(u, u_home, periodic, out_u[count - 1])
-                out_sigma[count - 1, :] = out_sigma[0, :]
-                out_res[count - 1] = out_res[0]
-                out_tau[count - 1] = out_tau[0]
+                close_path(u, u_home, periodic, count - 1, out_u, out_sigma, out_res, out_tau)
                 return count, CLOSED, h
+        # ---- step control: grow an easy adaptive step
         if not paper and iters <= 3 and turn > np.sqrt(cos_turn):
             h = min(h * 1.5, hmax)
     return count, BUDGET, h
+
+
+@njit(cache=True, inline="always")
+def write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, row, u, t, sig, r, tau, s):
+    """Row ``row`` of the march's outputs: the point, its tangent, singular values, residual, test value and
+    arclength."""
+    out_u[row, :] = u
+    out_t[row, :] = t
+    out_sigma[row, :] = sig
+    out_res[row] = r
+    out_tau[row] = tau
+    out_s[row] = s
+
+
+@njit(cache=True, inline="always")
+def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
+    """Whether an adaptive step is kept: the tangent turned by less than ``acos(cos_turn)``, the corrector neither
+    jumped (more than twice the step away) nor pulled the point back (less than ``advance`` of the step ahead)."""
+    jumped = dist > 2.0 * step + 1e-300
+    pulled_back = ahead < advance * step
+    return not (turn < cos_turn or jumped or pulled_back)
+
+
+@njit(cache=True, inline="always")
+def step_event(u, landing, lo, hi, detect, tau_product):
+    """The stop code an accepted step ends the march with (the target reached, a joint limit passed, a sign change
+    of the test function, ``tau_product`` being the product of its last two values), ``-1`` for none."""
+    if landing:
+        return TARGET
+    for a in range(u.shape[0]):
+        if u[a] < lo[a] or u[a] > hi[a]:
+            return LIMIT
+    if detect and tau_product < 0.0:
+        return SIGN_CHANGE
+    return -1
+
+
+@njit(cache=True, inline="always")
+def close_path(u, u_home, periodic, row, out_u, out_sigma, out_res, out_tau):
+    """Make row ``row`` the start again (in ``u``'s continuous angles, see :func:`snap_home`): the path closed."""
+    snap_home(u, u_home, periodic, out_u[row])
+    out_sigma[row, :] = out_sigma[0, :]
+    out_res[row] = out_res[0]
+    out_tau[row] = out_tau[0]
