@@ -110,20 +110,33 @@ def body_poses(
     q = np.asarray(q, dtype=float) if angles is None else mech.q_from_angles(angles)
     if not mech.bodies:
         return {}
+    root, edges = body_tree(mech)
+    poses = {root: np.eye(4)}
+    for body, j, other, s in edges:
+        poses[other] = poses[body] @ exp_se3(s * mech.twists[j] * q[j])
+    return poses
+
+
+def body_tree(mech: Mechanism) -> tuple[str, list[tuple[str, int, str, int]]]:
+    """The spanning tree along which body poses are chained: its root (the ground, when there is one, else the
+    first body) and its edges ``(body, joint, other, sign)`` in breadth-first order, ``other`` reached from
+    ``body`` through ``joint`` (``sign`` -1 when the joint is walked from its second body to its first)."""
     root = "ground" if "ground" in mech.bodies else mech.bodies[0]
     adjacency: dict[str, list[tuple[int, str, int]]] = {b: [] for b in mech.bodies}
     for j, (a, b) in enumerate(mech.joint_bodies):
         adjacency[a].append((j, b, 1))
         adjacency[b].append((j, a, -1))
-    poses = {root: np.eye(4)}
+    edges = []
+    seen = {root}
     queue = deque([root])
     while queue:
         body = queue.popleft()
         for j, other, s in adjacency[body]:
-            if other not in poses:
-                poses[other] = poses[body] @ exp_se3(s * mech.twists[j] * q[j])
+            if other not in seen:
+                seen.add(other)
+                edges.append((body, j, other, s))
                 queue.append(other)
-    return poses
+    return root, edges
 
 
 def spatial_twists(mech: Mechanism, q: ArrayLike, poses: dict[str, Array] | None = None) -> Array:

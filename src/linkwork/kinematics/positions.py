@@ -11,12 +11,11 @@ axis is fixed in both of its bodies).
 
 from __future__ import annotations
 
-from collections import deque
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.geometry import exp_se3
+from linkwork.kinematics.closure import body_tree
 from linkwork.kinematics.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -93,19 +92,10 @@ def poses_along(mech: Mechanism, angles: ArrayLike) -> dict[str, Array]:
     q = mech.q_from_angles(np.atleast_2d(np.asarray(angles, dtype=float)))
     if not mech.bodies:
         return {}
-    root = "ground" if "ground" in mech.bodies else mech.bodies[0]
-    adjacency: dict[str, list[tuple[int, str, int]]] = {b: [] for b in mech.bodies}
-    for j, (a, b) in enumerate(mech.joint_bodies):
-        adjacency[a].append((j, b, 1))
-        adjacency[b].append((j, a, -1))
+    root, edges = body_tree(mech)
     poses = {root: np.broadcast_to(np.eye(4), (len(q), 4, 4)).copy()}
-    queue = deque([root])
-    while queue:
-        body = queue.popleft()
-        for j, other, sign in adjacency[body]:
-            if other not in poses:
-                poses[other] = poses[body] @ exp_se3(sign * mech.twists[j] * q[:, j, None])
-                queue.append(other)
+    for body, j, other, sign in edges:
+        poses[other] = poses[body] @ exp_se3(sign * mech.twists[j] * q[:, j, None])
     return poses
 
 
