@@ -60,8 +60,7 @@ def hedgepeth(n: int = 6, couple: bool | None = None) -> Mechanism:
     n/2-fold symmetry is imposed by default: ``A = C = E = ...`` and ``B = D = F = ...``. Pass ``couple=False`` to
     get the free loop, or ``couple=True`` to impose the symmetry also for n = 4, 6.
     """
-    if n < 4 or n % 2:
-        raise SpecError(f"hedgepeth: n must be an even number >= 4, got {n}")
+    check_rod_count("hedgepeth", n)
     g = hedgepeth_angles(n)
     v = [float(np.cos(g["alpha3"])), 0.0, float(np.sin(g["alpha3"]))]
     rods = []
@@ -71,8 +70,27 @@ def hedgepeth(n: int = 6, couple: bool | None = None) -> Mechanism:
     names = default_joint_names(n)
     meta = {"linkage": "hedgepeth", "n": n, "deployed_A": deployed_angle(n)}
     mech, _ = from_rods(f"Hedgepeth hoop n={n}", rods, [0.0] * n, joint_names=names, meta=meta)
-    if couple if couple is not None else n >= 8:
-        mech = mech.with_couplings([names[0::2], names[1::2]])
+    return hoop_symmetry(mech, couple)
+
+
+ROD_COUNT = Param(
+    6, "int", "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry", low=4, high=MAX_RODS
+)
+"""The parameter ``n`` of both built-in hoops (``hedgepeth`` and ``hedgepeth-rods``)."""
+
+
+def check_rod_count(linkage: str, n: int) -> None:
+    """Raise :class:`SpecError` unless ``n`` is a hoop's number of rods: even and at least 4."""
+    if n < 4 or n % 2:
+        raise SpecError(f"{linkage}: n must be an even number >= 4, got {n}")
+
+
+def hoop_symmetry(mech: Mechanism, couple: bool | None) -> Mechanism:
+    """The hoop with its n/2-fold symmetry imposed (``A = C = E = ...``, ``B = D = F = ...``) when ``couple``;
+    by default (``None``) for n >= 8."""
+    names = list(mech.joint_names)
+    if couple if couple is not None else len(names) >= 8:
+        return mech.with_couplings([names[0::2], names[1::2]])
     return mech
 
 
@@ -82,14 +100,6 @@ register(
         build=lambda n: hedgepeth(int(n)),
         summary="Hedgepeth's hoop from Sec. 3's equations as printed (Gan & Pellegrino 2006); for n >= 6 it does "
         "not open flat: see hedgepeth-rods",
-        params={
-            "n": Param(
-                6,
-                "int",
-                "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry",
-                low=4,
-                high=MAX_RODS,
-            )
-        },
+        params={"n": ROD_COUNT},
     )
 )

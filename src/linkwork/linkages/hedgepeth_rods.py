@@ -35,7 +35,8 @@ from linkwork.errors import SpecError
 from linkwork.geometry import line_twist
 from linkwork.geometry.names import default_joint_names
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.linkages.registry import MAX_RODS, LinkageEntry, Param, register
+from linkwork.linkages.hedgepeth import ROD_COUNT, check_rod_count, hoop_symmetry
+from linkwork.linkages.registry import LinkageEntry, register
 
 Array = NDArray[np.float64]
 
@@ -91,8 +92,7 @@ def hedgepeth_rods(n: int = 6, couple: bool | None = None, width: float = 0.2) -
     :func:`~linkwork.linkages.hedgepeth.hedgepeth`, n >= 8 imposes n/2-fold symmetry by default (``A = C = ...``,
     ``B = D = ...``); ``couple=False`` gives the free loop.
     """
-    if n < 4 or n % 2:
-        raise SpecError(f"hedgepeth-rods: n must be an even number >= 4, got {n}")
+    check_rod_count("hedgepeth-rods", n)
     if not width > 0:
         raise SpecError(f"hedgepeth-rods: width must be positive, got {width}")
     twists = []
@@ -112,9 +112,7 @@ def hedgepeth_rods(n: int = 6, couple: bool | None = None, width: float = 0.2) -
         "deployed_B": outer,
     }
     mech = Mechanism.single_loop(f"Hedgepeth hoop (rods) n={n}", names, np.array(twists), meta=meta)
-    if couple if couple is not None else n >= 8:
-        mech = mech.with_couplings([names[0::2], names[1::2]])
-    return mech
+    return hoop_symmetry(mech, couple)
 
 
 register(
@@ -122,14 +120,6 @@ register(
         name="hedgepeth-rods",
         build=lambda n: hedgepeth_rods(int(n)),
         summary="Hedgepeth's hoop built from mitred triangular rods: bundle to flat n-gon (physical model)",
-        params={
-            "n": Param(
-                6,
-                "int",
-                "number of rods (even, >= 4); n >= 8 imposes n/2-fold symmetry",
-                low=4,
-                high=MAX_RODS,
-            )
-        },
+        params={"n": ROD_COUNT},
     )
 )

@@ -74,15 +74,18 @@ class LinkageEntry:
         low, high = param.bounds
         unit = " deg" if param.unit == "deg" else ""
         what = "a whole number" if param.unit == "int" else "a finite number"
-        expected = f"expected {what} from {low:g} to {high:g}{unit}"
+        bad = SpecError(
+            f"{self.name}: parameter {key} expected {what} from {low:g} to {high:g}{unit}, got {show(value)}",
+            key="--set",
+        )
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise SpecError(f"{self.name}: parameter {key} {expected}, got {show(value)}", key="--set")
+            raise bad
         number = float(value) if isinstance(value, float) or abs(value) < 10**300 else math.inf
         if not (math.isfinite(number) and low <= number <= high):
-            raise SpecError(f"{self.name}: parameter {key} {expected}, got {show(value)}", key="--set")
+            raise bad
         if param.unit == "int":
             if number != int(number):
-                raise SpecError(f"{self.name}: parameter {key} {expected}, got {show(value)}", key="--set")
+                raise bad
             return int(number)
         return math.radians(number) if param.unit == "deg" else number
 
