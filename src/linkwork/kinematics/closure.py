@@ -14,13 +14,11 @@ The compiled kernels in :mod:`linkwork.kinematics.kernels` compute the same quan
 
 from __future__ import annotations
 
-from collections import deque
-
 import numpy as np
 from numpy.typing import ArrayLike
 
 from linkwork.geometry import adjoint, bracket, exp_se3, log_se3
-from linkwork.kinematics.mechanism import Array, Mechanism
+from linkwork.kinematics.mechanism import Array, Mechanism, spanning_tree
 
 
 def loop_products(mech: Mechanism, q: ArrayLike) -> list[Array]:
@@ -122,21 +120,7 @@ def body_tree(mech: Mechanism) -> tuple[str, list[tuple[str, int, str, int]]]:
     first body) and its edges ``(body, joint, other, sign)`` in breadth-first order, ``other`` reached from
     ``body`` through ``joint`` (``sign`` -1 when the joint is walked from its second body to its first)."""
     root = "ground" if "ground" in mech.bodies else mech.bodies[0]
-    adjacency: dict[str, list[tuple[int, str, int]]] = {b: [] for b in mech.bodies}
-    for j, (a, b) in enumerate(mech.joint_bodies):
-        adjacency[a].append((j, b, 1))
-        adjacency[b].append((j, a, -1))
-    edges = []
-    seen = {root}
-    queue = deque([root])
-    while queue:
-        body = queue.popleft()
-        for j, other, s in adjacency[body]:
-            if other not in seen:
-                seen.add(other)
-                edges.append((body, j, other, s))
-                queue.append(other)
-    return root, edges
+    return root, spanning_tree(mech.joint_bodies, root)
 
 
 def spatial_twists(mech: Mechanism, q: ArrayLike, poses: dict[str, Array] | None = None) -> Array:

@@ -321,66 +321,87 @@ def cycle_basis(pairs: Sequence[tuple[str, str]], ground: str = "ground") -> tup
     if not bodies:
         return [], []
     root = ground if ground in bodies else bodies[0]
-    adjacency: dict[str, list[tuple[int, str]]] = {b: [] for b in bodies}
     for j, (a, b) in enumerate(pairs):
         if a == b:
             raise SpecError(f"joint {j} connects body {a!r} to itself")
-        adjacency[a].append((j, b))
-        adjacency[b].append((j, a))
     parent: dict[str, tuple[str, int] | None] = {root: None}
     depth = {root: 0}
-    queue = deque([root])
-    while queue:
-        body = queue.popleft()
-        for j, other in adjacency[body]:
-            if other not in parent:
-                parent[other] = (body, j)
-                depth[other] = depth[body] + 1
-                queue.append(other)
+    for body, j, other, _ in spanning_tree(pairs, root):
+        parent[other] = (body, j)
+        depth[other] = depth[body] + 1
     unreached = [b for b in bodies if b not in parent]
     if unreached:
         raise SpecError(f"bodies {unreached} are not connected to {root!r} by any joint")
     tree_edges = {edge[1] for edge in parent.values() if edge is not None}
-
-    def step_sign(j: int, frm: str) -> int:
-        return 1 if pairs[j][0] == frm else -1
-
-    loops: list[Loop] = []
-    for j, (a, b) in enumerate(pairs):
-        if j in tree_edges:
-            continue
-        # Walk a and b up to their lowest common ancestor.
-        up_a: list[tuple[int, str]] = []  # (joint, body above) walking from a upward
-        up_b: list[tuple[int, str]] = []
-        x, y = a, b
-        while depth[x] > depth[y]:
-            p = parent[x]
-            assert p is not None
-            up_a.append((p[1], p[0]))
-            x = p[0]
-        while depth[y] > depth[x]:
-            p = parent[y]
-            assert p is not None
-            up_b.append((p[1], p[0]))
-            y = p[0]
-        while x != y:
-            pa, pb = parent[x], parent[y]
-            assert pa is not None and pb is not None
-            up_a.append((pa[1], pa[0]))
-            up_b.append((pb[1], pb[0]))
-            x, y = pa[0], pb[0]
-        # Down from the ancestor to a: reverse of up_a, each joint traversed from its upper body.
-        joints: list[int] = []
-        signs: list[int] = []
-        for jj, above in reversed(up_a):
-            joints.append(jj)
-            signs.append(step_sign(jj, above))
-        joints.append(j)
-        signs.append(1)  # from a (before) to b (after)
-        below = b
-        for jj, above in up_b:
-            joints.append(jj)
-            signs.append(step_sign(jj, below))
-            below = above
-        loops.append(Loop(tuple(joints), tuple(signs)))
+    loops = [_fundamental_loop(pairs, parent, depth, j) for j in range(len(pairs)) if j not in tree_edges]
     return loops, bodies
+
+
+def spanning_tree(pairs: Sequence[tuple[str, str]], root: str) -> list[tuple[str, int, str, int]]:
+    """The breadth-first spanning tree from ``root`` of the body graph whose edges are the joints
+    ``(before, after)``: its edges ``(body, joint, other, sign)`` in the order they are reached, ``other`` reached
+    from ``body`` through ``joint`` (``sign`` -1 when walked from the joint's ``after`` body to its ``before``)."""
+    adjacency: dict[str, list[tuple[int, str, int]]] = {}
+    for j, (a, b) in enumerate(pairs):
+        adjacency.setdefault(a, []).append((j, b, 1))
+        adjacency.setdefault(b, []).append((j, a, -1))
+    edges = []
+    seen = {root}
+    queue = deque([root])
+    while queue:
+        body = queue.popleft()
+        for j, other, sign in adjacency.get(body, []):
+            if other not in seen:
+                seen.add(other)
+                edges.append((body, j, other, sign))
+                queue.append(other)
+    return edges
+
+
+def _fundamental_loop(
+    pairs: Sequence[tuple[str, str]],
+    parent: Mapping[str, tuple[str, int] | None],
+    depth: Mapping[str, int],
+    j: int,
+) -> Loop:
+    """The loop that joint ``j`` (not in the spanning tree ``parent``) closes: down from the lowest common ancestor
+    of its bodies to ``before``, across ``j``, and up from ``after``."""
+
+    def step_sign(jj: int, frm: str) -> int:
+        return 1 if pairs[jj][0] == frm else -1
+
+    a, b = pairs[j]
+    # Walk a and b up to their lowest common ancestor.
+    up_a: list[tuple[int, str]] = []  # (joint, body above) walking from a upward
+    up_b: list[tuple[int, str]] = []
+    x, y = a, b
+    while depth[x] > depth[y]:
+        p = parent[x]
+        assert p is not None
+        up_a.append((p[1], p[0]))
+        x = p[0]
+    while depth[y] > depth[x]:
+        p = parent[y]
+        assert p is not None
+        up_b.append((p[1], p[0]))
+        y = p[0]
+    while x != y:
+        pa, pb = parent[x], parent[y]
+        assert pa is not None and pb is not None
+        up_a.append((pa[1], pa[0]))
+        up_b.append((pb[1], pb[0]))
+        x, y = pa[0], pb[0]
+    # Down from the ancestor to a: reverse of up_a, each joint traversed from its upper body.
+    joints: list[int] = []
+    signs: list[int] = []
+    for jj, above in reversed(up_a):
+        joints.append(jj)
+        signs.append(step_sign(jj, above))
+    joints.append(j)
+    signs.append(1)  # from a (before) to b (after)
+    below = b
+    for jj, above in up_b:
+        joints.append(jj)
+        signs.append(step_sign(jj, below))
+        below = above
+    return Loop(tuple(joints), tuple(signs))
