@@ -53,21 +53,22 @@ def twist_hat(xi: ArrayLike) -> Array:
 
 def rot_z(angle: ArrayLike) -> Array:
     """Homogeneous rotation about z by ``angle`` (radians), shape ``(..., 4, 4)``."""
-    a = np.asarray(angle, dtype=float)
-    out = np.zeros((*a.shape, 4, 4))
-    c, s = np.cos(a), np.sin(a)
-    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
-    out[..., 2, 2] = out[..., 3, 3] = 1.0
-    return out
+    return _axis_rotation(angle, 2)
 
 
 def rot_x(angle: ArrayLike) -> Array:
     """Homogeneous rotation about x by ``angle`` (radians), shape ``(..., 4, 4)``."""
+    return _axis_rotation(angle, 0)
+
+
+def _axis_rotation(angle: ArrayLike, axis: int) -> Array:
+    """Homogeneous rotation about coordinate axis ``axis`` (0, 1, 2: x, y, z) by ``angle``, right-handed."""
     a = np.asarray(angle, dtype=float)
     out = np.zeros((*a.shape, 4, 4))
     c, s = np.cos(a), np.sin(a)
-    out[..., 1, 1], out[..., 1, 2], out[..., 2, 1], out[..., 2, 2] = c, -s, s, c
-    out[..., 0, 0] = out[..., 3, 3] = 1.0
+    i, k = ((1, 2), (2, 0), (0, 1))[axis]  # the plane turned, in the order that makes the rotation positive
+    out[..., i, i], out[..., i, k], out[..., k, i], out[..., k, k] = c, -s, s, c
+    out[..., axis, axis] = out[..., 3, 3] = 1.0
     return out
 
 
