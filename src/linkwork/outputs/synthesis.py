@@ -165,6 +165,16 @@ def _matrix_table(title: str, result: SynthesisResult, cells: np.ndarray, fmt: s
 
 def print_synthesis_summary(result: SynthesisResult) -> None:
     """Print the profiles, the design, the segment and error matrices and the compound merges."""
+    _print_profiles_and_design(result)
+    console.print(_matrix_table("Segment matrix (pieces)", result, result.segment_matrix, "d"))
+    console.print(_matrix_table("Error matrix after segmentation", result, result.error_matrix, ".4f"))
+    console.print(_matrix_table("Error matrix after joining", result, result.joined_error_matrix, ".4f"))
+    _print_errors(result)
+    _print_compound(result)
+
+
+def _print_profiles_and_design(result: SynthesisResult) -> None:
+    """The profiles' table, the design vector and how the search found it (with the designs it skipped)."""
     profiles = _table("Profiles")
     for column in ("profile", "arc length C", "pieces m", "target length s", "S / C"):
         profiles.add_column(column, justify="left" if column == "profile" else "right")
@@ -199,9 +209,11 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
         console.print(f"skipped {design}: {reason}", highlight=False, markup=False)
     if len(stats.skipped) > 5:
         console.print(f"... and {len(stats.skipped) - 5} more skipped (see chain.json search.skipped)")
-    console.print(_matrix_table("Segment matrix (pieces)", result, result.segment_matrix, "d"))
-    console.print(_matrix_table("Error matrix after segmentation", result, result.error_matrix, ".4f"))
-    console.print(_matrix_table("Error matrix after joining", result, result.joined_error_matrix, ".4f"))
+
+
+def _print_errors(result: SynthesisResult) -> None:
+    """E_max and E_mean after segmentation, after joining and with compound segments."""
+    compound = result.compound
     errors = _table("Errors")
     for column in ("stage", "E_max", "E_mean"):
         errors.add_column(column, justify="left" if column == "stage" else "right")
@@ -209,10 +221,14 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
     errors.add_row(
         "joined", f"{result.joined_e_max:.4f}", f"{float(np.mean(result.joined_error_matrix)):.4f}"
     )
-    compound = result.compound
     if compound is not None and compound.merged:
         errors.add_row("compound", f"{compound.e_max:.4f}", f"{float(np.mean(compound.error_matrix)):.4f}")
     console.print(errors)
+
+
+def _print_compound(result: SynthesisResult) -> None:
+    """The joints' ranges of motion (Eq. 34) and which were merged into compound segments."""
+    compound = result.compound
     if compound is None:
         console.print("compound segments: off (merge_below = 0)")
         return
