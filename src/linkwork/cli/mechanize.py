@@ -52,13 +52,14 @@ def mechanize(
         print_mechanization,
         resolve_options,
     )
-    from linkwork.outputs.synthesis import load_synthesis
+    from linkwork.outputs.synthesis import rerun_synthesis, synthesis_problem
 
     check_output_folder(out or folder)
     if "dof" in flags:
         check_range("--dof", flags["dof"], 1, MAX_DOF, "a whole number of degrees of freedom")
-    result = load_synthesis(folder, problem)
-    options = resolve_options(result.problem, flags)
+    spec = synthesis_problem(folder, problem)
+    options = resolve_options(spec, flags)  # a bad flag stops here, before the synthesis is run again
+    result = rerun_synthesis(folder, spec)
     target = out or folder
     with staged_output(target) as stage, progress_bar("[bold]mechanizing[/]", None) as progress:
         found, written = mechanize_into(

@@ -20,6 +20,7 @@ from linkwork.outputs.staging import console, have_matplotlib, staged_output
 if TYPE_CHECKING:
     from rich.table import Table
 
+    from linkwork.synthesis.problem import Problem
     from linkwork.synthesis.result import SynthesisResult
 
 
@@ -93,23 +94,35 @@ def load_synthesis(folder: Path, problem: Path | None = None) -> SynthesisResult
     SpecError
         When ``chain.json`` or the problem file is missing, or the problem no longer gives the same chain.
     """
-    from linkwork.io.problem import load_problem
-    from linkwork.synthesis import synthesize
+    return rerun_synthesis(folder, synthesis_problem(folder, problem))
 
-    chain_file = folder / "chain.json"
-    if not chain_file.is_file():
+
+def synthesis_problem(folder: Path, problem: Path | None = None) -> Problem:
+    """The problem a ``linkwork synth`` output folder came from (``folder/problem/problem.toml`` unless
+    ``problem`` is given), read without running the synthesis; the folder must hold a ``chain.json``."""
+    from linkwork.io.problem import load_problem
+
+    if not (folder / "chain.json").is_file():
         raise SpecError(f"{folder}: no chain.json; expected a `linkwork synth` output folder")
     problem = problem or folder / "problem" / "problem.toml"
     if not problem.is_file():
         raise SpecError(
             f"{folder}: no problem file at {problem}; pass the problem the chain came from with --problem"
         )
+    return load_problem(problem)
+
+
+def rerun_synthesis(folder: Path, spec: Problem) -> SynthesisResult:
+    """Run the (seeded) synthesis of ``spec`` again and check that it gives the chain of ``folder/chain.json``."""
+    from linkwork.synthesis import synthesize
+
+    chain_file = folder / "chain.json"
     design, e_max = _read_chain_json(chain_file)
-    result = synthesize(load_problem(problem))
+    result = synthesize(spec)
     same = design == result.design and math.isclose(e_max, result.joined_e_max, rel_tol=1e-9, abs_tol=1e-12)
     if not same:
         raise SpecError(
-            f"{chain_file}: the chain (design {show(design)}) is not what {problem} gives now "
+            f"{chain_file}: the chain (design {show(design)}) is not what {spec.source} gives now "
             f"(design {result.design}); run `linkwork synth` again"
         )
     return result
