@@ -191,6 +191,12 @@ def track(displacements: Array, point: ArrayLike) -> Array:
     return np.array([apply(g, point) for g in displacements])
 
 
+def track_direction(displacements: Array, direction: ArrayLike) -> Array:
+    """``(p, 2)`` a direction of a body (profile-1 coordinates) as it turns with the body's ``(p, 3)``
+    displacements."""
+    return np.array([apply(np.array([0.0, 0.0, g[2]]), direction) for g in displacements])
+
+
 @dataclass(frozen=True)
 class _Pieces:
     """The joined (or compound) profiles cut into the segments' pieces."""
