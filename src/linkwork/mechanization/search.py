@@ -112,11 +112,29 @@ def _free_directions(chain: ShapeChain, body: str, via: str | None, m: Array) ->
     return np.column_stack([-r[:, 1], r[:, 0]]) / n
 
 
-def _quality(link_dir: Array, free: Array | None) -> Array:
-    """Sine of the transmission angle on every profile (signed), 1 when there is no neighbour."""
+def _transmitting(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    m: Array,
+    kind: str,
+    acting: Array,
+    options: MechanizeOptions,
+) -> Array | None:
+    """Signed sine of the transmission angle on every profile of a link with moving pivot ``m`` on ``body``
+    (1 when there is no neighbour ``via``), or ``None`` when the link is dropped: its pivot on the neighbour's
+    joint, a transmission angle below the limit, or a change of assembly mode (:func:`_accepts`).
+
+    ``acting`` ``(p, 2)`` is the direction in the world of an RR link (``kind`` ``"RR"``), or of a slider's guide
+    (``"PR"``), which reacts along its normal (:func:`linkwork.mechanization.sliders.transmission`).
+    """
+    free = _free_directions(chain, body, via, m)
     if free is None:
-        return np.ones(len(link_dir))
-    return np.sum(link_dir * free, axis=1)
+        return np.ones(chain.count)
+    if np.any(~np.isfinite(free)):
+        return None
+    s = np.sum(acting * free, axis=1) if kind == "RR" else sliders.transmission(acting, free)
+    return s if _accepts(s, options) else None
 
 
 def body_candidates(
@@ -145,10 +163,8 @@ def body_candidates(
     return out
 
 
-def _accepts(s: Array | None, options: MechanizeOptions) -> bool:
+def _accepts(s: Array, options: MechanizeOptions) -> bool:
     """Transmission above the limit on every profile, one assembly mode throughout (one sign)."""
-    if s is None:
-        return True
     limit = math.sin(options.min_transmission)
     return not (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0)))
 
@@ -180,11 +196,8 @@ def _rr_candidates(
             continue
         u = track(g_body, m) - track(g_anchor, c)
         u /= np.linalg.norm(u, axis=1, keepdims=True)
-        free = _free_directions(chain, body, via, m)
-        if free is not None and np.any(~np.isfinite(free)):
-            continue
-        s = _quality(u, free)
-        if not _accepts(None if free is None else s, options):
+        s = _transmitting(chain, body, via, m, "RR", u, options)
+        if s is None:
             continue
         mu = _smallest_angle(s)
         ratio = abs(math.log(r / (0.5 * chain.size)))
@@ -206,7 +219,6 @@ def _slider_candidates(
 ) -> list[Candidate]:
     """PR sliders: slider points of the body (exact for three profiles), guides fitted through their positions,
     kept when the slider moves one way, its guide lies in the region (on the ground) and it transmits well."""
-    p = chain.count
     g_anchor = chain.motion(anchor)
     grid = _moving_pivots(chain, body, max(3, options.candidates // 2), options.link_offset)
     out = []
@@ -219,12 +231,8 @@ def _slider_candidates(
                 ends = start + np.outer([travel[0], travel[-1]], u)
                 if anchor == "ground" and not np.all(region.contains(ends)):
                     continue
-                free = _free_directions(chain, body, via, m)
-                if free is not None and np.any(~np.isfinite(free)):
-                    continue
-                world_u = track_direction(g_anchor, u)
-                s = sliders.transmission(world_u, free) if free is not None else np.ones(p)
-                if not _accepts(None if free is None else s, options):
+                s = _transmitting(chain, body, via, m, "PR", track_direction(g_anchor, u), options)
+                if s is None:
                     continue
                 mu = _smallest_angle(s)
                 score = math.degrees(mu) - 1e3 * error / chain.size
