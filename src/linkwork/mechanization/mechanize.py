@@ -16,7 +16,14 @@ import numpy as np
 
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
-from linkwork.mechanization.options import MechanizeOptions, ProgressCallback, options_from_values
+from linkwork.mechanization.options import (
+    ACTUATORS,
+    ANCHORS,
+    BINARY_LINKS,
+    MechanizeOptions,
+    ProgressCallback,
+    options_from_values,
+)
 from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
@@ -288,18 +295,13 @@ def _check(options: MechanizeOptions) -> None:
     """Reject options no search can use (the problem reader and the flags check them too)."""
     if options.dof < 1:
         raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
-    if options.actuator not in ("revolute", "prismatic"):
-        raise MechanizationError(
-            f"mechanize: actuator {options.actuator!r}: expected 'revolute' or 'prismatic'"
-        )
-    if options.binary_links not in ("revolute", "prismatic", "both"):
-        raise MechanizationError(
-            f"mechanize: binary_links {options.binary_links!r}: expected 'revolute', 'prismatic' or 'both'"
-        )
-    if options.anchors not in ("ground", "any", "auto"):
-        raise MechanizationError(
-            f"mechanize: anchors {options.anchors!r}: expected 'ground', 'any' or 'auto'"
-        )
+    for key, choices in (("actuator", ACTUATORS), ("binary_links", BINARY_LINKS), ("anchors", ANCHORS)):
+        value = getattr(options, key)
+        if value not in choices:
+            quoted = [f"'{c}'" for c in choices]
+            raise MechanizationError(
+                f"mechanize: {key} {value!r}: expected {', '.join(quoted[:-1])} or {quoted[-1]}"
+            )
 
 
 def _with_transmissions(design: Design, check: Verification) -> Design:
