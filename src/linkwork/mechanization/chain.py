@@ -72,6 +72,10 @@ class ChainJoint:
     values: Array
     role: str
 
+    def other(self, body: str) -> str:
+        """The joint's body that is not ``body`` (one of its two)."""
+        return self.bodies[1] if self.bodies[0] == body else self.bodies[0]
+
 
 @dataclass(frozen=True)
 class ChainSegment:
@@ -191,15 +195,21 @@ def track(displacements: Array, point: ArrayLike) -> Array:
     return np.array([apply(g, point) for g in displacements])
 
 
+def turned(displacement: Array, direction: ArrayLike) -> Array:
+    """A direction of a body (profile-1 coordinates) turned by the body's displacement ``(x, y, angle)``."""
+    return apply(np.array([0.0, 0.0, displacement[2]]), direction)
+
+
 def track_direction(displacements: Array, direction: ArrayLike) -> Array:
     """``(p, 2)`` a direction of a body (profile-1 coordinates) as it turns with the body's ``(p, 3)``
     displacements."""
-    return np.array([apply(np.array([0.0, 0.0, g[2]]), direction) for g in displacements])
+    return np.array([turned(g, direction) for g in displacements])
 
 
 @dataclass(frozen=True)
 class _Pieces:
-    """The joined (or compound) profiles cut into the segments' pieces."""
+    """The joined (or compound) profiles cut into the segments' pieces: ``starts`` and ``counts`` ``(q, p)`` are
+    every segment's first point and number of pieces on every profile (the segment matrix)."""
 
     profiles: tuple[JoinedProfile, ...]
     starts: NDArray[np.int64]
@@ -358,8 +368,7 @@ def build_chain(result: SynthesisResult) -> ShapeChain:
     )
     design = result.design
     q = len(design)
-    sm = np.asarray(result.segment_matrix)
-    pieces = _Pieces(profiles, segment_starts(result.segment_matrix), sm)  # starts: (q, p)
+    pieces = _Pieces(profiles, segment_starts(result.segment_matrix), np.asarray(result.segment_matrix))
     targets = tuple(np.asarray(t.points, dtype=float) for t in result.targets)
     size = float(np.ptp(np.vstack(targets), axis=0).max()) or 1.0
     parts, seg_parts = _parts(design, pieces)
@@ -370,7 +379,9 @@ def build_chain(result: SynthesisResult) -> ShapeChain:
     for e, kind in enumerate(design):
         pair = (owner[seg_parts[e][0]], owner[seg_parts[e][1]])
         if kind == "M":
-            segs.append(ChainSegment("M", *pair, pieces.piece(e, 0), 0.0, 0.0, sm[e].astype(np.int64)))
+            segs.append(
+                ChainSegment("M", *pair, pieces.piece(e, 0), 0.0, 0.0, pieces.counts[e].astype(np.int64))
+            )
             continue
         seg, slide = _c_segment(result, e, pair, pieces, bodies, size)
         segs.append(seg)

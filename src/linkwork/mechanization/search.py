@@ -101,7 +101,7 @@ def _free_directions(chain: ShapeChain, body: str, via: str | None, m: Array) ->
     g = chain.body(body).displacements
     p = chain.count
     if jt.kind == "P":
-        other = jt.bodies[0] if jt.bodies[1] == body else jt.bodies[1]
+        other = jt.other(body)
         assert jt.direction is not None
         d = track_direction(chain.motion(other), jt.direction)
         return d / np.linalg.norm(d, axis=1, keepdims=True)
@@ -295,12 +295,7 @@ def _pivots_from_region(
 
 def _adjacent(chain: ShapeChain, body: str) -> list[tuple[str, str]]:
     """``(joint, other body)`` for every chain joint of ``body``."""
-    out = []
-    for j in chain.joints:
-        if body in j.bodies:
-            other = j.bodies[1] if j.bodies[0] == body else j.bodies[0]
-            out.append((j.name, other))
-    return out
+    return [(j.name, j.other(body)) for j in chain.joints if body in j.bodies]
 
 
 def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
@@ -312,7 +307,7 @@ def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
         )
     pinned = [j for j in chain.joints if "ground" in j.bodies]
     if pinned:
-        return [pinned[0].bodies[1] if pinned[0].bodies[0] == "ground" else pinned[0].bodies[0]]
+        return [pinned[0].other("ground")]
     if options.root is not None:
         return [options.root]
     return sorted(
@@ -396,7 +391,7 @@ def _steps(
         if options.anchors == "any":
             adjacent = {o for _, o in _adjacent(chain, body)}
             anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
-        parent = next(b for b in joints[via].bodies if b != body)
+        parent = joints[via].other(body)
         if parent in deferred:
             # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)

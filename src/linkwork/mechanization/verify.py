@@ -22,13 +22,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import AssemblyError
+from linkwork.geometry.angles import wrap
+from linkwork.geometry.se2 import apply, pose_of
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.tracer import trace
 from linkwork.mechanization.assemble import Design, spec_text
-from linkwork.mechanization.chain import pose_of, wrap
+from linkwork.mechanization.chain import turned
 
 Array = NDArray[np.float64]
 
@@ -357,8 +359,6 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     The angle at the moving pivot between the link and the line to the point that, with the link, places the
     body: the body's chain joint ``via``, or the other root link's moving pivot.
     """
-    from linkwork.mechanization.chain import apply
-
     disp = chain_displacements(design, mech, values)
     joints = {jt.name: jt for jt in design.chain.joints}
     links = {link.name: link for link in design.links}
@@ -369,7 +369,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
         m = apply(disp[link.body], link.circle)
         if link.kind == "PR":  # the guide reacts along its normal
             assert link.direction is not None
-            d = apply(np.array([0.0, 0.0, disp[link.anchor][2]]), link.direction)
+            d = turned(disp[link.anchor], link.direction)
             u = np.array([-d[1], d[0]])
         else:
             c = apply(disp[link.name], link.centre)
@@ -377,8 +377,8 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
         if link.via in joints:
             jt = joints[link.via]
             if jt.kind == "P":
-                other = jt.bodies[0] if jt.bodies[1] == link.body else jt.bodies[1]
-                d = apply(np.array([0.0, 0.0, disp[other][2]]), jt.direction)  # type: ignore[arg-type]
+                assert jt.direction is not None
+                d = turned(disp[jt.other(link.body)], jt.direction)
                 out[link.name] = abs(float(u @ d))
                 continue
             pj = apply(disp[link.body], jt.point)
