@@ -191,7 +191,8 @@ def _frame(origin: Array, towards: Array) -> Array:
 
 def track(displacements: Array, point: ArrayLike) -> Array:
     """``(p, 2)`` the positions of a body point (profile-1 coordinates) under the body's ``(p, 3)``
-    displacements."""
+    displacements, pose by pose with :func:`~linkwork.geometry.se2.apply`
+    (:func:`linkwork.mechanization.guidance.positions` is the vectorised form, equal to rounding)."""
     return np.array([apply(g, point) for g in displacements])
 
 
