@@ -121,12 +121,10 @@ def closure_jacobian(
 
     :func:`closure_pass` without a weight, with work arrays of its own (the hot loop of tracing).
     """
-    col, lg = np.empty(6), np.empty(6)
+    matrices, vectors = work_arrays()
     closure_pass(
-        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, None, residual, jac,
-        (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))),
-        (np.empty(3), np.empty(3), np.empty(3), np.empty(3), col, lg, lg),  # no weight: no weighted copy
-    )  # fmt: skip
+        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, None, residual, jac, matrices, vectors
+    )
 
 
 @njit(cache=True, inline="always")
@@ -151,13 +149,13 @@ def closure_pass(
     coupled joints add up (``J C``); fixed joints contribute no column. ``weight`` ``W (6, 6)`` maps every
     6-vector before its ``rows`` are kept; ``None`` means none (and numba compiles the weighting out).
 
-    Work arrays: ``matrices`` three ``(3, 3)``, ``vectors`` four ``(3,)`` then three ``(6,)``. Inlined into its
+    Work arrays (:func:`work_arrays`): ``matrices`` three ``(3, 3)``, ``vectors`` four ``(3,)`` then two ``(6,)``. Inlined into its
     callers (numba passes every array as a dozen scalars: a call per evaluation would cost a quarter of it).
     """
     nrows = rows.shape[0]
     jac[:, :] = 0.0
     Rg, Re, Rn = matrices
-    pg, pe, w, v, col, lg, kept = vectors
+    pg, pe, w, v, col, lg = vectors
     for k in range(loop_ptr.shape[0] - 1):
         for i in range(3):
             for c in range(3):
@@ -173,19 +171,24 @@ def closure_pass(
             if g >= 0:
                 adjoint_column(Rg, pg, w, v, col)
                 if weight is not None:
-                    weigh_rows(weight, rows, col, kept)
                     for r in range(nrows):
-                        jac[k * nrows + r, g] += kept[rows[r]]
+                        jac[k * nrows + r, g] += weighted_entry(weight, rows[r], col)
                 else:
                     for r in range(nrows):
                         jac[k * nrows + r, g] += col[rows[r]]
             exp_unit_twist(w, v, q[j], Re, pe)
             compose(Rg, pg, Re, pe, Rn)
         log_rigid(Rg, pg, lg)
-        if weight is not None:
-            weigh_rows(weight, rows, lg, kept)
         for r in range(nrows):
-            residual[k * nrows + r] = lg[rows[r]] if weight is None else kept[rows[r]]
+            residual[k * nrows + r] = lg[rows[r]] if weight is None else weighted_entry(weight, rows[r], lg)
+
+
+@njit(cache=True, inline="always")
+def work_arrays() -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, ...]]:
+    """The work arrays of :func:`closure_pass`: ``(Rg, Re, Rn)`` and ``(pg, pe, w, v, column, log)``."""
+    matrices = (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)))
+    vectors = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(6), np.empty(6))
+    return matrices, vectors
 
 
 @njit(cache=True, inline="always")
@@ -213,13 +216,12 @@ def compose(Rg: np.ndarray, pg: np.ndarray, Re: np.ndarray, pe: np.ndarray, Rn: 
 
 
 @njit(cache=True, inline="always")
-def weigh_rows(weight: np.ndarray, rows: np.ndarray, vector: np.ndarray, out: np.ndarray) -> None:
-    """``out[i] = (W vector)[i]`` for the kept rows ``i`` in ``rows`` (the other entries are left alone)."""
-    for r in range(rows.shape[0]):
-        acc = 0.0
-        for c in range(6):
-            acc += weight[rows[r], c] * vector[c]
-        out[rows[r]] = acc
+def weighted_entry(weight: np.ndarray, row: int, vector: np.ndarray) -> float:
+    """``(W vector)[row]`` for a 6-vector."""
+    acc = 0.0
+    for c in range(6):
+        acc += weight[row, c] * vector[c]
+    return acc
 
 
 @njit(cache=True)

@@ -346,8 +346,9 @@ def march(
             continue
         # ---- accept the step
         s_total += dist
-        u[:] = u_try
-        t[:] = t_new
+        for a in range(m):
+            u[a] = u_try[a]
+            t[a] = t_new[a]
         basis[:, :] = basis_try
         write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, count, u, t, sig, r, tau_new, s_total)
         recent[count % recent.shape[0]] = dist

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand
+from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand, work_arrays
 
 
 @njit(cache=True)
@@ -37,14 +37,6 @@ def weighted_closure(
     closure_pass(
         twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, residual, jac, matrices, vectors
     )
-
-
-@njit(cache=True)
-def work_arrays() -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, ...]]:
-    """The work arrays of :func:`linkwork.kinematics.kernels.closure_pass`, allocated once per misfit solve."""
-    matrices = (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)))
-    vectors = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(6), np.empty(6), np.empty(6))
-    return matrices, vectors
 
 
 @njit(cache=True, inline="always")
@@ -169,7 +161,8 @@ def misfit_along_path(
             converged = best - norm <= 1e-10 * norm
             best = norm
             halvings = 0
-            y_old[:] = y
+            for c in range(p):
+                y_old[c] = y[c]
             if converged or norm == 0.0:
                 break
             _in_plane(J, normal, k, Jy)
