@@ -13,6 +13,7 @@ costs ``48 N b`` bytes before base64.
 from __future__ import annotations
 
 import base64
+import html
 import json
 import math
 import re
@@ -24,6 +25,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.geometry.angles import wrap
+from linkwork.io.results import file_units
 from linkwork.kinematics.closure import body_poses
 from linkwork.viz.palette import TAB10
 
@@ -76,19 +79,21 @@ def _asset(name: str) -> str:
     return (resources.files("linkwork.viz") / "viewer_assets" / name).read_text(encoding="utf-8")
 
 
-def _page(template: str, title: str, data: dict[str, Any], scripts: list[str]) -> str:
-    """Fill an HTML template: ``{{TITLE}}``, ``{{CSS}}``, ``{{DATA}}`` and ``{{JS}}``, in one pass."""
+def _page(body: str, title: str, data: dict[str, Any], scripts: list[str]) -> str:
+    """A viewer page: the shell ``page.html`` (head, title, footer, data and script) around the ``body`` asset
+    (the viewer's own controls), then ``{{TITLE}}``, ``{{CSS}}``, ``{{DATA}}``, ``{{JS}}`` filled in one pass."""
     from linkwork import __version__
 
     payload = script_json(data)
     values = {
-        "TITLE": _escape(title),
+        "TITLE": html.escape(title),
         "CSS": _asset("viewer.css"),
         "DATA": payload,
         "JS": "\n".join(_asset(s) for s in scripts).replace("</script", "<\\/script"),
         "VERSION": __version__,
     }
-    return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], _asset(template))
+    shell = _asset("page.html").replace("{{BODY}}", _asset(body).rstrip("\n"))
+    return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], shell)
 
 
 #: Characters of JSON text that must not appear raw inside an HTML <script> element: "<" and ">" could open
@@ -102,16 +107,6 @@ def script_json(data: Any) -> str:
     """``data`` as JSON text safe to embed inside ``<script type="application/json">`` (no NaN or inf)."""
     payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
     return re.sub("[<>&\u2028\u2029]", lambda m: _SCRIPT_UNSAFE[m.group(0)], payload)
-
-
-def _escape(text: str) -> str:
-    return (
-        text.replace("&", "&amp;")
-        .replace("<", "&lt;")
-        .replace(">", "&gt;")
-        .replace('"', "&quot;")
-        .replace("'", "&#x27;")
-    )
 
 
 def _write(file: str | Path, text: str) -> Path:
@@ -274,7 +269,7 @@ def _difference(
 ) -> NDArray[np.float64]:
     """Rows of ``a`` minus configuration ``b``, revolute joints wrapped into [-pi, pi)."""
     d = a - b
-    d[:, revolute] = (d[:, revolute] + np.pi) % (2 * np.pi) - np.pi
+    d[:, revolute] = wrap(d[:, revolute])
     return d
 
 
@@ -316,11 +311,71 @@ def trace_viewer_data(
     visits_all = [_visits(path, b, revolute) for b in path.bifurcations]
     per_branch = _kept_points(path, max_points, {int(i) for v in visits_all for i in v})
     keep = np.concatenate(per_branch) if per_branch else np.zeros(0, dtype=np.int64)
-    # Where each kept point lands: (branch index, row within the branch).
-    where = {int(k): (bi, row) for bi, idx in enumerate(per_branch) for row, k in enumerate(idx)}
-    angles = path.angles[keep]
+    parts = linkage_parts(mech)
+    poses = _pose_rows(mech, path.angles[keep])
+    centres = _centres(parts, poses)
+    steady = _steady_rows(path, per_branch)
+    return {
+        "kind": "trace",
+        "title": title or mech.name,
+        "mechanism": mech.name,
+        "drive": mech.index(path.drive) if path.drive in mech.joint_names else 0,
+        "planar": bool(mech.planar),
+        "joints": _joint_entries(mech, joint_labels(mech, parts)),
+        "bodies": list(mech.bodies),
+        "parts": [_part_entry(p) for p in parts],
+        "bounds": {
+            "fixed": _bounds(parts, poses, np.zeros_like(centres)),
+            "centred": _bounds(parts, _compose(steady, poses), np.zeros_like(centres)),
+        },
+        "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
+        "centres": _packed(centres, "f4"),
+        "steady": _packed(steady, "f4"),
+        "points": len(keep),
+        "points_traced": len(path.branch),
+        "poses": _packed(poses, "f4"),
+        "angles": _packed(file_units(mech, path.angles[keep]), "f4"),
+        "sigma": _packed(path.sigma[keep], "f8"),
+        "rank": _packed(path.rank[keep], "i4"),
+        "step": _packed(path.step[keep], "i4"),
+        "arclength": _packed(np.degrees(path.arclength[keep]), "f4"),
+        "residual": _packed(path.residual[keep], "f4"),
+        "unknowns": mech.n_unknowns,
+        "branches": _branch_entries(path, per_branch),
+        "bifurcations": _bifurcation_entries(path, visits_all, per_branch),
+    }
+
+
+def _joint_entries(mech: Mechanism, labels: list[tuple[int, NDArray[np.float64]]]) -> list[dict[str, Any]]:
+    """Per joint: name, type, plot colour and dash (the one palette), and where its label sits on which body."""
+    return [
+        {
+            "name": name,
+            "type": kind,
+            "color": JOINT_COLORS[j % len(JOINT_COLORS)],
+            "dash": j // len(JOINT_COLORS) + (j % 4),
+            "body": labels[j][0],
+            "point": labels[j][1].tolist(),
+        }
+        for j, (name, kind) in enumerate(zip(mech.joint_names, mech.joint_types, strict=True))
+    ]
+
+
+def _part_entry(part: Part) -> dict[str, Any]:
+    """A part's mesh for the page: vertices as float32, faces as 16-bit indices when they fit."""
+    return {
+        "body": part.body,
+        "name": part.name,
+        "color": part.color,
+        "vertices": _packed(part.vertices, "f4"),
+        "faces": _packed(part.faces, "u2" if len(part.vertices) < 65536 else "u4"),
+    }
+
+
+def _branch_entries(path: Trace, per_branch: list[NDArray[np.int64]]) -> list[dict[str, Any]]:
+    """Per branch: how it was found and ended, and which run of the page's points (``start``, ``count``) it is."""
     starts = np.cumsum([0] + [len(idx) for idx in per_branch])
-    branches = [
+    return [
         {
             "id": br.id,
             "parent": br.parent,
@@ -333,86 +388,27 @@ def trace_viewer_data(
         }
         for bi, br in enumerate(path.branches)
     ]
-    bifurcations = []
-    for b, visits in zip(path.bifurcations, visits_all, strict=True):
-        seen = [list(where[int(k)]) for k in visits if int(k) in where]
-        bifurcations.append(
-            {
-                "id": b.id,
-                "branch": b.branch,
-                "step": b.step,
-                "rank": b.rank,
-                "method": b.method,
-                "tangents": len(b.tangents),
-                "angles": _display(mech, b.angles).tolist(),
-                "visits": seen,
-            }
-        )
-
-    parts = linkage_parts(mech)
-    poses = _pose_rows(mech, angles)
-    labels = joint_labels(mech, parts)
-    centres = _centres(parts, poses)
-    steady = _steady_rows(path, per_branch)
-    steadied = _compose(steady, poses)
-    display = _display(mech, angles)
-    drive = mech.index(path.drive) if path.drive in mech.joint_names else 0
-    return {
-        "kind": "trace",
-        "title": title or mech.name,
-        "mechanism": mech.name,
-        "drive": drive,
-        "planar": bool(mech.planar),
-        "joints": [
-            {
-                "name": name,
-                "type": kind,
-                "color": JOINT_COLORS[j % len(JOINT_COLORS)],
-                "dash": j // len(JOINT_COLORS) + (j % 4),
-                "body": labels[j][0],
-                "point": labels[j][1].tolist(),
-            }
-            for j, (name, kind) in enumerate(zip(mech.joint_names, mech.joint_types, strict=True))
-        ],
-        "bodies": list(mech.bodies),
-        "parts": [
-            {
-                "body": p.body,
-                "name": p.name,
-                "color": p.color,
-                "vertices": _packed(p.vertices, "f4"),
-                "faces": _packed(p.faces, "u2" if len(p.vertices) < 65536 else "u4"),
-            }
-            for p in parts
-        ],
-        "bounds": {
-            "fixed": _bounds(parts, poses, np.zeros_like(centres)),
-            "centred": _bounds(parts, steadied, np.zeros_like(centres)),
-        },
-        "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
-        "centres": _packed(centres, "f4"),
-        "steady": _packed(steady, "f4"),
-        "points": len(keep),
-        "points_traced": len(path.branch),
-        "poses": _packed(poses, "f4"),
-        "angles": _packed(display, "f4"),
-        "sigma": _packed(path.sigma[keep], "f8"),
-        "rank": _packed(path.rank[keep], "i4"),
-        "step": _packed(path.step[keep], "i4"),
-        "arclength": _packed(np.degrees(path.arclength[keep]), "f4"),
-        "residual": _packed(path.residual[keep], "f4"),
-        "unknowns": mech.n_unknowns,
-        "branches": branches,
-        "bifurcations": bifurcations,
-    }
 
 
-def _display(mech: Mechanism, values: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Joint values in the units users read: degrees for revolute joints, lengths for prismatic ones."""
-    out = np.array(values, dtype=float, copy=True)
-    revolute = np.array([t == "R" for t in mech.joint_types])
-    out[..., revolute] = np.degrees(out[..., revolute])
-    return out
+def _bifurcation_entries(
+    path: Trace, visits_all: list[NDArray[np.int64]], per_branch: list[NDArray[np.int64]]
+) -> list[dict[str, Any]]:
+    """Per bifurcation point: where it was found, its rank and tangents, its angles in file units, and its visits
+    as ``[branch index, row within the branch]`` among the page's points."""
+    where = {int(k): (bi, row) for bi, idx in enumerate(per_branch) for row, k in enumerate(idx)}
+    return [
+        {
+            "id": b.id,
+            "branch": b.branch,
+            "step": b.step,
+            "rank": b.rank,
+            "method": b.method,
+            "tangents": len(b.tangents),
+            "angles": file_units(path.mechanism, b.angles).tolist(),
+            "visits": [list(where[int(k)]) for k in visits if int(k) in where],
+        }
+        for b, visits in zip(path.bifurcations, visits_all, strict=True)
+    ]
 
 
 def write_trace_viewer(
@@ -445,7 +441,11 @@ def write_trace_viewer(
 
 def trace_viewer_page(path: Trace, *, title: str | None = None, max_points: int = MAX_POINTS) -> str:
     """The HTML text of :func:`write_trace_viewer`'s page (for an inline view in a notebook)."""
-    data = trace_viewer_data(path, title=title, max_points=max_points)
+    return _trace_page(trace_viewer_data(path, title=title, max_points=max_points))
+
+
+def _trace_page(data: dict[str, Any]) -> str:
+    """The trace viewer's page around ``data`` (:func:`trace_viewer_data`, or the mechanism viewer's)."""
     return _page("trace.html", data["title"], data, ["common.js", "scene.js", "trace.js"])
 
 
