@@ -79,20 +79,36 @@ def _asset(name: str) -> str:
     return (resources.files("linkwork.viz") / "viewer_assets" / name).read_text(encoding="utf-8")
 
 
-def _page(body: str, title: str, data: dict[str, Any], scripts: list[str]) -> str:
-    """A viewer page: the shell ``page.html`` (head, title, footer, data and script) around the ``body`` asset
-    (the viewer's own controls), then ``{{TITLE}}``, ``{{CSS}}``, ``{{DATA}}``, ``{{JS}}`` filled in one pass."""
+@dataclass(frozen=True)
+class _Viewer:
+    """One viewer's assets: its ``body`` (panel, controls and plots inside the shared ``page.html``), its scripts
+    in load order, and the accessible name of its slider (inside the shared ``player.html``)."""
+
+    body: str
+    scripts: tuple[str, ...]
+    slider: str
+
+
+_TRACE = _Viewer("trace.html", ("common.js", "scene.js", "trace.js"), "position along the branch")
+_SYNTHESIS = _Viewer("synthesis.html", ("common.js", "synthesis.js"), "target profile")
+
+
+def _page(viewer: _Viewer, data: dict[str, Any]) -> str:
+    """A self-contained page: the shared shell ``page.html`` (head, title, footer, data, script) around the
+    viewer's body, its play button and slider from ``player.html``; then ``{{TITLE}}`` (``data["title"]``),
+    ``{{CSS}}``, ``{{DATA}}``, ``{{JS}}`` and the rest filled in one pass."""
     from linkwork import __version__
 
-    payload = script_json(data)
     values = {
-        "TITLE": html.escape(title),
+        "TITLE": html.escape(data["title"]),
         "CSS": _asset("viewer.css"),
-        "DATA": payload,
-        "JS": "\n".join(_asset(s) for s in scripts).replace("</script", "<\\/script"),
+        "DATA": script_json(data),
+        "JS": "\n".join(_asset(s) for s in viewer.scripts).replace("</script", "<\\/script"),
         "VERSION": __version__,
+        "SLIDER": viewer.slider,
     }
-    shell = _asset("page.html").replace("{{BODY}}", _asset(body).rstrip("\n"))
+    body = _asset(viewer.body).rstrip("\n").replace("{{PLAYER}}", _asset("player.html").rstrip("\n"))
+    shell = _asset("page.html").replace("{{BODY}}", body)
     return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], shell)
 
 
@@ -446,7 +462,7 @@ def trace_viewer_page(path: Trace, *, title: str | None = None, max_points: int 
 
 def _trace_page(data: dict[str, Any]) -> str:
     """The trace viewer's page around ``data`` (:func:`trace_viewer_data`, or the mechanism viewer's)."""
-    return _page("trace.html", data["title"], data, ["common.js", "scene.js", "trace.js"])
+    return _page(_TRACE, data)
 
 
 # ----------------------------------------------------------------------------------------------- synthesis viewer
@@ -544,5 +560,4 @@ def write_synthesis_viewer(result: SynthesisResult, file: str | Path, *, title: 
 
 def synthesis_viewer_page(result: SynthesisResult, *, title: str | None = None) -> str:
     """The HTML text of :func:`write_synthesis_viewer`'s page (for an inline view in a notebook)."""
-    data = synthesis_viewer_data(result, title=title)
-    return _page("synthesis.html", data["title"], data, ["common.js", "synthesis.js"])
+    return _page(_SYNTHESIS, synthesis_viewer_data(result, title=title))
