@@ -135,6 +135,13 @@ def _draw_fit(ax: Axes, piece: Array, instance: Array, j: int, piece_label: str 
     ax.plot(*instance.T, "-", color=_colour(j), linewidth=1.5, label=label)
 
 
+def _titles_and_legends(axes: Any, *titles: str) -> None:
+    """Each panel's title (one per axes, in order), then its legend."""
+    for ax, title in zip(axes, titles, strict=True):
+        ax.set_title(title, fontsize="medium")
+        _legend(ax)
+
+
 def _draw_targets(ax: Axes, result: SynthesisResult, *, label: bool = True) -> None:
     for j, target in enumerate(result.targets):
         ax.plot(
@@ -213,9 +220,7 @@ def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
         fitted = f"mean on {_name(result, j)}: E = {segment.errors[j]:.3g}"
         _draw_fit(axes[3], piece, segment.instances[j], j, f"{_name(result, j)} target", fitted)
     axes[2].plot(*mean.T, "k.-", linewidth=1.5, markersize=3, label="mean segment")
-    for ax, title in zip(axes, panels, strict=True):
-        ax.set_title(title, fontsize="medium")
-        _legend(ax)
+    _titles_and_legends(axes, *panels)
     figure.suptitle(f"M-segment {index + 1}: {int(segment.pieces[0])} pieces on every profile")
     return figure
 
@@ -244,10 +249,7 @@ def plot_arc_segment(result: SynthesisResult, index: int) -> Figure:
         _draw_fit(axes[1], piece, segment.instances[j], j, None, fitted)
     radius = segment.radius
     shown = "straight (r = inf)" if radius is None or math.isinf(radius) else f"r = {radius:.4g}"
-    axes[0].set_title("(a) pieces on the target profiles", fontsize="medium")
-    axes[1].set_title(f"(b) arcs of one radius, {shown}", fontsize="medium")
-    for ax in axes:
-        _legend(ax)
+    _titles_and_legends(axes, "(a) pieces on the target profiles", f"(b) arcs of one radius, {shown}")
     figure.suptitle(f"C-segment {index + 1}: mean piece length {segment.piece_length:.4g}")
     return figure
 
@@ -270,16 +272,12 @@ def plot_chain(result: SynthesisResult) -> Figure:
             axes[0].plot(*instance[[0, -1]].T, "|", color="black", markersize=7)
     for j, chain in enumerate(result.joined):
         _draw_chain(axes[1], chain, _colour(j), f"chain on {_name(result, j)}")
-    axes[0].set_title(
-        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
+    unit = length_unit(result)
+    _titles_and_legends(
+        axes,
+        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g} {unit}",
+        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g} {unit}",
     )
-    axes[1].set_title(
-        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
-    )
-    for ax in axes:
-        _legend(ax)
     return figure
 
 
@@ -314,18 +312,14 @@ def plot_compound(result: SynthesisResult) -> Figure:
             color="black" if is_merged else "dimgray",
             weight="bold" if is_merged else "normal",
         )
-    axes[0].set_title(
-        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
-    )
+    unit = length_unit(result)
     merged_list = ", ".join(str(i + 1) for i in compound.merged) or "none"
-    axes[1].set_title(
+    _titles_and_legends(
+        axes,
+        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {unit}",
         f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; "
-        f"E_max = {compound.e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
+        f"E_max = {compound.e_max:.3g} {unit}",
     )
-    for ax in axes:
-        _legend(ax)
     return figure
 
 
