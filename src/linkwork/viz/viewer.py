@@ -4,21 +4,16 @@
 a slider along the path, a play button, a branch selector, and the hinge-angle and singular-value plots linked to
 the slider. :func:`write_synthesis_viewer` shows a synthesised chain posed on every target profile.
 
-Everything the page needs is inlined: the script and style from ``viewer_assets/``, and the data as JSON with the
-bulky arrays as little-endian base64. The page fetches nothing, from no host. The trace viewer sends each body's
-mesh once (reference configuration) and its 3x4 pose per path point, so a path of ``N`` points over ``b`` bodies
-costs ``48 N b`` bytes before base64.
+Everything the page needs is inlined (:mod:`linkwork.viz.viewer_page`): the script and style from
+``viewer_assets/``, and the data as JSON with the bulky arrays as little-endian base64. The page fetches nothing,
+from no host. The trace viewer sends each body's mesh once (reference configuration) and its 3x4 pose per path
+point, so a path of ``N`` points over ``b`` bodies costs ``48 N b`` bytes before base64. This module holds the
+trace viewer; the synthesis viewer is :mod:`linkwork.viz.synthesis_viewer` (its names are importable from here).
 """
 
 from __future__ import annotations
 
-import base64
-import html
-import json
-import math
-import re
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -29,11 +24,17 @@ from linkwork.geometry.angles import wrap
 from linkwork.io.results import file_units
 from linkwork.kinematics.closure import body_poses
 from linkwork.viz.palette import TAB10
+from linkwork.viz.synthesis_viewer import (
+    joint_turns,
+    synthesis_viewer_data,
+    synthesis_viewer_page,
+    write_synthesis_viewer,
+)
+from linkwork.viz.viewer_page import DATA_ID, _packed, _page, _Viewer, _write, script_json, unpack
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Bifurcation, Trace
-    from linkwork.synthesis.result import SynthesisResult
 
 #: Joint colours of the plots and labels (the one palette, so the viewer matches the PNG figures).
 JOINT_COLORS = TAB10
@@ -45,8 +46,26 @@ MAX_POINTS = 20000
 #: a branch leaves a located point after a polish that may move it by a few 1e-6.
 SAME_POINT = 1e-5
 
-DATA_ID = "linkwork-data"
-"""The ``id`` of the ``<script type="application/json">`` element holding a viewer's data."""
+__all__ = [
+    "DATA_ID",
+    "JOINT_COLORS",
+    "MAX_POINTS",
+    "SAME_POINT",
+    "Part",
+    "joint_labels",
+    "joint_turns",
+    "linkage_parts",
+    "script_json",
+    "synthesis_viewer_data",
+    "synthesis_viewer_page",
+    "trace_viewer_data",
+    "trace_viewer_page",
+    "unpack",
+    "write_synthesis_viewer",
+    "write_trace_viewer",
+]
+
+_TRACE = _Viewer("trace.html", ("common.js", "scene.js", "trace.js"), "position along the branch")
 
 
 @dataclass(frozen=True)
@@ -58,78 +77,6 @@ class Part:
     vertices: NDArray[np.float64]
     faces: NDArray[np.int64]
     color: str
-
-
-# ----------------------------------------------------------------------------------------------- encoding
-
-
-def _packed(values: Any, dtype: str) -> dict[str, Any]:
-    """A numpy array as ``{"dtype", "shape", "b64"}``, little-endian, for ``decode`` in the page's script."""
-    arr = np.ascontiguousarray(np.asarray(values), dtype=np.dtype(dtype).newbyteorder("<"))
-    return {"dtype": dtype, "shape": list(arr.shape), "b64": base64.b64encode(arr.tobytes()).decode("ascii")}
-
-
-def unpack(entry: dict[str, Any]) -> NDArray[Any]:
-    """Inverse of the page's packing: the numpy array of a ``{"dtype", "shape", "b64"}`` entry (for tests)."""
-    raw = base64.b64decode(entry["b64"])
-    return np.frombuffer(raw, dtype=np.dtype(entry["dtype"]).newbyteorder("<")).reshape(entry["shape"])
-
-
-def _asset(name: str) -> str:
-    return (resources.files("linkwork.viz") / "viewer_assets" / name).read_text(encoding="utf-8")
-
-
-@dataclass(frozen=True)
-class _Viewer:
-    """One viewer's assets: its ``body`` (panel, controls and plots inside the shared ``page.html``), its scripts
-    in load order, and the accessible name of its slider (inside the shared ``player.html``)."""
-
-    body: str
-    scripts: tuple[str, ...]
-    slider: str
-
-
-_TRACE = _Viewer("trace.html", ("common.js", "scene.js", "trace.js"), "position along the branch")
-_SYNTHESIS = _Viewer("synthesis.html", ("common.js", "synthesis.js"), "target profile")
-
-
-def _page(viewer: _Viewer, data: dict[str, Any]) -> str:
-    """A self-contained page: the shared shell ``page.html`` (head, title, footer, data, script) around the
-    viewer's body, its play button and slider from ``player.html``; then ``{{TITLE}}`` (``data["title"]``),
-    ``{{CSS}}``, ``{{DATA}}``, ``{{JS}}`` and the rest filled in one pass."""
-    from linkwork import __version__
-
-    values = {
-        "TITLE": html.escape(data["title"]),
-        "CSS": _asset("viewer.css"),
-        "DATA": script_json(data),
-        "JS": "\n".join(_asset(s) for s in viewer.scripts).replace("</script", "<\\/script"),
-        "VERSION": __version__,
-        "SLIDER": viewer.slider,
-    }
-    body = _asset(viewer.body).rstrip("\n").replace("{{PLAYER}}", _asset("player.html").rstrip("\n"))
-    shell = _asset("page.html").replace("{{BODY}}", body)
-    return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], shell)
-
-
-#: Characters of JSON text that must not appear raw inside an HTML <script> element: "<" and ">" could open
-#: "</script>" or "<!--" (which changes how the element ends), "&" for symmetry with HTML escaping, and U+2028
-#: / U+2029, which older JavaScript parsers treat as line breaks. Each is written as its JSON \\u escape, so the
-#: data parse back to the same strings.
-_SCRIPT_UNSAFE = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
-
-
-def script_json(data: Any) -> str:
-    """``data`` as JSON text safe to embed inside ``<script type="application/json">`` (no NaN or inf)."""
-    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
-    return re.sub("[<>&\u2028\u2029]", lambda m: _SCRIPT_UNSAFE[m.group(0)], payload)
-
-
-def _write(file: str | Path, text: str) -> Path:
-    file = Path(file)
-    file.parent.mkdir(parents=True, exist_ok=True)
-    file.write_text(text, encoding="utf-8")
-    return file
 
 
 # ----------------------------------------------------------------------------------------------- geometry
@@ -463,101 +410,3 @@ def trace_viewer_page(path: Trace, *, title: str | None = None, max_points: int 
 def _trace_page(data: dict[str, Any]) -> str:
     """The trace viewer's page around ``data`` (:func:`trace_viewer_data`, or the mechanism viewer's)."""
     return _page(_TRACE, data)
-
-
-# ----------------------------------------------------------------------------------------------- synthesis viewer
-
-
-def joint_turns(points: NDArray[np.float64], joints: list[int]) -> NDArray[np.float64]:
-    """Relative angle (degrees) at each joint of a posed chain: the turn from the piece arriving at the joint
-    point to the piece leaving it (positive to the left)."""
-    pts = np.asarray(points, dtype=float)
-    out = []
-    for k in joints:
-        a, b = pts[k] - pts[k - 1], pts[k + 1] - pts[k]
-        out.append(math.degrees(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b)))
-    return np.array(out)
-
-
-def synthesis_viewer_data(result: SynthesisResult, *, title: str | None = None) -> dict[str, Any]:
-    """Everything the synthesis viewer page shows, as JSON-ready data (angles in degrees)."""
-
-    def chain(profiles: Any) -> list[dict[str, Any]]:
-        return [
-            {
-                "joints": np.asarray(prof.joints).tolist(),
-                "points": np.asarray(prof.points).tolist(),
-                "angles": np.degrees(prof.angles).tolist(),
-                "errors": np.asarray(prof.errors).tolist(),
-                "turns": joint_turns(
-                    prof.points, [int(seg.starts[j]) for seg in result.segments[1:]]
-                ).tolist(),
-            }
-            for j, prof in enumerate(profiles)
-        ]
-
-    segments = [
-        {
-            "kind": seg.kind,
-            "pieces": [int(m) for m in seg.pieces],
-            "starts": [int(k) for k in seg.starts],
-            "radius": None if seg.radius is None or math.isinf(seg.radius) else float(seg.radius),
-            "lengths": [float(v) for v in seg.lengths],
-        }
-        for seg in result.segments
-    ]
-    compound = result.compound
-    return {
-        "kind": "synthesis",
-        "joint_colors": list(TAB10),
-        "title": title or f"Shape-change synthesis: design {result.design}",
-        "profile_kind": result.problem.kind,
-        "design": result.design,
-        "e_max": float(result.e_max),
-        "e_mean": float(result.e_mean),
-        "joined_e_max": float(result.joined_e_max),
-        "piece_length": float(result.problem.piece_length),
-        "targets": [
-            {
-                "name": t.name or f"profile {j + 1}",
-                "points": np.asarray(t.points).tolist(),
-                "arc_length": float(t.arc_length),
-                "pieces": int(t.pieces),
-            }
-            for j, t in enumerate(result.targets)
-        ],
-        "segments": segments,
-        "joined": chain(result.joined),
-        "joined_errors": np.asarray(result.joined_error_matrix).tolist(),
-        "compound": None
-        if compound is None
-        else {
-            "merged": [int(i) for i in compound.merged],
-            "merge_below": math.degrees(compound.threshold),
-            "joint_ranges": np.degrees(compound.joint_ranges).tolist(),
-            "joint_angles": np.degrees(compound.joint_angles).tolist(),
-            "e_max": float(compound.e_max),
-            "errors": np.asarray(compound.error_matrix).tolist(),
-            "profiles": chain(compound.profiles),
-            "notes": list(compound.notes),
-        },
-    }
-
-
-def write_synthesis_viewer(result: SynthesisResult, file: str | Path, *, title: str | None = None) -> Path:
-    """Write the interactive viewer of a synthesis result: one self-contained HTML file that works offline.
-
-    The page draws the target profiles and the joined chain posed on one of them, with a slider (and a play
-    button) across the profiles, the segments coloured by type (M rigid, C constant curvature), the joints,
-    and the error of every segment on the profile shown. See ``docs/viewer.md``.
-
-    Returns
-    -------
-    The path of the file written.
-    """
-    return _write(file, synthesis_viewer_page(result, title=title))
-
-
-def synthesis_viewer_page(result: SynthesisResult, *, title: str | None = None) -> str:
-    """The HTML text of :func:`write_synthesis_viewer`'s page (for an inline view in a notebook)."""
-    return _page(_SYNTHESIS, synthesis_viewer_data(result, title=title))
