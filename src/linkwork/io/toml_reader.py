@@ -228,6 +228,28 @@ class TomlReader:
             raise self.error(key_path(path, key), f"expected true or false, got {show(value)}")
         return value
 
+    def integer(
+        self,
+        table: Mapping[str, Any],
+        key: str,
+        path: str,
+        *,
+        default: int | None,
+        minimum: int,
+        maximum: int | None = None,
+        what: str = "a whole number",
+    ) -> int | None:
+        """A whole number in ``[minimum, maximum]``; the message states the bounds."""
+        if key not in table:
+            return default
+        value = table[key]
+        bounds = f"{minimum} <= {key}" + (f" <= {maximum}" if maximum is not None else "")
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(key_path(path, key), f"expected {what}, {bounds}, got {show(value)}")
+        if value < minimum or (maximum is not None and value > maximum):
+            raise self.error(key_path(path, key), f"expected {what}, {bounds}, got {show(value)}")
+        return int(value)
+
     def number(
         self,
         table: Mapping[str, Any],
