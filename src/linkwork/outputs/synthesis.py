@@ -99,11 +99,12 @@ def load_synthesis(folder: Path, problem: Path | None = None) -> SynthesisResult
 
 def synthesis_problem(folder: Path, problem: Path | None = None) -> Problem:
     """The problem a ``linkwork synth`` output folder came from (``folder/problem/problem.toml`` unless
-    ``problem`` is given), read without running the synthesis; the folder must hold a ``chain.json``."""
+    ``problem`` is given), read without running the synthesis; the folder must hold a valid ``chain.json``."""
     from linkwork.io.problem import load_problem
 
     if not (folder / "chain.json").is_file():
         raise SpecError(f"{folder}: no chain.json; expected a `linkwork synth` output folder")
+    _read_chain_json(folder / "chain.json")  # a broken chain.json is named before the problem is read
     problem = problem or folder / "problem" / "problem.toml"
     if not problem.is_file():
         raise SpecError(
