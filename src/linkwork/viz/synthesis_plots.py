@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 
 from linkwork.synthesis.result import JoinedProfile, Segment, SynthesisResult
 from linkwork.viz.labels import plain
+from linkwork.viz.palette import PROFILE_COLORS
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -40,8 +41,8 @@ DPI = 100
 
 
 def _colour(j: int) -> str:
-    palette = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
-    return palette[j % len(palette)]
+    """Profile ``j``'s colour (:data:`linkwork.viz.palette.PROFILE_COLORS`, cycling)."""
+    return PROFILE_COLORS[j % len(PROFILE_COLORS)]
 
 
 def _name(result: SynthesisResult, j: int) -> str:
