@@ -149,8 +149,9 @@ def closure_pass(
     coupled joints add up (``J C``); fixed joints contribute no column. ``weight`` ``W (6, 6)`` maps every
     6-vector before its ``rows`` are kept; ``None`` means none (and numba compiles the weighting out).
 
-    Work arrays (:func:`work_arrays`): ``matrices`` three ``(3, 3)``, ``vectors`` four ``(3,)`` then two ``(6,)``. Inlined into its
-    callers (numba passes every array as a dozen scalars: a call per evaluation would cost a quarter of it).
+    Work arrays (:func:`work_arrays`): ``matrices`` three ``(3, 3)``, ``vectors`` four ``(3,)`` then two ``(6,)``.
+    Inlined into its callers (numba passes every array as a dozen scalars: a call per evaluation would cost a
+    quarter of it).
     """
     nrows = rows.shape[0]
     jac[:, :] = 0.0
