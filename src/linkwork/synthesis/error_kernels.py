@@ -63,8 +63,8 @@ class ProfileTables:
     def mean_errors(self, starts: Sequence[int], pieces: int) -> Array:
         """``(p,)`` errors of an M-segment of ``pieces`` pieces from ``starts`` (Eqs. 12-15, 21)."""
         if self.compiled:
-            return compiled.mean_errors(
-                self.stacked, self.offsets, np.asarray(starts, dtype=np.int64), int(pieces)
+            return compiled.mean_fits(
+                self.stacked, self.offsets, np.asarray(starts, dtype=np.int64), int(pieces), False
             )
         z = np.stack([pts[s : s + pieces + 1] for pts, s in zip(self.points, starts, strict=True)])
         first = np.broadcast_to(z[0], z.shape)
@@ -95,13 +95,14 @@ class ProfileTables:
         s_bar /= len(pieces)  # Eq. (20) with its 1/p
         kappa = kappa_total / interior if interior else 0.0  # Eq. (18), averaging 1/r
         if self.compiled:
-            return compiled.arc_errors(
+            return compiled.arc_fits(
                 self.stacked,
                 self.offsets,
                 np.asarray(starts, dtype=np.int64),
                 np.asarray(pieces, dtype=np.int64),
                 kappa,
                 s_bar,
+                False,
             )
         arc = arc_points(kappa, s_bar, int(max(pieces)))
         out = np.empty(len(pieces))
