@@ -33,16 +33,16 @@ from linkwork.synthesis.targets import target_profiles
 SearchMethod = Literal["paper", "refined"]
 
 
-def _check_initial(problem: Problem, designs: list[str], pieces: list[int]) -> None:
-    """The given initial segment matrix fits the (single) design vector and the target profiles."""
+def _check_initial(problem: Problem, design: str, pieces: list[int]) -> None:
+    """The given initial segment matrix fits the design vector and the target profiles.
+
+    That it comes with one design vector (not ``design = "auto"``) is a rule of :class:`Problem`.
+    """
     sm = problem.initial_segment_matrix
     if sm is None:
         return
     key = "initial_segment_matrix"
     src = None if problem.source is None else str(problem.source)
-    if len(designs) != 1:
-        raise SpecError("needs a design vector, not design 'auto'", source=src, key=key)
-    design = designs[0]
     arr = np.asarray(sm)
     if arr.shape != (len(design), len(pieces)):
         raise SpecError(
@@ -171,16 +171,17 @@ def synthesize(
 
 def _designs_to_try(problem: Problem, pieces: list[int]) -> list[str]:
     """The design vectors to search: the problem's own, or every one of ``segments`` letters (``design =
-    "auto"``), each checked against the profiles' pieces (and the initial segment matrix, when given)."""
-    if problem.design is not None and problem.design.strip().lower() != "auto":
-        designs = [check_design(problem.design)]
-    else:
-        if problem.segments is None:
-            raise SpecError("design 'auto' needs the number of segments", key="segments")
+    "auto"``; the rules of :class:`Problem` ensure ``segments`` then), each checked against the profiles' pieces
+    (and the initial segment matrix, which comes only with one design vector)."""
+    if problem.auto_design:
+        assert problem.segments is not None
         designs = design_vectors(problem.segments, pieces)
+    else:
+        assert problem.design is not None
+        designs = [check_design(problem.design)]
     for design in designs:
         check_feasible(design, pieces, problem.min_pieces)
-    _check_initial(problem, designs, pieces)
+    _check_initial(problem, designs[0], pieces)
     return designs
 
 
