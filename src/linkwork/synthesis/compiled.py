@@ -46,33 +46,27 @@ def _best_turn(
     return (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
 
 
-@njit(cache=True)
-def _aligned_residuals(src: Array, tgt: Array) -> tuple[float, float]:  # pragma: no cover - compiled
-    """``(largest, sum)`` of the squared distances after the best rigid registration of ``src (n, 2)`` onto
-    ``tgt (n, 2)``: the one kernel behind both the error (Eq. 21) and the RMS of :func:`fit_bound`."""
+@njit(cache=True, inline="always")
+def _aligned_distance(src: Array, tgt: Array, rms: bool) -> float:  # pragma: no cover - compiled
+    """Largest (or with ``rms`` the root mean square) distance after the best rigid registration of
+    ``src (n, 2)`` onto ``tgt (n, 2)``: the one kernel behind both the error (Eq. 21) and :func:`fit_bound`.
+
+    Inlined where it is called (as is :func:`_fit`), so that numba compiles each caller with ``rms`` known and
+    the loop holds only the branch taken: one source, no cost over two separate kernels.
+    """
     ms, mt = _centroid(src), _centroid(tgt)
     c, s = _best_turn(src, tgt, ms, mt)
-    worst = total = 0.0
+    acc = 0.0
     for i in range(src.shape[0]):
         ax, ay = src[i, 0] - ms[0], src[i, 1] - ms[1]
         rx = c * ax - s * ay - (tgt[i, 0] - mt[0])
         ry = s * ax + c * ay - (tgt[i, 1] - mt[1])
         d2 = rx * rx + ry * ry
-        worst = max(worst, d2)
-        total += d2
-    return worst, total
-
-
-@njit(cache=True)
-def _aligned_error(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
-    """Largest distance after the best rigid registration of ``src (n, 2)`` onto ``tgt (n, 2)``."""
-    return math.sqrt(_aligned_residuals(src, tgt)[0])
-
-
-@njit(cache=True)
-def _aligned_rms(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
-    """Root mean square distance after the best rigid registration of ``src (n, 2)`` onto ``tgt (n, 2)``."""
-    return math.sqrt(_aligned_residuals(src, tgt)[1] / src.shape[0])
+        if rms:
+            acc += d2
+        else:
+            acc = max(acc, d2)
+    return math.sqrt(acc / src.shape[0]) if rms else math.sqrt(acc)
 
 
 @njit(cache=True)
@@ -85,14 +79,14 @@ def fit_bound(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
     distances, so ``d_a + d_b >= | |S_a - S_b| - |T_a - T_b| |``).
     """
     n = src.shape[0]
-    best = _aligned_rms(src, tgt)
+    best = _aligned_distance(src, tgt, True)
     idx = np.array([0, n // 2, n - 1])
     s3 = np.empty((3, 2))
     t3 = np.empty((3, 2))
     for k in range(3):
         s3[k] = src[idx[k]]
         t3[k] = tgt[idx[k]]
-    best = max(best, _aligned_rms(s3, t3))
+    best = max(best, _aligned_distance(s3, t3, True))
     for a in range(3):
         for b in range(a + 1, 3):
             ds = math.hypot(s3[a, 0] - s3[b, 0], s3[a, 1] - s3[b, 1])
@@ -101,10 +95,10 @@ def fit_bound(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _fit(src: Array, tgt: Array, bound: bool) -> float:  # pragma: no cover - compiled
     """The error of ``src`` registered onto ``tgt`` (Eq. 21), or with ``bound`` its :func:`fit_bound`."""
-    return fit_bound(src, tgt) if bound else _aligned_error(src, tgt)
+    return fit_bound(src, tgt) if bound else _aligned_distance(src, tgt, False)
 
 
 @njit(cache=True)

@@ -9,7 +9,7 @@ exhaustive design search over ``2^q - 1`` design vectors affordable. The tests c
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -24,29 +24,6 @@ IntArray = NDArray[np.int64]
 
 #: Largest ``q * p`` of a segment matrix searched compiled (numpy's pairwise sums are reproduced up to this size).
 MAX_ENTRIES = 128
-
-
-class CompiledTables(NamedTuple):
-    """The target profiles stacked for the compiled search (points, chord and curvature prefix sums).
-
-    A named tuple, so that the compiled kernels take it as one argument. Profile ``j`` starts at row
-    ``offsets[j]`` of ``points``, ``chord_sum`` and ``curvature_sum`` (see :class:`ProfileTables`).
-    """
-
-    points: Array
-    offsets: IntArray
-    chord_sum: Array
-    curvature_sum: Array
-
-    @classmethod
-    def from_tables(cls, tables: ProfileTables) -> CompiledTables:
-        """Stack the prefix sums of :class:`ProfileTables` (each as long as its profile's points)."""
-        return cls(
-            tables.stacked,
-            tables.offsets,
-            np.ascontiguousarray(np.concatenate(tables.chord_sum)),
-            np.ascontiguousarray(np.concatenate(tables.curvature_sum)),
-        )
 
 
 @njit(cache=True)
@@ -80,7 +57,7 @@ def _pairwise_sum(a: Array, lo: int, n: int) -> float:  # pragma: no cover - com
 
 @njit(cache=True)
 def _arc_parameters(
-    tables: CompiledTables, first: IntArray, pieces: IntArray
+    offsets: IntArray, chord_sum: Array, curvature_sum: Array, first: IntArray, pieces: IntArray
 ) -> tuple[float, float]:  # pragma: no cover - compiled
     """``(curvature, piece_length)`` of a C-segment of ``pieces[j]`` pieces from ``first[j]`` on profile ``j``:
     the mean interior curvature (Eq. 18, averaging ``1/r``) and mean chord (Eq. 20 with its ``1/p``), from the
@@ -90,10 +67,10 @@ def _arc_parameters(
     interior = 0
     s_bar = 0.0
     for j in range(p):
-        s, m, o = first[j], pieces[j], tables.offsets[j]
-        s_bar += (tables.chord_sum[o + s + m] - tables.chord_sum[o + s]) / m
+        s, m, o = first[j], pieces[j], offsets[j]
+        s_bar += (chord_sum[o + s + m] - chord_sum[o + s]) / m
         if m > 1:
-            kappa_total += tables.curvature_sum[o + s + m] - tables.curvature_sum[o + s + 1]
+            kappa_total += curvature_sum[o + s + m] - curvature_sum[o + s + 1]
             interior += m - 1
     s_bar /= p
     kappa = kappa_total / interior if interior else 0.0
@@ -102,7 +79,13 @@ def _arc_parameters(
 
 @njit(cache=True)
 def _segment_matrix_table(
-    sm: IntArray, is_m: NDArray[np.bool_], tables: CompiledTables, rms: bool
+    sm: IntArray,
+    is_m: NDArray[np.bool_],
+    points: Array,
+    offsets: IntArray,
+    chord_sum: Array,
+    curvature_sum: Array,
+    rms: bool,
 ) -> Array:  # pragma: no cover - compiled
     """``(q, p)`` errors (Eq. 21) of a segment matrix, or with ``rms`` the lower bounds of ``compiled.fit_bound``.
 
@@ -113,11 +96,10 @@ def _segment_matrix_table(
     first = np.zeros(p, dtype=np.int64)
     for e in range(q):
         if is_m[e]:
-            em[e] = mean_fits(tables.points, tables.offsets, first, sm[e, 0], rms)
+            em[e] = mean_fits(points, offsets, first, sm[e, 0], rms)
         else:
-            pieces = sm[e].copy()
-            kappa, s_bar = _arc_parameters(tables, first, pieces)
-            em[e] = arc_fits(tables.points, tables.offsets, first, pieces, kappa, s_bar, rms)
+            kappa, s_bar = _arc_parameters(offsets, chord_sum, curvature_sum, first, sm[e])
+            em[e] = arc_fits(points, offsets, first, sm[e].copy(), kappa, s_bar, rms)
         for j in range(p):
             first[j] += sm[e, j]
     return em
@@ -189,7 +171,10 @@ def _search(
     is_m: NDArray[np.bool_],
     absorber: int,
     alpha: int,
-    tables: CompiledTables,
+    points: Array,
+    offsets: IntArray,
+    chord_sum: Array,
+    curvature_sum: Array,
     patience: int,
     max_iterations: int,
 ) -> tuple[IntArray, Array, Array, IntArray]:  # pragma: no cover - compiled
@@ -203,7 +188,7 @@ def _search(
     for k in range(n_starts):
         sm = starts[k].copy()
         for it in range(max_iterations):
-            em = _segment_matrix_table(sm, is_m, tables, False)
+            em = _segment_matrix_table(sm, is_m, points, offsets, chord_sum, curvature_sum, False)
             e_max = em.max()  # Eq. (22)
             e_mean = _pairwise_sum(em.ravel(), 0, q * p) / (q * p)
             if e_max < best_max or (e_max == best_max and e_mean < best_mean):
@@ -221,6 +206,26 @@ def _search(
     return best_sm, best_em, history, lengths
 
 
+@dataclass(frozen=True)
+class CompiledTables:
+    """The target profiles stacked for the compiled search (points, chord and curvature prefix sums)."""
+
+    points: Array
+    offsets: IntArray
+    chord_sum: Array
+    curvature_sum: Array
+
+    @classmethod
+    def from_tables(cls, tables: ProfileTables) -> CompiledTables:
+        """Stack the prefix sums of :class:`ProfileTables` (each as long as its profile's points)."""
+        return cls(
+            tables.stacked,
+            tables.offsets,
+            np.ascontiguousarray(np.concatenate(tables.chord_sum)),
+            np.ascontiguousarray(np.concatenate(tables.curvature_sum)),
+        )
+
+
 def compiled_search(
     design: str, starts: Sequence[IntArray], min_pieces: int, tables: CompiledTables
 ) -> SearchOutcome:
@@ -233,7 +238,10 @@ def compiled_search(
         is_m,
         absorber,
         int(min_pieces),
-        tables,
+        tables.points,
+        tables.offsets,
+        tables.chord_sum,
+        tables.curvature_sum,
         PATIENCE,
         MAX_ITERATIONS,
     )
@@ -247,5 +255,7 @@ def compiled_rms_bound(design: str, segment_matrix: IntArray, tables: CompiledTa
     rigidly; see :func:`linkwork.synthesis.search.joined_error_bound`)."""
     is_m = np.array([k == "M" for k in design])
     sm = np.ascontiguousarray(np.asarray(segment_matrix, dtype=np.int64))
-    table = _segment_matrix_table(sm, is_m, tables, True)
+    table = _segment_matrix_table(
+        sm, is_m, tables.points, tables.offsets, tables.chord_sum, tables.curvature_sum, True
+    )
     return float(table.max())
