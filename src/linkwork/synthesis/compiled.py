@@ -16,7 +16,7 @@ Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _centroid(points: Array) -> tuple[float, float]:  # pragma: no cover - compiled
     """Mean of ``points (n, 2)``, summed in order."""
     n = points.shape[0]
@@ -27,7 +27,7 @@ def _centroid(points: Array) -> tuple[float, float]:  # pragma: no cover - compi
     return mx / n, my / n
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _best_turn(
     src: Array, tgt: Array, ms: tuple[float, float], mt: tuple[float, float]
 ) -> tuple[float, float]:  # pragma: no cover - compiled
@@ -51,8 +51,8 @@ def _aligned_distance(src: Array, tgt: Array, rms: bool) -> float:  # pragma: no
     """Largest (or with ``rms`` the root mean square) distance after the best rigid registration of
     ``src (n, 2)`` onto ``tgt (n, 2)``: the one kernel behind both the error (Eq. 21) and :func:`fit_bound`.
 
-    Inlined where it is called (as is :func:`_fit`), so that numba compiles each caller with ``rms`` known and
-    the loop holds only the branch taken: one source, no cost over two separate kernels.
+    Inlined where it is called (as are :func:`_fit` and its own steps), so that numba compiles each caller with
+    ``rms`` known and the loop holds only the branch taken: one source, no cost over two separate kernels.
     """
     ms, mt = _centroid(src), _centroid(tgt)
     c, s = _best_turn(src, tgt, ms, mt)
