@@ -52,3 +52,16 @@ def test_bad_option_is_one_line_and_exit_code_2(tmp_path: Path) -> None:
     assert run.exit_code == 2
     assert "--ground-region" in run.output
     assert not (folder / "mechanization.json").exists()
+
+
+def test_bad_flags_stop_before_the_synthesis_is_run_again(tmp_path: Path, monkeypatch) -> None:
+    import linkwork.synthesis as synthesis
+
+    folder = _synth_folder(tmp_path)
+    runs: list[object] = []
+    monkeypatch.setattr(synthesis, "synthesize", lambda *a, **k: runs.append(a))
+    for flag, value in (("--ground-region", "1,2,3"), ("--min-transmission", "120"), ("--max-link", "-1")):
+        run = CliRunner().invoke(_app(), [str(folder), flag, value, "--no-plots"])
+        assert run.exit_code == 2, (flag, run.output)
+        assert flag.lstrip("-").replace("-", "_") in run.output or flag in run.output
+    assert runs == []  # every mistake was found from the problem and the flags alone

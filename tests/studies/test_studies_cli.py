@@ -173,3 +173,20 @@ def test_couplings_only_restrict_the_misfit(tmp_path):
     assert np.median(sym / free) > 1.05  # and the restriction is felt
     bad = invoke("robustness", *common, "--couple", "A", "-o", str(tmp_path / "bad"))
     assert bad.exit_code == 2 and "--couple" in ANSI.sub("", bad.stderr)
+
+
+def test_robustness_short_of_until_keeps_the_study_and_exits_3(tmp_path):
+    out = tmp_path / "short"
+    res = invoke(
+        "robustness", "bennett", "--until", "A=100", "--max-steps", "5", "--samples", "10",
+        "--hinge-position-tol", "1e-4", "--hinge-direction-tol", "0.01", "--workers", "0", "--no-plots",
+        "-o", str(out),
+    )  # fmt: skip
+    assert res.exit_code == 3
+    line = ANSI.sub("", res.stderr).strip()
+    assert line.startswith("error: the nominal path stopped before A = 100 (step budget, at ")
+    stopped = float(re.search(r"at ([-0-9.e]+)\)", line).group(1))
+    summary = json.loads((out / "robustness.json").read_text())
+    assert summary["samples"] == 10
+    # where it says it stopped is the last point of the study's drive grid (degrees)
+    assert stopped == pytest.approx(summary["bands"]["drive_deg"][-1], abs=1e-4)

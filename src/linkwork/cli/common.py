@@ -11,7 +11,7 @@ import math
 import warnings
 from collections.abc import Callable, Iterator
 from functools import wraps
-from typing import Any, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
@@ -20,6 +20,9 @@ from rich.text import Text
 from linkwork.errors import LinkworkError, RequestNotMetError
 from linkwork.io.toml_reader import escape_line, show
 from linkwork.progress import Progress
+
+if TYPE_CHECKING:
+    from linkwork.kinematics.mechanism import Mechanism
 
 err_console = Console(stderr=True)
 
@@ -100,11 +103,18 @@ def check_range(
         raise fail(f"{flag} {show(value)}: expected {what}, {low:g} {sign} {flag} <= {high:g}")
 
 
+def check_workers(workers: int | None) -> None:
+    """Refuse a negative ``--workers`` (0 runs a study in this process)."""
+    if workers is not None and workers < 0:
+        raise fail(f"--workers {workers}: expected 0 or more")
+
+
 @contextlib.contextmanager
 def progress_bar(label: str, total: int | None, *, fraction: bool = False) -> Iterator[Progress]:
     """A rich progress bar on a terminal (nothing otherwise), handed out as a ``progress(done, total)`` callback.
 
-    The bar counts ``total`` units labelled ``label``. The callback's ``done`` is shown as it is, or, with
+    The bar counts ``total`` units labelled ``label``, or, with ``total=None``, as many as the callback's ``total``
+    says as the work goes on. The callback's ``done`` is shown as it is, or, with
     ``fraction``, as the fraction ``done / total`` of the bar (a computation that counts other units, such as
     chunks of samples).
     """
@@ -125,7 +135,10 @@ def progress_bar(label: str, total: int | None, *, fraction: bool = False) -> It
         task = bar.add_task("", total=total)
 
         def update(done: int, of: int | None) -> None:
-            if fraction and total is not None:
+            if total is None:  # the computation says how much there is as it goes
+                bar.update(task, completed=done, total=None if of is None else max(of, done))
+                return
+            if fraction:
                 done = min(total, round(total * done / max(of or 1, 1)))
             bar.update(task, completed=done)
 
@@ -144,6 +157,15 @@ def parse_until(text: str | None) -> tuple[str, float] | None:
     if not sep or not name.strip() or not math.isfinite(value):
         raise fail(f"--until {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
     return name.strip(), value
+
+
+def until_in_api_units(mech: Mechanism, target: tuple[str, float] | None) -> tuple[str, float] | None:
+    """A parsed ``--until`` in the API's units: degrees become radians for a revolute joint; a length stays."""
+    if target is None:
+        return None
+    name, value = target
+    revolute = mech.joint_types[mech.index(name)] == "R"
+    return name, math.radians(value) if revolute else float(value)
 
 
 def parse_couple(items: list[str] | None) -> list[list[str]]:

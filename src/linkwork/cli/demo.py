@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import html
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NamedTuple
 
 import typer
 from rich.text import Text
@@ -30,109 +30,120 @@ def demo(
     console.print(f"\nopen {out / 'index.html'} to see every result")
 
 
+class Section(NamedTuple):
+    """One part of the demo as index.html shows it: a title, a paragraph, its folder and its figures."""
+
+    title: str
+    text: str
+    folder: Path
+    figures: list[str]
+
+
 def _build_demo(out: Path, no_plots: bool) -> None:
     """Run the four parts of the demo and write them, with index.html, into ``out`` (the staging folder)."""
+    plots = not no_plots
+    sections = [
+        _hexagon(out, plots),
+        _guest_frame(out, plots),
+        _wing(out, plots),
+        _mechanized_wing(out, plots),
+    ]
+    _write_index(out, sections)
+
+
+def _heading(text: str) -> None:
+    """A rule with the part's title on the terminal."""
+    console.rule(Text(text, style="bold"))
+
+
+def _hexagon(out: Path, plots: bool) -> Section:
+    """Part 1: Hedgepeth's hexagon deployed from the bundle to the flat hexagon in the paper's 200 steps."""
     import numpy as np
 
     import linkwork as lw
     from linkwork.linkages.hedgepeth_rods import deployed_angles
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
-    from linkwork.viz.viewer import write_synthesis_viewer
 
-    sections: list[tuple[str, str, Path, list[str]]] = []
-
-    console.rule(
-        Text("1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)", style="bold")
-    )
+    _heading("1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)")
     hexagon = lw.load("hedgepeth-rods", n=6)
     inner, outer = deployed_angles(6)
     path = lw.trace(hexagon, until=("A", inner), steps=200)
-    figs = write_trace_outputs(path, out / "hexagon", plots=not no_plots, html=True, animate=not no_plots)
+    figs = write_trace_outputs(path, out / "hexagon", plots=plots, html=True, animate=plots)
     print_trace_summary(path)
     a = np.degrees(path.angles[-1])
-    sections.append(
-        (
-            "Hedgepeth's hexagon (Sec. 5, Figs. 12-13): from the bundle to the flat hexagon",
-            f"The hoop built from its six mitred triangular rods, in 200 equal steps of θA from the folded "
-            f"bundle to the flat hexagon; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
-            f"B = D = F = {a[1]:.4f}° at the end (closed form {np.degrees(inner):.4f}° and "
-            f"{np.degrees(outer):.4f}°; max |A - C| along the path "
-            f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°). Eq. (10)'s 87.0067° "
-            "cannot be a flat hexagon: see docs/linkages.md.",
-            out / "hexagon",
-            [f.name for f in figs],
-        )
+    return Section(
+        "Hedgepeth's hexagon (Sec. 5, Figs. 12-13): from the bundle to the flat hexagon",
+        f"The hoop built from its six mitred triangular rods, in 200 equal steps of θA from the folded "
+        f"bundle to the flat hexagon; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
+        f"B = D = F = {a[1]:.4f}° at the end (closed form {np.degrees(inner):.4f}° and "
+        f"{np.degrees(outer):.4f}°; max |A - C| along the path "
+        f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°). Eq. (10)'s 87.0067° "
+        "cannot be a flat hexagon: see docs/linkages.md.",
+        out / "hexagon",
+        [f.name for f in figs],
     )
 
-    console.rule(
-        Text(
-            "2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)", style="bold"
-        )
+
+def _guest_frame(out: Path, plots: bool) -> Section:
+    """Part 2: Guest's rectangular frame, every branch through its bifurcation points."""
+    import linkwork as lw
+    from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
+
+    _heading("2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)")
+    path = lw.trace(lw.load("guest-frame"), branches=True, max_steps=6000)
+    figs = write_trace_outputs(path, out / "guest-frame", plots=plots, html=True, animate=plots)
+    print_trace_summary(path)
+    lowest = min((b.rank for b in path.bifurcations), default=path.stats["start_rank"])
+    return Section(
+        "Guest's frame, every branch",
+        f"{len(path.bifurcations)} bifurcation points (rank {path.stats['start_rank']} → {lowest}) and "
+        f"{len(path.branches)} traced branches.",
+        out / "guest-frame",
+        [f.name for f in figs],
     )
-    try:
-        frame = lw.load("guest-frame")
-    except lw.SpecError:
-        frame = None
-    if frame is not None:
-        path = lw.trace(frame, branches=True, max_steps=6000)
-        figs = write_trace_outputs(
-            path, out / "guest-frame", plots=not no_plots, html=True, animate=not no_plots
-        )
-        print_trace_summary(path)
-        sections.append(
-            (
-                "Guest's frame, every branch",
-                f"{len(path.bifurcations)} bifurcation points (rank {path.stats['start_rank']} → "
-                f"{min((b.rank for b in path.bifurcations), default=path.stats['start_rank'])}) and "
-                f"{len(path.branches)} traced branches.",
-                out / "guest-frame",
-                [f.name for f in figs],
-            )
-        )
 
-    console.rule(Text("3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)", style="bold"))
-    try:
-        from linkwork.outputs.synthesis import run_synthesis_example
-    except ImportError:  # pragma: no cover - synthesis not installed
-        run_synthesis_example = None  # type: ignore[assignment]
-    if run_synthesis_example is not None:
-        from linkwork.outputs.synthesis import print_synthesis_summary
 
-        result = run_synthesis_example(out / "synthesis-wing", "wing", plots=not no_plots)
-        write_synthesis_viewer(result, out / "synthesis-wing" / "viewer.html")
-        print_synthesis_summary(result)
-        figs_s = sorted(p.name for p in (out / "synthesis-wing").glob("*.png"))
-        sections.append(
-            (
-                "Morphing wing synthesis",
-                "A chain of rigid links that approximates three wing profiles of different arc length.",
-                out / "synthesis-wing",
-                figs_s,
-            )
-        )
-    if run_synthesis_example is not None:
-        console.rule(
-            Text("4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)", style="bold")
-        )
-        import json
+def _wing(out: Path, plots: bool) -> Section:
+    """Part 3: the morphing wing synthesised from its three profiles, with its viewer."""
+    from linkwork.outputs.synthesis import print_synthesis_summary, run_synthesis_example
+    from linkwork.viz.viewer import write_synthesis_viewer
 
-        folder = out / "mechanism-wing"
-        run_synthesis_example(folder, "wing", plots=not no_plots, file="mechanize.toml")
-        report = json.loads((folder / "mechanization.json").read_text())
-        design = json.loads((folder / "chain.json").read_text())["design"]
-        errors = ", ".join(f"{p['e_max']:.4f}" for p in report["profiles"])
-        text = (
-            f"The wing chain (design {design}) with binary links added by rigid-body "
-            f"guidance: DOF {report['dof']}, drive {report['drive']}, verified by tracing it through every "
-            f"profile in order (no circuit, branch or order defect); E_max per profile {errors}. "
-            "mechanism.toml runs with linkwork trace as it is."
-        )
-        console.print(text)
-        figs_m = sorted(p.name for p in folder.glob("mechanism*.png")) + sorted(
-            p.name for p in folder.glob("mechanism*.gif")
-        )
-        sections.append(("Mechanized wing (one degree of freedom)", text, folder, figs_m))
-    _write_index(out, sections)
+    _heading("3. Shape-change synthesis: a morphing wing (Shamsudin et al. 2013)")
+    folder = out / "synthesis-wing"
+    result = run_synthesis_example(folder, "wing", plots=plots)
+    write_synthesis_viewer(result, folder / "viewer.html")
+    print_synthesis_summary(result)
+    return Section(
+        "Morphing wing synthesis",
+        "A chain of rigid links that approximates three wing profiles of different arc length.",
+        folder,
+        sorted(p.name for p in folder.glob("*.png")),
+    )
+
+
+def _mechanized_wing(out: Path, plots: bool) -> Section:
+    """Part 4: the wing chain mechanized to one degree of freedom and verified by tracing."""
+    import json
+
+    from linkwork.outputs.synthesis import run_synthesis_example
+
+    _heading("4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)")
+    folder = out / "mechanism-wing"
+    run_synthesis_example(folder, "wing", plots=plots, file="mechanize.toml")
+    report = json.loads((folder / "mechanization.json").read_text())
+    design = json.loads((folder / "chain.json").read_text())["design"]
+    errors = ", ".join(f"{p['e_max']:.4f}" for p in report["profiles"])
+    text = (
+        f"The wing chain (design {design}) with binary links added by rigid-body "
+        f"guidance: DOF {report['dof']}, drive {report['drive']}, verified by tracing it through every "
+        f"profile in order (no circuit, branch or order defect); E_max per profile {errors}. "
+        "mechanism.toml runs with linkwork trace as it is."
+    )
+    console.print(text)
+    figures = sorted(p.name for p in folder.glob("mechanism*.png")) + sorted(
+        p.name for p in folder.glob("mechanism*.gif")
+    )
+    return Section("Mechanized wing (one degree of freedom)", text, folder, figures)
 
 
 #: What each section's interactive viewer lets a reader do.
@@ -143,7 +154,7 @@ VIEWER_HINTS = {
 }
 
 
-def _write_index(out: Path, sections: list[tuple[str, str, Path, list[str]]]) -> None:
+def _write_index(out: Path, sections: list[Section]) -> None:
     """A plain, self-contained index.html linking every file written, each interactive viewer first."""
     parts = [
         "<!doctype html><html><head><meta charset='utf-8'><title>linkwork demo</title>",

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from linkwork.cli import help
+from linkwork.cli import options as opt
 from linkwork.cli.common import friendly_errors, parse_assignments
 from linkwork.outputs.staging import console
 
@@ -65,12 +66,7 @@ def mjcf(
         str, typer.Argument(help="A built-in name, a TOML spec file or a `linkwork trace --out` folder.")
     ],
     out: Out,
-    set_: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
-        ),
-    ] = None,
+    set_: opt.SetParams = None,
     drive: Annotated[
         str | None,
         typer.Option("--drive", help="Joint the position actuator turns (default: the trace's drive)."),
@@ -105,12 +101,7 @@ def dxf(
     units: Annotated[
         str | None, typer.Option("--units", help="Length unit of the drawing: mm, cm, m, um, in or ft.")
     ] = None,
-    set_: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
-        ),
-    ] = None,
+    set_: opt.SetParams = None,
 ) -> None:
     """A planar mechanism's links and pivots as a DXF drawing.
 

@@ -6,6 +6,7 @@ from typing import Annotated
 
 import typer
 
+from linkwork.cli import options as opt
 from linkwork.cli.common import friendly_errors, parse_assignments
 from linkwork.outputs.staging import console
 
@@ -36,12 +37,7 @@ def linkages() -> None:
 @friendly_errors
 def show(
     spec: Annotated[str, typer.Argument(help="A built-in name or a TOML spec file.")],
-    set_: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
-        ),
-    ] = None,
+    set_: opt.SetParams = None,
 ) -> None:
     """Print a linkage as a TOML spec file (its joints' axes at the start), ready to edit and trace."""
     from linkwork.io.spec import dump_spec, resolve_spec

@@ -10,12 +10,12 @@ override them.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from linkwork.cli import mechanize_flags as mf
-from linkwork.cli.common import check_range, friendly_errors
+from linkwork.cli.common import check_range, friendly_errors, progress_bar
 from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 MAX_DOF = 20
@@ -23,6 +23,7 @@ MAX_DOF = 20
 
 
 @friendly_errors
+@mf.with_mechanize_flags(after="out")
 def mechanize(
     folder: Annotated[
         Path, typer.Argument(help="A `linkwork synth` output folder (chain.json).", show_default=False)
@@ -33,19 +34,6 @@ def mechanize(
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="Folder to write into (default: DIR).")
     ] = None,
-    dof: mf.Dof = None,
-    drive: mf.Drive = None,
-    root: mf.Root = None,
-    anchors: mf.Anchors = None,
-    actuator: mf.Actuator = None,
-    binary_links: mf.BinaryLinks = None,
-    ground_region: mf.GroundRegion = None,
-    link_offset: mf.LinkOffset = None,
-    max_link: mf.MaxLink = None,
-    min_transmission: mf.MinTransmission = None,
-    attempts: mf.Attempts = None,
-    designs: mf.Designs = None,
-    time_limit: mf.TimeLimit = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Do not draw the figures and animation.")
     ] = False,
@@ -53,6 +41,8 @@ def mechanize(
         bool,
         typer.Option("--html", help="Also write mechanism.html: the mechanism over the target profiles."),
     ] = False,
+    *,
+    flags: dict[str, Any],
 ) -> None:
     """Add binary links (RR dyads, linear actuators) to a synthesised chain until it has DOF degrees of freedom,
     verify that it moves through every profile in order without circuit, branch or order defects, and write
@@ -60,33 +50,18 @@ def mechanize(
     from linkwork.outputs.mechanization import (
         mechanize_into,
         print_mechanization,
-        progress_bar,
         resolve_options,
     )
-    from linkwork.outputs.synthesis import load_synthesis
+    from linkwork.outputs.synthesis import rerun_synthesis, synthesis_problem
 
-    flags = mf.flag_values(
-        dof=dof,
-        drive=drive,
-        root=root,
-        anchors=anchors,
-        actuator=actuator,
-        binary_links=binary_links,
-        ground_region=ground_region,
-        link_offset=link_offset,
-        max_link=max_link,
-        min_transmission=min_transmission,
-        attempts=attempts,
-        designs=designs,
-        time_limit=time_limit,
-    )
     check_output_folder(out or folder)
-    if dof is not None:
-        check_range("--dof", dof, 1, MAX_DOF, "a whole number of degrees of freedom")
-    result = load_synthesis(folder, problem)
-    options = resolve_options(result.problem, flags)
+    if "dof" in flags:
+        check_range("--dof", flags["dof"], 1, MAX_DOF, "a whole number of degrees of freedom")
+    spec = synthesis_problem(folder, problem)
+    options = resolve_options(spec, flags)  # a bad flag stops here, before the synthesis is run again
+    result = rerun_synthesis(folder, spec)
     target = out or folder
-    with staged_output(target) as stage, progress_bar() as progress:
+    with staged_output(target) as stage, progress_bar("[bold]mechanizing[/]", None) as progress:
         found, written = mechanize_into(
             result, stage, options=options, plots=not no_plots, progress=progress, html=html
         )

@@ -1,8 +1,15 @@
 """The mechanization flags shared by ``linkwork mechanize`` and ``linkwork synth`` (each is also a problem-file
-key of the same name; a flag overrides the key)."""
+key of the same name; a flag overrides the key).
+
+The flags are declared once, in :data:`FLAGS`; :func:`with_mechanize_flags` adds them to a command's parameters
+and hands the command the ones given, as problem-file values.
+"""
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
+from functools import wraps
 from typing import Annotated, Any
 
 import typer
@@ -75,6 +82,55 @@ TimeLimit = Annotated[
     float | None,
     typer.Option(rich_help_panel=PANEL, help="Seconds after which the search stops; key time_limit."),
 ]
+
+
+FLAGS: dict[str, Any] = {
+    "dof": Dof,
+    "drive": Drive,
+    "root": Root,
+    "anchors": Anchors,
+    "actuator": Actuator,
+    "binary_links": BinaryLinks,
+    "ground_region": GroundRegion,
+    "link_offset": LinkOffset,
+    "max_link": MaxLink,
+    "min_transmission": MinTransmission,
+    "attempts": Attempts,
+    "designs": Designs,
+    "time_limit": TimeLimit,
+}
+"""Each mechanization flag's parameter name and its typer annotation, in the order ``--help`` lists them."""
+
+
+def with_mechanize_flags(after: str) -> Callable[[Callable[..., None]], Callable[..., None]]:
+    """Add the mechanization flags of :data:`FLAGS` to a command, after its parameter ``after``.
+
+    The decorated command declares a keyword parameter ``flags`` instead of the thirteen flags; it receives the
+    flags given on the command line as problem-file values (see :func:`flag_values`).
+    """
+
+    def decorate(command: Callable[..., None]) -> Callable[..., None]:
+        signature = inspect.signature(command, eval_str=True)
+        own = [p for p in signature.parameters.values() if p.name != "flags"]
+        at = [p.name for p in own].index(after) + 1
+        added = [
+            inspect.Parameter(
+                name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=None, annotation=annotation
+            )
+            for name, annotation in FLAGS.items()
+        ]
+
+        @wraps(command)
+        def run(*args: Any, **kwargs: Any) -> None:
+            given = {name: kwargs.pop(name, None) for name in FLAGS}
+            command(*args, flags=flag_values(**given), **kwargs)
+
+        parameters = own[:at] + added + own[at:]
+        run.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+        run.__annotations__ = {p.name: p.annotation for p in parameters} | {"return": None}
+        return run
+
+    return decorate
 
 
 def flag_values(**flags: Any) -> dict[str, Any]:

@@ -3,27 +3,32 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.text import Text
 
+from linkwork.cli import options as opt
 from linkwork.cli.common import (
+    check_workers,
     fail,
     friendly_errors,
     parse_assignments,
     parse_couple,
     parse_until,
     progress_bar,
+    until_in_api_units,
 )
 from linkwork.outputs.staging import console
+
+if TYPE_CHECKING:
+    from linkwork.kinematics.mechanism import Mechanism
+    from linkwork.kinematics.trace_result import Trace
 
 
 @friendly_errors
 def robustness(
-    spec: Annotated[
-        str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")
-    ],
+    spec: opt.SpecName,
     samples: Annotated[int, typer.Option(help="Number of imperfect samples.")],
     hinge_position_tol: Annotated[
         float, typer.Option(help="Hinge position tolerance, normal to the line (length units).")
@@ -31,12 +36,7 @@ def robustness(
     hinge_direction_tol: Annotated[
         float, typer.Option(help="Hinge direction tolerance: cone half-angle (deg).")
     ],
-    set_: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
-        ),
-    ] = None,
+    set_: opt.SetParams = None,
     until: Annotated[
         str | None, typer.Option(help="Nominal path: trace until JOINT reaches VALUE (degrees), e.g. A=120.")
     ] = None,
@@ -48,69 +48,40 @@ def robustness(
             help="Force joints equal, e.g. A=C=E (kept in every sample); repeatable.", show_default=False
         ),
     ] = None,
-    fixed: Annotated[
-        list[str] | None,
-        typer.Option(help="Hold a joint at its start value; repeatable.", show_default=False),
-    ] = None,
+    fixed: opt.Fixed = None,
     distribution: Annotated[
         str, typer.Option(help="normal (tolerance = standard deviation) or uniform (within the tolerance).")
     ] = "normal",
     seed: Annotated[int, typer.Option(help="Seed of the study; sample i gets its own seed from it.")] = 0,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."
-        ),
-    ] = None,
-    workers: Annotated[
-        int | None,
-        typer.Option(help="Local worker processes (default: one per core; 0 runs in this process)."),
-    ] = None,
+    scheduler: opt.Scheduler = None,
+    workers: opt.Workers = None,
     spatial_errors: Annotated[
         bool,
         typer.Option(
             "--spatial-errors", help="Planar mechanisms: tilt and shift hinges out of the plane too."
         ),
     ] = False,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
-    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
+    out: opt.OutFolder = Path("out"),
+    no_plots: opt.NoPlots = False,
 ) -> None:
     """Imperfection sensitivity: robustness.json, samples.parquet and figures in --out."""
     import numpy as np
 
-    from linkwork.errors import SpecError
-    from linkwork.io.spec import resolve_spec
-    from linkwork.kinematics.tracer import trace as run_trace
     from linkwork.studies.imperfections import ImperfectionModel
     from linkwork.studies.robustness import nominal_ratio, prepare
 
-    if samples < 1:
-        raise fail(f"--samples {samples}: expected at least 1")
-    if seed < 0:
-        raise fail(f"--seed {seed}: expected a non-negative whole number")
-    if workers is not None and workers < 0:
-        raise fail(f"--workers {workers}: expected 0 or more")
+    _check_counts(samples, seed, workers)
     if steps is not None and until is None:
         raise fail("--steps needs --until JOINT=VALUE")
-    params = parse_assignments(set_, "--set")
     target = parse_until(until)
-    loaded = resolve_spec(spec, params)
-    mech = loaded.mechanism
-    if couple or fixed:
-        mech = mech.with_couplings(parse_couple(couple), fixed or [])
+    mech = _mechanism(spec, set_, couple, fixed)
     model = ImperfectionModel(
         position_tol=hinge_position_tol,
         direction_tol=float(np.radians(hinge_direction_tol)),
         distribution=distribution,
         spatial=spatial_errors or not mech.planar,
     )
-    until_api = None
-    if target is not None:
-        j = mech.index(target[0])
-        until_api = (target[0], float(np.radians(target[1]) if mech.joint_types[j] == "R" else target[1]))
-    path = run_trace(mech, until=until_api, steps=steps, max_steps=max_steps)
-    if path.angles.shape[0] < 2:
-        raise SpecError("the nominal path has a single point; give --until or a longer budget")
+    path = _nominal_path(mech, until_in_api_units(mech, target), steps, max_steps)
     setup = prepare(mech, path, model, seed)
     console.print(
         Text(mech.name, style="bold"),
@@ -138,13 +109,56 @@ def robustness(
     print_robustness_summary(robustness_dict(result, spec))
     written = ["robustness.json", "samples.parquet", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
-    end = path.branches[0].end_reason if path.branches else ""
-    if target is not None and end != "reached target":
-        from linkwork.errors import RequestNotMetError
+    if target is not None:
+        _check_reached(mech, path, float(setup.drive_values[-1]), target)
 
-        last = float(setup.drive_values[-1])
-        reached = float(np.degrees(last)) if mech.joint_types[mech.index(target[0])] == "R" else last
-        raise RequestNotMetError(
-            f"the nominal path stopped before {target[0]} = {target[1]:g} ({end}, at {reached:.6g}); "
-            "the study covers the path up to there"
-        )
+
+def _check_counts(samples: int, seed: int, workers: int | None) -> None:
+    """Refuse a study of no samples, a negative seed or a negative number of workers."""
+    if samples < 1:
+        raise fail(f"--samples {samples}: expected at least 1")
+    if seed < 0:
+        raise fail(f"--seed {seed}: expected a non-negative whole number")
+    check_workers(workers)
+
+
+def _mechanism(
+    spec: str, set_: list[str] | None, couple: list[str] | None, fixed: list[str] | None
+) -> Mechanism:
+    """The linkage of the study, with its couplings and fixed joints."""
+    from linkwork.io.spec import resolve_spec
+
+    mech = resolve_spec(spec, parse_assignments(set_, "--set")).mechanism
+    if couple or fixed:
+        mech = mech.with_couplings(parse_couple(couple), fixed or [])
+    return mech
+
+
+def _nominal_path(
+    mech: Mechanism, until: tuple[str, float] | None, steps: int | None, max_steps: int
+) -> Trace:
+    """The perfect linkage's path, along which every sample is measured (at least two points)."""
+    from linkwork.errors import SpecError
+    from linkwork.kinematics.tracer import trace as run_trace
+
+    path = run_trace(mech, until=until, steps=steps, max_steps=max_steps)
+    if path.angles.shape[0] < 2:
+        raise SpecError("the nominal path has a single point; give --until or a longer budget")
+    return path
+
+
+def _check_reached(mech: Mechanism, path: Trace, last: float, target: tuple[str, float]) -> None:
+    """Exit 3 (after everything is written) when the nominal path stopped short of ``--until``; ``last`` is the
+    drive's value (radians or a length) where it stopped."""
+    import numpy as np
+
+    from linkwork.errors import RequestNotMetError
+
+    end = path.branches[0].end_reason if path.branches else ""
+    if end == "reached target":
+        return
+    reached = float(np.degrees(last)) if mech.joint_types[mech.index(target[0])] == "R" else last
+    raise RequestNotMetError(
+        f"the nominal path stopped before {target[0]} = {target[1]:g} ({end}, at {reached:.6g}); "
+        "the study covers the path up to there"
+    )

@@ -8,7 +8,8 @@ from typing import Annotated
 import typer
 from rich.text import Text
 
-from linkwork.cli.common import fail, friendly_errors, progress_bar
+from linkwork.cli import options as opt
+from linkwork.cli.common import check_workers, friendly_errors, progress_bar
 from linkwork.outputs.staging import console
 
 
@@ -17,18 +18,10 @@ def sweep(
     study_file: Annotated[
         Path, typer.Argument(help="The study file (TOML): a linkage or problem and a \\[grid] table.")
     ],
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."
-        ),
-    ] = None,
-    workers: Annotated[
-        int | None,
-        typer.Option(help="Local worker processes (default: one per core; 0 runs in this process)."),
-    ] = None,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
-    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
+    scheduler: opt.Scheduler = None,
+    workers: opt.Workers = None,
+    out: opt.OutFolder = Path("out"),
+    no_plots: opt.NoPlots = False,
 ) -> None:
     """Run every grid point of a study: sweep.parquet, sweep.csv and plots in --out."""
 
@@ -37,8 +30,7 @@ def sweep(
     from linkwork.studies.study_file import load_study
     from linkwork.studies.sweep import prepare_study, run_sweep
 
-    if workers is not None and workers < 0:
-        raise fail(f"--workers {workers}: expected 0 or more")
+    check_workers(workers)
     study = prepare_study(load_study(study_file))
     total = len(study.points())
     console.print(Text(study.name, style="bold"), f"{study.kind} study of {total} grid point(s)", sep=": ")

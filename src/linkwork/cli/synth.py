@@ -9,17 +9,18 @@ a failure never leaves half an output. :func:`run_synthesis_example` runs a bund
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from linkwork.cli import mechanize_flags as mf
-from linkwork.cli.common import friendly_errors
+from linkwork.cli.common import friendly_errors, progress_bar
 from linkwork.errors import SpecError
 from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
 
 
 @friendly_errors
+@mf.with_mechanize_flags(after="mechanize")
 def synth(
     problem: Annotated[
         Path,
@@ -47,19 +48,6 @@ def synth(
             help="Also mechanize the chain (default: the problem's `mechanize` key, or any mechanization flag).",
         ),
     ] = None,
-    dof: mf.Dof = None,
-    drive: mf.Drive = None,
-    root: mf.Root = None,
-    anchors: mf.Anchors = None,
-    actuator: mf.Actuator = None,
-    binary_links: mf.BinaryLinks = None,
-    ground_region: mf.GroundRegion = None,
-    link_offset: mf.LinkOffset = None,
-    max_link: mf.MaxLink = None,
-    min_transmission: mf.MinTransmission = None,
-    attempts: mf.Attempts = None,
-    designs: mf.Designs = None,
-    time_limit: mf.TimeLimit = None,
     exhaustive: Annotated[
         bool,
         typer.Option(
@@ -68,6 +56,8 @@ def synth(
             "chosen design is the same, only slower).",
         ),
     ] = False,
+    *,
+    flags: dict[str, Any],
 ) -> None:
     """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
 
@@ -78,8 +68,6 @@ def synth(
     `mechanize = true`, --mechanize or any mechanization flag) the chain's files are written first; if no
     mechanism passes they stay and the command exits with code 3 naming the closest design.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
     from linkwork.io.problem import load_problem
     from linkwork.outputs.problem_copy import copy_problem
     from linkwork.outputs.synthesis import print_synthesis_summary, write_synthesis_outputs
@@ -94,36 +82,9 @@ def synth(
     spec = load_problem(problem)
     from linkwork.outputs.mechanization import resolve_options
 
-    flags = mf.flag_values(
-        dof=dof,
-        drive=drive,
-        root=root,
-        anchors=anchors,
-        actuator=actuator,
-        binary_links=binary_links,
-        ground_region=ground_region,
-        link_offset=link_offset,
-        max_link=max_link,
-        min_transmission=min_transmission,
-        attempts=attempts,
-        designs=designs,
-        time_limit=time_limit,
-    )
     options = resolve_options(spec, flags)  # a bad flag or key stops here, before the synthesis
     mechanizing = (spec.mechanize or bool(flags)) if mechanize is None else mechanize
-    with Progress(
-        TextColumn("[bold]synthesising[/]"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-    ) as bar:
-        task = bar.add_task("synthesis", total=None)
-
-        def progress(done: int, total: int) -> None:
-            bar.update(task, completed=done, total=total)
-
+    with progress_bar("[bold]synthesising[/]", None) as progress:
         result = synthesize(spec, progress=progress, search=search, prune=not exhaustive)  # type: ignore[arg-type]
 
     plots = not no_plots
@@ -141,9 +102,9 @@ def synth(
     console.print(f"wrote {len(written)} files to {out}/: " + ", ".join(path.name for path in written))
     if mechanizing:
         # the chain is on disk already: a mechanization that fails (exit 3) loses nothing of it
-        from linkwork.outputs.mechanization import mechanize_into, print_mechanization, progress_bar
+        from linkwork.outputs.mechanization import mechanize_into, print_mechanization
 
-        with staged_output(out) as stage, progress_bar() as step:
+        with staged_output(out) as stage, progress_bar("[bold]mechanizing[/]", None) as step:
             found, more = mechanize_into(
                 result, stage, options=options, plots=plots, progress=step, html=html
             )

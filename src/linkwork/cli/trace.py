@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.text import Text
 
+from linkwork.cli import options as opt
 from linkwork.cli.common import (
     check_range,
     fail,
@@ -17,6 +18,7 @@ from linkwork.cli.common import (
     parse_couple,
     parse_until,
     progress_bar,
+    until_in_api_units,
 )
 from linkwork.errors import RequestNotMetError
 from linkwork.outputs.staging import check_output_folder, console
@@ -61,15 +63,8 @@ def _parse_limits(items: list[str] | None) -> dict[str, tuple[float, float]]:
 
 @friendly_errors
 def trace(
-    spec: Annotated[
-        str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")
-    ],
-    set_: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--set", help="Built-in parameter KEY=VALUE (angles in degrees); repeatable.", show_default=False
-        ),
-    ] = None,
+    spec: opt.SpecName,
+    set_: opt.SetParams = None,
     drive: Annotated[str | None, typer.Option(help="Joint that orients and counts the steps.")] = None,
     until: Annotated[
         str | None, typer.Option(help="Stop exactly when JOINT reaches VALUE (degrees), e.g. A=87.0067.")
@@ -85,10 +80,7 @@ def trace(
     couple: Annotated[
         list[str] | None, typer.Option(help="Force joints equal, e.g. A=C=E; repeatable.", show_default=False)
     ] = None,
-    fixed: Annotated[
-        list[str] | None,
-        typer.Option(help="Hold a joint at its start value; repeatable.", show_default=False),
-    ] = None,
+    fixed: opt.Fixed = None,
     branches: Annotated[
         bool, typer.Option("--branches", help="Follow every branch at every bifurcation.")
     ] = False,
@@ -107,8 +99,8 @@ def trace(
             "link parameters are slightly inconsistent; report.json states it and the largest misfit met.",
         ),
     ] = 1e-12,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("out"),
-    no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw figures.")] = False,
+    out: opt.OutFolder = Path("out"),
+    no_plots: opt.NoPlots = False,
     animate: Annotated[
         bool,
         typer.Option(
@@ -148,11 +140,7 @@ def trace(
     if couple or fixed:
         mech = mech.with_couplings(parse_couple(couple), fixed or [])
     limits = _limits_in_api_units(mech, limits_file)
-    until_rad = None
-    if target is not None:
-        j = mech.index(target[0])
-        value = np.radians(target[1]) if mech.joint_types[j] == "R" else target[1]
-        until_rad = (target[0], float(value))
+    until_rad = until_in_api_units(mech, target)
 
     console.print(
         Text(mech.name, style="bold"),

@@ -9,13 +9,15 @@ from the bodies' displacements; the verification compares the traced motion with
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.geometry.se2 import pose_matrix, pose_of, relative
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.mechanization.chain import ShapeChain, apply, relative
+from linkwork.mechanization.chain import ShapeChain, track
 
 Array = NDArray[np.float64]
 
@@ -125,113 +127,20 @@ class Design:
         disp: dict[str, Array] = {"ground": np.zeros((p, 3))}
         disp.update({b.name: b.displacements for b in self.chain.bodies})
         for link in self.links:
-            ga, gb = disp[link.anchor], disp[link.body]
-            rel = relative(ga, gb)
-            # the moving pivot and fixed pivot as seen from the anchor (profile-1 coordinates)
-            m = np.array([apply(r, link.circle) for r in rel])
-            d = m - link.centre
-            phi = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
-            phi = phi - phi[0]
-            c = link.centre
-            if link.kind == "PR":
-                assert link.direction is not None
-                travel = (m - m[0]) @ link.direction
-                slide = np.column_stack([np.outer(travel, link.direction), np.zeros(p)])
-                disp[link.name] = _compose(ga, slide)
-                continue
-            if link.kind == "RR":
-                rot = np.array([[ga_pose(c, a)] for a in phi]).reshape(p, 3)
-                disp[f"{link.name}"] = _compose(ga, rot)
-            else:
-                rot = np.array([ga_pose(c, a) for a in phi])
-                dist = np.linalg.norm(d, axis=1)
-                u0 = d[0] / dist[0]
-                slide = np.column_stack([np.outer(dist - dist[0], u0), np.zeros(p)])
-                disp[f"{link.name}c"] = _compose(ga, rot)
-                disp[f"{link.name}r"] = _compose(
-                    ga, np.array([_then(r, s) for r, s in zip(rot, slide, strict=True)])
-                )
+            disp.update(_link_displacements(link, disp[link.anchor], disp[link.body]))
         return disp
 
     def joint_specs(self) -> list[dict[str, object]]:
-        """Joints for :meth:`Mechanism.from_joints` (profile-1 positions)."""
+        """Joints for :meth:`Mechanism.from_joints` (profile-1 positions): the chain's, then every link's in
+        :meth:`BinaryLink.joint_names` order."""
         out: list[dict[str, object]] = []
         for jt in self.chain.joints:
-            entry: dict[str, object] = {"name": jt.name, "type": jt.kind, "bodies": list(jt.bodies)}
-            entry["point"] = [float(jt.point[0]), float(jt.point[1])]
-            entry["direction"] = [0.0, 0.0, 1.0] if jt.kind == "R" else [float(v) for v in jt.direction]  # type: ignore[union-attr]
-            out.append(entry)
+            direction = _AXIS if jt.kind == "R" else [float(v) for v in jt.direction]  # type: ignore[union-attr]
+            out.append(
+                _joint(jt.name, jt.kind, jt.bodies, [float(jt.point[0]), float(jt.point[1])], direction)
+            )
         for link in self.links:
-            c, m = [float(v) for v in link.centre], [float(v) for v in link.circle]
-            if link.kind == "PR":
-                assert link.direction is not None
-                out.append(
-                    {
-                        "name": f"{link.name}s",
-                        "type": "P",
-                        "bodies": [link.anchor, link.name],
-                        "point": c,
-                        "direction": [float(v) for v in link.direction],
-                    }
-                )
-                out.append(
-                    {
-                        "name": f"{link.name}m",
-                        "type": "R",
-                        "bodies": [link.name, link.body],
-                        "point": m,
-                        "direction": [0.0, 0.0, 1.0],
-                    }
-                )
-            elif link.kind == "RR":
-                out.append(
-                    {
-                        "name": f"{link.name}a",
-                        "type": "R",
-                        "bodies": [link.anchor, link.name],
-                        "point": c,
-                        "direction": [0.0, 0.0, 1.0],
-                    }
-                )
-                out.append(
-                    {
-                        "name": f"{link.name}m",
-                        "type": "R",
-                        "bodies": [link.name, link.body],
-                        "point": m,
-                        "direction": [0.0, 0.0, 1.0],
-                    }
-                )
-            else:
-                u = (link.circle - link.centre) / link.length
-                cyl, rod = f"{link.name}c", f"{link.name}r"
-                out.append(
-                    {
-                        "name": f"{link.name}a",
-                        "type": "R",
-                        "bodies": [link.anchor, cyl],
-                        "point": c,
-                        "direction": [0.0, 0.0, 1.0],
-                    }
-                )
-                out.append(
-                    {
-                        "name": f"{link.name}s",
-                        "type": "P",
-                        "bodies": [cyl, rod],
-                        "point": c,
-                        "direction": [float(u[0]), float(u[1])],
-                    }
-                )
-                out.append(
-                    {
-                        "name": f"{link.name}m",
-                        "type": "R",
-                        "bodies": [rod, link.body],
-                        "point": m,
-                        "direction": [0.0, 0.0, 1.0],
-                    }
-                )
+            out += _link_joints(link)
         return out
 
     def mechanism(self) -> Mechanism:
@@ -257,6 +166,29 @@ class Design:
         return np.column_stack(cols)
 
 
+def _link_displacements(link: BinaryLink, ga: Array, gb: Array) -> dict[str, Array]:
+    """``(p, 3)`` displacements of a link's bodies (the slider ``<name>``, the dyad ``<name>``, or the actuator's
+    cylinder ``<name>c`` and rod ``<name>r``) when its anchor moves by ``ga`` and its body by ``gb``."""
+    p = len(ga)
+    # the moving pivot and fixed pivot as seen from the anchor (profile-1 coordinates)
+    m = track(relative(ga, gb), link.circle)
+    d = m - link.centre
+    if link.kind == "PR":
+        assert link.direction is not None
+        travel = (m - m[0]) @ link.direction
+        slide = np.column_stack([np.outer(travel, link.direction), np.zeros(p)])
+        return {link.name: _compose(ga, slide)}
+    phi = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    rot = np.array([ga_pose(link.centre, a) for a in phi - phi[0]])
+    if link.kind == "RR":
+        return {link.name: _compose(ga, rot)}
+    dist = np.linalg.norm(d, axis=1)
+    u0 = d[0] / dist[0]
+    slide = np.column_stack([np.outer(dist - dist[0], u0), np.zeros(p)])
+    rod = np.array([_then(r, s) for r, s in zip(rot, slide, strict=True)])
+    return {f"{link.name}c": _compose(ga, rot), f"{link.name}r": _compose(ga, rod)}
+
+
 def ga_pose(centre: Array, angle: float) -> Array:
     """Displacement ``(x, y, angle)`` of a rotation by ``angle`` about ``centre``."""
     c, s = math.cos(angle), math.sin(angle)
@@ -264,10 +196,46 @@ def ga_pose(centre: Array, angle: float) -> Array:
     return np.array([t[0], t[1], angle])
 
 
+#: The axis of every revolute joint of a planar mechanism.
+_AXIS = [0.0, 0.0, 1.0]
+
+
+def _joint(
+    name: str, kind: str, bodies: Sequence[str], point: list[float], direction: list[float]
+) -> dict[str, object]:
+    """One joint entry of :meth:`Design.joint_specs`."""
+    return {"name": name, "type": kind, "bodies": list(bodies), "point": point, "direction": list(direction)}
+
+
+def _link_joints(link: BinaryLink) -> list[dict[str, object]]:
+    """The joints of a binary link, anchor side first: a slider's guide ``<name>s`` and pivot ``<name>m``, an RR
+    dyad's pivots ``<name>a`` and ``<name>m``, an actuator's pivot ``<name>a``, stroke ``<name>s`` (cylinder
+    ``<name>c`` to rod ``<name>r``) and pivot ``<name>m``."""
+    c, m = [float(v) for v in link.centre], [float(v) for v in link.circle]
+    n = link.name
+    if link.kind == "PR":
+        assert link.direction is not None
+        guide = [float(v) for v in link.direction]
+        return [
+            _joint(f"{n}s", "P", [link.anchor, n], c, guide),
+            _joint(f"{n}m", "R", [n, link.body], m, _AXIS),
+        ]
+    if link.kind == "RR":
+        return [
+            _joint(f"{n}a", "R", [link.anchor, n], c, _AXIS),
+            _joint(f"{n}m", "R", [n, link.body], m, _AXIS),
+        ]
+    u = (link.circle - link.centre) / link.length
+    cyl, rod = f"{n}c", f"{n}r"
+    return [
+        _joint(f"{n}a", "R", [link.anchor, cyl], c, _AXIS),
+        _joint(f"{n}s", "P", [cyl, rod], c, [float(u[0]), float(u[1])]),
+        _joint(f"{n}m", "R", [rod, link.body], m, _AXIS),
+    ]
+
+
 def _then(first: Array, second: Array) -> Array:
     """``first`` composed with ``second`` (``second`` applied first, both displacements)."""
-    from linkwork.mechanization.chain import pose_matrix, pose_of
-
     return pose_of(pose_matrix(first) @ pose_matrix(second))
 
 

@@ -72,6 +72,10 @@ class ChainJoint:
     values: Array
     role: str
 
+    def other(self, body: str) -> str:
+        """The joint's body that is not ``body`` (one of its two)."""
+        return self.bodies[1] if self.bodies[0] == body else self.bodies[0]
+
 
 @dataclass(frozen=True)
 class ChainSegment:
@@ -123,6 +127,12 @@ class ShapeChain:
             if b.name == name:
                 return b
         raise KeyError(name)
+
+    def motion(self, name: str) -> Array:
+        """``(p, 3)`` displacements of body ``name`` on every profile (all zero for ``"ground"``)."""
+        if name == "ground":
+            return np.zeros((self.count, 3))
+        return self.body(name).displacements
 
     def mobility(self) -> int:
         """Degrees of freedom of the chain alone (Grubler, planar: 3 per body, -2 per joint)."""
@@ -179,8 +189,173 @@ def _frame(origin: Array, towards: Array) -> Array:
     return np.array([origin[0], origin[1], math.atan2(d[1], d[0])])
 
 
+def track(displacements: Array, point: ArrayLike) -> Array:
+    """``(p, 2)`` the positions of a body point (profile-1 coordinates) under the body's ``(p, 3)``
+    displacements, pose by pose with :func:`~linkwork.geometry.se2.apply`
+    (:func:`linkwork.mechanization.guidance.positions` is the vectorised form, equal to rounding)."""
+    return np.array([apply(g, point) for g in displacements])
+
+
+def turned(displacement: Array, direction: ArrayLike) -> Array:
+    """A direction of a body (profile-1 coordinates) turned by the body's displacement ``(x, y, angle)``."""
+    return apply(np.array([0.0, 0.0, displacement[2]]), direction)
+
+
+def track_direction(displacements: Array, direction: ArrayLike) -> Array:
+    """``(p, 2)`` a direction of a body (profile-1 coordinates) as it turns with the body's ``(p, 3)``
+    displacements."""
+    return np.array([turned(g, direction) for g in displacements])
+
+
+@dataclass(frozen=True)
+class _Pieces:
+    """The joined (or compound) profiles cut into the segments' pieces: ``starts`` and ``counts`` ``(q, p)`` are
+    every segment's first point and number of pieces on every profile (the segment matrix)."""
+
+    profiles: tuple[JoinedProfile, ...]
+    starts: NDArray[np.int64]
+    counts: NDArray[np.int64]
+
+    def piece(self, e: int, j: int) -> Array:
+        """The points of segment ``e`` on profile ``j``."""
+        a = int(self.starts[e, j])
+        return self.profiles[j].points[a : a + int(self.counts[e, j]) + 1]
+
+
+@dataclass(frozen=True)
+class _Part:
+    """A segment's rigid part before merged joints weld parts into bodies: its frame on every profile."""
+
+    name: str
+    frames: Array
+    outline: Array
+
+    def displacements(self) -> Array:
+        """``(p, 3)`` from profile 1 to every profile: ``frame_j * frame_1^-1``."""
+        first = np.linalg.inv(pose_matrix(self.frames[0]))
+        return np.array([pose_of(pose_matrix(f) @ first) for f in self.frames])
+
+
+def _parts(design: str, pieces: _Pieces) -> tuple[list[_Part], list[tuple[str, str]]]:
+    """Every segment's parts (one for an M-segment, first and last piece for a C-segment), and each segment's
+    ``(first part, last part)``."""
+    p = len(pieces.profiles)
+    parts: list[_Part] = []
+    seg_parts: list[tuple[str, str]] = []
+    for e, kind in enumerate(design):
+        pts0 = pieces.piece(e, 0)
+        if kind == "M":
+            frames = np.array([_frame(pieces.piece(e, j)[0], pieces.piece(e, j)[-1]) for j in range(p)])
+            parts.append(_Part(f"s{e + 1}", frames, pts0))
+            seg_parts.append((f"s{e + 1}", f"s{e + 1}"))
+        else:
+            half = len(pts0) // 2
+            fa = np.array([_frame(pieces.piece(e, j)[0], pieces.piece(e, j)[1]) for j in range(p)])
+            fb = np.array([_frame(pieces.piece(e, j)[-2], pieces.piece(e, j)[-1]) for j in range(p)])
+            parts.append(_Part(f"s{e + 1}a", fa, pts0[: half + 1]))
+            parts.append(_Part(f"s{e + 1}b", fb, pts0[half:]))
+            seg_parts.append((f"s{e + 1}a", f"s{e + 1}b"))
+    return parts, seg_parts
+
+
+def _owners(parts: list[_Part], seg_parts: list[tuple[str, str]], merged: set[int]) -> dict[str, str]:
+    """The body owning every part: a merged joint ``i`` welds the last part of segment ``i`` to the first of
+    segment ``i + 1`` (``s2b+s3a``)."""
+    owner = {part.name: part.name for part in parts}
+    for i in sorted(merged):
+        ra, rb = owner[seg_parts[i][1]], owner[seg_parts[i + 1][0]]
+        new = f"{ra}+{rb}"
+        for k, v in list(owner.items()):
+            if v in (ra, rb):
+                owner[k] = new
+    return owner
+
+
+def _bodies(parts: list[_Part], owner: dict[str, str], size: float) -> dict[str, ChainBody]:
+    """The chain's bodies from the welded parts, checking that welded parts move as one.
+
+    Raises
+    ------
+    LinkworkError
+        When a merged joint does not hold on every profile.
+    """
+    tol = CONSISTENCY * max(size, 1.0)
+    bodies: dict[str, ChainBody] = {}
+    for part in parts:
+        body, disp = owner[part.name], part.displacements()
+        if body in bodies:
+            d0 = bodies[body].displacements
+            if (
+                np.max(np.abs(d0[:, :2] - disp[:, :2])) > tol
+                or np.max(np.abs(wrap(d0[:, 2] - disp[:, 2]))) > tol
+            ):
+                raise LinkworkError(
+                    f"mechanization: the merged joint welding {body} does not hold on every profile"
+                )
+            bodies[body] = ChainBody(body, d0, np.vstack([bodies[body].outline, part.outline]))
+        else:
+            bodies[body] = ChainBody(body, disp, part.outline)
+    return bodies
+
+
+def _revolute(
+    name: str, pair: tuple[str, str], point: Array, role: str, bodies: dict[str, ChainBody], size: float
+) -> ChainJoint:
+    """The revolute joint between two bodies (or a body and ``"ground"``) at ``point`` (profile 1).
+
+    Raises
+    ------
+    LinkworkError
+        When the point of the two bodies does not stay one point on every profile.
+    """
+    p = len(next(iter(bodies.values())).displacements)
+    da, db = (bodies[b].displacements if b != "ground" else np.zeros((p, 3)) for b in pair)
+    if np.max(np.abs(track(da, point) - track(db, point))) > 1e-6 * max(size, 1.0):
+        raise LinkworkError(f"mechanization: joint {name} does not stay one point on every profile")
+    values = np.unwrap(db[:, 2] - da[:, 2])
+    return ChainJoint(name, "R", pair, np.asarray(point, float), None, values - values[0], role)
+
+
+def _c_segment(
+    result: SynthesisResult,
+    e: int,
+    pair: tuple[str, str],
+    pieces: _Pieces,
+    bodies: dict[str, ChainBody],
+    size: float,
+) -> tuple[ChainSegment, ChainJoint]:
+    """C-segment ``e`` between its first and last body, and its arc slide ``S<e>``: a revolute joint at the
+    centre of the arc's circle, or a prismatic joint along the first piece when the arc is straight."""
+    first, last = pair
+    pts0 = pieces.piece(e, 0)
+    seg = result.segments[e]
+    kappa = float(seg.curvature or 0.0)
+    s_bar = float(seg.piece_length)
+    turn = 2.0 * math.asin(float(np.clip(0.5 * kappa * s_bar, -1.0, 1.0)))
+    m1 = int(pieces.counts[e, 0])
+    head = pts0[1] - pts0[0]
+    head /= np.linalg.norm(head)
+    normal = np.array([-head[1], head[0]])
+    name = f"S{e + 1}"
+    if kappa == 0.0:
+        rel = relative(bodies[first].displacements, bodies[last].displacements)
+        values = rel[:, :2] @ head
+        slide = ChainJoint(name, "P", pair, pts0[0].copy(), head, values - values[0], "slide")
+        centre = pts0[0]
+    else:
+        # circumcentre of the regular polygon: half a chord along the first piece, then inwards
+        centre = pts0[0] + 0.5 * s_bar * head + (0.5 * s_bar / math.tan(0.5 * turn)) * normal
+        slide = _revolute(name, pair, centre, "slide", bodies, size)
+    ref = np.vstack([pts0[0], pts0[1], pts0[-2], pts0[-1], centre, [(m1 - 1) * turn, 0.0]])
+    pieces_e = pieces.counts[e].astype(np.int64)
+    return ChainSegment("C", first, last, ref, kappa, turn, pieces_e), slide
+
+
 def build_chain(result: SynthesisResult) -> ShapeChain:
     """The chain of ``result`` (its compound chain when joints were merged) as bodies and joints.
+
+    Joints come in this order: the arc slides ``S<e>``, the joints ``J<i>`` between segments, then the pins or
+    the closing joint ``J0``.
 
     Raises
     ------
@@ -193,115 +368,36 @@ def build_chain(result: SynthesisResult) -> ShapeChain:
         compound.profiles if compound is not None and merged else result.joined
     )
     design = result.design
-    q, p = len(design), len(profiles)
-    starts = segment_starts(result.segment_matrix)  # (q, p)
-    sm = np.asarray(result.segment_matrix)
+    q = len(design)
+    pieces = _Pieces(profiles, segment_starts(result.segment_matrix), np.asarray(result.segment_matrix))
     targets = tuple(np.asarray(t.points, dtype=float) for t in result.targets)
-    allpts = np.vstack(targets)
-    size = float(np.ptp(allpts, axis=0).max()) or 1.0
-
-    def piece(e: int, j: int) -> Array:
-        a = int(starts[e, j])
-        return profiles[j].points[a : a + int(sm[e, j]) + 1]
-
-    # frames of every part on every profile; a part's displacement is frame_j * frame_1^-1
-    parts: list[tuple[str, Array, Array]] = []  # (name, (p, 3) frames, outline on profile 1)
-    seg_parts: list[tuple[str, str]] = []
-    for e, kind in enumerate(design):
-        if kind == "M":
-            frames = np.array([_frame(piece(e, j)[0], piece(e, j)[-1]) for j in range(p)])
-            parts.append((f"s{e + 1}", frames, piece(e, 0)))
-            seg_parts.append((f"s{e + 1}", f"s{e + 1}"))
-        else:
-            pts0 = piece(e, 0)
-            half = len(pts0) // 2
-            fa = np.array([_frame(piece(e, j)[0], piece(e, j)[1]) for j in range(p)])
-            fb = np.array([_frame(piece(e, j)[-2], piece(e, j)[-1]) for j in range(p)])
-            parts.append((f"s{e + 1}a", fa, pts0[: half + 1]))
-            parts.append((f"s{e + 1}b", fb, pts0[half:]))
-            seg_parts.append((f"s{e + 1}a", f"s{e + 1}b"))
-    disp = {
-        name: np.array([pose_of(pose_matrix(f[j]) @ np.linalg.inv(pose_matrix(f[0]))) for j in range(p)])
-        for name, f, _ in parts
-    }
-    outline = {name: o for name, _, o in parts}
-    # welds of merged joints: union the last part of segment i with the first part of segment i + 1
-    owner = {name: name for name, _, _ in parts}
-    for i in sorted(merged):
-        a, b = seg_parts[i][1], seg_parts[i + 1][0]
-        ra, rb = owner[a], owner[b]
-        new = f"{ra}+{rb}"
-        for k, v in list(owner.items()):
-            if v in (ra, rb):
-                owner[k] = new
-    tol = CONSISTENCY * max(size, 1.0)
-    bodies: dict[str, ChainBody] = {}
-    for name, _, _ in parts:
-        body = owner[name]
-        if body in bodies:
-            d0, d1 = bodies[body].displacements, disp[name]
-            if np.max(np.abs(d0[:, :2] - d1[:, :2])) > tol or np.max(np.abs(wrap(d0[:, 2] - d1[:, 2]))) > tol:
-                raise LinkworkError(
-                    f"mechanization: the merged joint welding {body} does not hold on every profile"
-                )
-            bodies[body] = ChainBody(body, d0, np.vstack([bodies[body].outline, outline[name]]))
-        else:
-            bodies[body] = ChainBody(body, disp[name], outline[name])
-
+    size = float(np.ptp(np.vstack(targets), axis=0).max()) or 1.0
+    parts, seg_parts = _parts(design, pieces)
+    owner = _owners(parts, seg_parts, merged)
+    bodies = _bodies(parts, owner, size)
     joints: list[ChainJoint] = []
-
-    def add_r(name: str, a: str, b: str, point: Array, role: str) -> None:
-        da = bodies[a].displacements if a != "ground" else np.zeros((p, 3))
-        db = bodies[b].displacements if b != "ground" else np.zeros((p, 3))
-        pa, pb = np.array([apply(x, point) for x in da]), np.array([apply(x, point) for x in db])
-        if np.max(np.abs(pa - pb)) > 1e-6 * max(size, 1.0):
-            raise LinkworkError(f"mechanization: joint {name} does not stay one point on every profile")
-        values = np.unwrap(db[:, 2] - da[:, 2])
-        joints.append(ChainJoint(name, "R", (a, b), np.asarray(point, float), None, values - values[0], role))
-
     segs: list[ChainSegment] = []
     for e, kind in enumerate(design):
-        first, last = owner[seg_parts[e][0]], owner[seg_parts[e][1]]
-        pts0 = piece(e, 0)
-        pieces = sm[e].astype(np.int64)
+        pair = (owner[seg_parts[e][0]], owner[seg_parts[e][1]])
         if kind == "M":
-            segs.append(ChainSegment("M", first, last, pts0, 0.0, 0.0, pieces))
-            continue
-        seg = result.segments[e]
-        kappa = float(seg.curvature or 0.0)
-        s_bar = float(seg.piece_length)
-        turn = 2.0 * math.asin(float(np.clip(0.5 * kappa * s_bar, -1.0, 1.0)))
-        m1 = int(sm[e, 0])
-        head = pts0[1] - pts0[0]
-        head /= np.linalg.norm(head)
-        normal = np.array([-head[1], head[0]])
-        name = f"S{e + 1}"
-        if kappa == 0.0:
-            da, db = bodies[first].displacements, bodies[last].displacements
-            rel = relative(da, db)
-            values = rel[:, :2] @ head
-            joints.append(
-                ChainJoint(name, "P", (first, last), pts0[0].copy(), head, values - values[0], "slide")
+            segs.append(
+                ChainSegment("M", *pair, pieces.piece(e, 0), 0.0, 0.0, pieces.counts[e].astype(np.int64))
             )
-            centre = pts0[0]
-        else:
-            # circumcentre of the regular polygon: half a chord along the first piece, then inwards
-            centre = pts0[0] + 0.5 * s_bar * head + (0.5 * s_bar / math.tan(0.5 * turn)) * normal
-            add_r(name, first, last, centre, "slide")
-        ref = np.vstack([pts0[0], pts0[1], pts0[-2], pts0[-1], centre, [(m1 - 1) * turn, 0.0]])
-        segs.append(ChainSegment("C", first, last, ref, kappa, turn, pieces))
+            continue
+        seg, slide = _c_segment(result, e, pair, pieces, bodies, size)
+        segs.append(seg)
+        joints.append(slide)
     firsts = [owner[s[0]] for s in seg_parts]
     lasts = [owner[s[1]] for s in seg_parts]
     j0 = profiles[0].joints
     for i in range(q - 1):
         if i not in merged:
-            add_r(f"J{i + 1}", lasts[i], firsts[i + 1], j0[i + 1], "joint")
+            joints.append(_revolute(f"J{i + 1}", (lasts[i], firsts[i + 1]), j0[i + 1], "joint", bodies, size))
     if result.problem.kind == "fixed-end":
-        add_r("J0", "ground", firsts[0], j0[0], "pin")
-        add_r(f"J{q}", lasts[-1], "ground", j0[-1], "pin")
+        joints.append(_revolute("J0", ("ground", firsts[0]), j0[0], "pin", bodies, size))
+        joints.append(_revolute(f"J{q}", (lasts[-1], "ground"), j0[-1], "pin", bodies, size))
     elif result.problem.kind == "closed":
-        add_r("J0", lasts[-1], firsts[0], j0[0], "joint")
-    joined_errors = np.array([float(np.max(prof.errors)) for prof in profiles])
+        joints.append(_revolute("J0", (lasts[-1], firsts[0]), j0[0], "joint", bodies, size))
     return ShapeChain(
         kind=result.problem.kind,
         bodies=tuple(bodies.values()),
@@ -309,5 +405,5 @@ def build_chain(result: SynthesisResult) -> ShapeChain:
         segments=tuple(segs),
         targets=targets,
         size=size,
-        joined_errors=joined_errors,
+        joined_errors=np.array([float(np.max(prof.errors)) for prof in profiles]),
     )

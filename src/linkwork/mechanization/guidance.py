@@ -261,6 +261,35 @@ def _newton2(f: object, g: object, z: Array, scale: float) -> Array:
     return z
 
 
+def _common_zeros(
+    ca: dict[tuple[int, int], float], cb: dict[tuple[int, int], float], origin: Array, scale: float
+) -> list[Array]:
+    """Approximate real common zeros of two cubics (coefficients in the scaled coordinates about ``origin``): the
+    hidden-variable resultant in ``y`` as a generalised eigenvalue problem, then the roots in ``x`` of the first
+    cubic at each real eigenvalue."""
+    mats = _sylvester_pencil(_in_x(ca), _in_x(cb))
+    n = 6
+    eye, zero = np.eye(n), np.zeros((n, n))
+    big_a = np.block([[zero, eye, zero], [zero, zero, eye], [-mats[0], -mats[1], -mats[2]]])
+    big_b = np.block([[eye, zero, zero], [zero, eye, zero], [zero, zero, mats[3]]])
+    ys = scipy.linalg.eigvals(big_a, big_b)
+    candidates: list[Array] = []
+    fx = _in_x(ca)
+    for y in ys:
+        if not np.isfinite(y) or abs(y.imag) > 1e-5 * max(1.0, abs(y)):
+            continue
+        yr = float(y.real)
+        if abs(yr) > 1e3:
+            continue
+        poly = np.array([np.polyval(fx[i], yr) for i in range(3, -1, -1)])
+        roots = np.roots(poly) if np.any(poly) else np.array([])
+        for x in roots:
+            if abs(x.imag) > 1e-4 * max(1.0, abs(x)):
+                continue
+            candidates.append(origin + scale * np.array([float(x.real), yr]))
+    return candidates
+
+
 def burmester_points(poses: ArrayLike, *, tol: float = 1e-8) -> list[Dyad]:
     """The Burmester points of five positions: circle points whose five positions lie on one circle.
 
@@ -283,28 +312,8 @@ def burmester_points(poses: ArrayLike, *, tol: float = 1e-8) -> list[Dyad]:
 
     ca = _cubic_coefficients(fa, origin, scale)
     cb = _cubic_coefficients(fb, origin, scale)
-    mats = _sylvester_pencil(_in_x(ca), _in_x(cb))
-    n = 6
-    eye, zero = np.eye(n), np.zeros((n, n))
-    big_a = np.block([[zero, eye, zero], [zero, zero, eye], [-mats[0], -mats[1], -mats[2]]])
-    big_b = np.block([[eye, zero, zero], [zero, eye, zero], [zero, zero, mats[3]]])
-    ys = scipy.linalg.eigvals(big_a, big_b)
-    candidates: list[Array] = []
-    fx = _in_x(ca)
-    for y in ys:
-        if not np.isfinite(y) or abs(y.imag) > 1e-5 * max(1.0, abs(y)):
-            continue
-        yr = float(y.real)
-        if abs(yr) > 1e3:
-            continue
-        poly = np.array([np.polyval(fx[i], yr) for i in range(3, -1, -1)])
-        roots = np.roots(poly) if np.any(poly) else np.array([])
-        for x in roots:
-            if abs(x.imag) > 1e-4 * max(1.0, abs(x)):
-                continue
-            candidates.append(origin + scale * np.array([float(x.real), yr]))
     found: list[Dyad] = []
-    for z0 in candidates:
+    for z0 in _common_zeros(ca, cb, origin, scale):
         z = _newton2(
             lambda m: compatibility(g, m, (1, 2, 3)), lambda m: compatibility(g, m, (1, 2, 4)), z0, scale
         )

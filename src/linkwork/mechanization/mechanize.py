@@ -16,7 +16,14 @@ import numpy as np
 
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
-from linkwork.mechanization.options import MechanizeOptions, ProgressCallback, options_from_values
+from linkwork.mechanization.options import (
+    ACTUATORS,
+    ANCHORS,
+    BINARY_LINKS,
+    MechanizeOptions,
+    ProgressCallback,
+    options_from_values,
+)
 from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
@@ -80,7 +87,18 @@ class _Search:
     closest: tuple[int, str] | None = None
 
     def out_of_time(self) -> bool:
+        """The search's time limit has passed."""
         return time.perf_counter() - self.started > self.options.time_limit
+
+    def done(self) -> bool:
+        """Enough designs passed, or the time is up."""
+        return self.out_of_time() or len(self.passed) >= self.options.designs
+
+    def unusable(self, line: str) -> None:
+        """Record a plan or design that could not be traced (the closest so far when nothing was traced)."""
+        self.rejected.append(line)
+        if self.closest is None:
+            self.closest = (-1, line)
 
     def traced(self, label: str, design: Design, check: Verification) -> None:
         """Record a verified design (passed or rejected) and report progress."""
@@ -190,12 +208,48 @@ def mechanize(
         When no design passes: the design that came closest (the most profiles reached) and what it violated,
         and how many designs were tried.
     """
+    options = _options(result, options)
+    chain, label = _chain(result, name)
+    # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
+    # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
+    modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
+    order = roots(chain, options)
+    state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
+    for root in order:
+        for mode in modes:
+            if state.done():
+                break
+            opts = replace(options, anchors=mode)
+            try:
+                pl = plan(chain, root, opts)
+            except MechanizationError as exc:
+                state.unusable(f"root {root}, anchors {mode}: {exc}")
+                continue
+            _search(chain, pl, opts, label, state)
+        if state.passed:  # the designs of one root are compared; other roots only when none passed
+            break
+    return _outcome(state)
+
+
+def _options(result: SynthesisResult | ShapeChain, options: MechanizeOptions | None) -> MechanizeOptions:
+    """The options asked for (default: the problem file's mechanization keys), checked."""
     if options is None:
         problem = getattr(result, "problem", None)
         options = (
             options_from_values(problem.mechanize_options) if problem is not None else MechanizeOptions()
         )
     _check(options)
+    return options
+
+
+def _chain(result: SynthesisResult | ShapeChain, name: str | None) -> tuple[ShapeChain, str]:
+    """The chain to mechanize and the mechanism's name.
+
+    Raises
+    ------
+    MechanizationError
+        With fewer than three profiles.
+    """
     if isinstance(result, ShapeChain):
         chain = result
         label = name or "mechanized chain"
@@ -208,26 +262,17 @@ def mechanize(
             f"mechanize: needs at least three profiles, got {chain.count}: rigid-body guidance places each pivot "
             "through three or more positions of a body (Sec. 7)"
         )
-    # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
-    # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
-    modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
-    order = roots(chain, options)
-    state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
-    for root in order:
-        for mode in modes:
-            if state.out_of_time() or len(state.passed) >= state.options.designs:
-                break
-            opts = replace(options, anchors=mode)
-            try:
-                pl = plan(chain, root, opts)
-            except MechanizationError as exc:
-                state.rejected.append(f"root {root}, anchors {mode}: {exc}")
-                if state.closest is None:
-                    state.closest = (-1, f"root {root}, anchors {mode}: {exc}")
-                continue
-            _search(chain, pl, opts, label, state)
-        if state.passed:  # the designs of one root are compared; other roots only when none passed
-            break
+    return chain, label
+
+
+def _outcome(state: _Search) -> Mechanization:
+    """The best passing design with the others ranked.
+
+    Raises
+    ------
+    MechanizationError
+        When none passed: the closest design and what it violated.
+    """
     seconds = time.perf_counter() - state.started
     if state.passed:
         # ties (the same weakest link) keep the order found: rounding keeps that order stable to the last bits
@@ -238,9 +283,10 @@ def mechanize(
         )
     closest = state.closest[1].removeprefix("mechanize: ") if state.closest else "no design"
     timed_out = " (time limit reached)" if state.out_of_time() else ""
+    dof = state.options.dof
     raise MechanizationError(
         f"mechanize: no design passes after {state.attempts} traced{timed_out}"
-        + (f" (DOF {options.dof} asked for)" if options.dof != 1 else "")
+        + (f" (DOF {dof} asked for)" if dof != 1 else "")
         + f"; closest: {closest}"
     )
 
@@ -249,18 +295,13 @@ def _check(options: MechanizeOptions) -> None:
     """Reject options no search can use (the problem reader and the flags check them too)."""
     if options.dof < 1:
         raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
-    if options.actuator not in ("revolute", "prismatic"):
-        raise MechanizationError(
-            f"mechanize: actuator {options.actuator!r}: expected 'revolute' or 'prismatic'"
-        )
-    if options.binary_links not in ("revolute", "prismatic", "both"):
-        raise MechanizationError(
-            f"mechanize: binary_links {options.binary_links!r}: expected 'revolute', 'prismatic' or 'both'"
-        )
-    if options.anchors not in ("ground", "any", "auto"):
-        raise MechanizationError(
-            f"mechanize: anchors {options.anchors!r}: expected 'ground', 'any' or 'auto'"
-        )
+    for key, choices in (("actuator", ACTUATORS), ("binary_links", BINARY_LINKS), ("anchors", ANCHORS)):
+        value = getattr(options, key)
+        if value not in choices:
+            quoted = [f"'{c}'" for c in choices]
+            raise MechanizationError(
+                f"mechanize: {key} {value!r}: expected {', '.join(quoted[:-1])} or {quoted[-1]}"
+            )
 
 
 def _with_transmissions(design: Design, check: Verification) -> Design:
@@ -293,17 +334,15 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
             count += 1
             index[f"D{count}"] = i
     for attempt in range(1, options.attempts + 1):
-        if state.out_of_time() or len(state.passed) >= state.options.designs:
+        if state.done():
             return
         design = _design(chain, pl, root_pair, choice, options, label)
         if options.drive is not None and options.drive not in design.joint_names():
             # a link's joint names depend on the design: this one has no such joint, another may
-            state.rejected.append(
+            state.unusable(
                 f"root {pl.root}, anchors {options.anchors}, design {attempt}: no joint {options.drive!r} "
                 f"(joints are {', '.join(design.joint_names())})"
             )
-            if state.closest is None:
-                state.closest = (-1, state.rejected[-1])
             return
         check = verify(design)
         state.traced(f"root {pl.root}, anchors {options.anchors}, design {attempt}", design, check)

@@ -40,6 +40,11 @@ OPTION_KEYS = (
     "designs",
 )
 
+#: The values ``actuator``, ``anchors`` and ``binary_links`` may take.
+ACTUATORS = ("revolute", "prismatic")
+ANCHORS = ("ground", "any", "auto")
+BINARY_LINKS = ("revolute", "prismatic", "both")
+
 ProgressCallback = Progress
 """The one progress protocol (:class:`linkwork.progress.Progress`): ``progress(done, total)``, designs traced so far
 and the most the search will trace."""
@@ -215,6 +220,17 @@ def _number(value: Any) -> float | None:
     return float(value)
 
 
+def _whole(value: Any, low: int, high: float = math.inf) -> int | None:
+    """``value`` when it is a whole number (not a bool) from ``low`` to ``high``, else ``None``."""
+    return value if isinstance(value, int) and not isinstance(value, bool) and low <= value <= high else None
+
+
+def _one_of(choices: tuple[str, ...]) -> tuple[Callable[[Any], Any], str]:
+    """The check of a value that must be one of ``choices``, and what it expects (``"a", "b" or "c"``)."""
+    quoted = [f'"{c}"' for c in choices]
+    return (lambda v: v if v in choices else None), f"{', '.join(quoted[:-1])} or {quoted[-1]}"
+
+
 def _region(value: Any) -> Any:
     expected = '"inside", a box [xmin, ymin, xmax, ymax] or a polygon [[x, y], ...] of at least 3 vertices'
     if isinstance(value, str):
@@ -236,32 +252,20 @@ def _region(value: Any) -> Any:
 
 
 _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
-    "dof": (
-        lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None,
-        "a whole number >= 1",
-    ),
+    "dof": (lambda v: _whole(v, 1), "a whole number >= 1"),
     "drive": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a joint name"),
     "root": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a body name"),
-    "actuator": (lambda v: v if v in ("revolute", "prismatic") else None, '"revolute" or "prismatic"'),
-    "anchors": (lambda v: v if v in ("ground", "any", "auto") else None, '"ground", "any" or "auto"'),
-    "binary_links": (
-        lambda v: v if v in ("revolute", "prismatic", "both") else None,
-        '"revolute", "prismatic" or "both"',
-    ),
+    "actuator": _one_of(ACTUATORS),
+    "anchors": _one_of(ANCHORS),
+    "binary_links": _one_of(BINARY_LINKS),
     "link_offset": (lambda v: n if (n := _number(v)) is not None and n >= 0 else None, "a number >= 0"),
     "max_link": (lambda v: n if (n := _number(v)) is not None and n > 0 else None, "a positive number"),
     "min_transmission": (
         lambda v: math.radians(n) if (n := _number(v)) is not None and 0 <= n < 90 else None,
         "an angle in degrees, 0 <= min_transmission < 90",
     ),
-    "attempts": (
-        lambda v: v if isinstance(v, int) and not isinstance(v, bool) and v >= 1 else None,
-        "a whole number >= 1",
-    ),
-    "designs": (
-        lambda v: v if isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 20 else None,
-        "a whole number of designs, 1 to 20",
-    ),
+    "attempts": (lambda v: _whole(v, 1), "a whole number >= 1"),
+    "designs": (lambda v: _whole(v, 1, 20), "a whole number of designs, 1 to 20"),
     "time_limit": (
         lambda v: n if (n := _number(v)) is not None and n > 0 else None,
         "a positive number of seconds",

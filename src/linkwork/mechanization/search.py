@@ -25,9 +25,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, MechanizationError
+from linkwork.geometry.se2 import relative
 from linkwork.mechanization import guidance, sliders
 from linkwork.mechanization.assemble import BinaryLink
-from linkwork.mechanization.chain import ShapeChain, apply, relative
+from linkwork.mechanization.chain import ShapeChain, track, track_direction
 from linkwork.mechanization.options import GroundRegion, MechanizeOptions
 
 Array = NDArray[np.float64]
@@ -100,25 +101,40 @@ def _free_directions(chain: ShapeChain, body: str, via: str | None, m: Array) ->
     g = chain.body(body).displacements
     p = chain.count
     if jt.kind == "P":
-        other = jt.bodies[0] if jt.bodies[1] == body else jt.bodies[1]
-        go = chain.body(other).displacements if other != "ground" else np.zeros((p, 3))
+        other = jt.other(body)
         assert jt.direction is not None
-        d = np.array([apply(np.array([0.0, 0.0, x[2]]), jt.direction) for x in go])
+        d = track_direction(chain.motion(other), jt.direction)
         return d / np.linalg.norm(d, axis=1, keepdims=True)
-    pm = np.array([apply(x, m) for x in g])
-    pj = np.array([apply(x, jt.point) for x in g])
-    r = pm - pj
+    r = track(g, m) - track(g, jt.point)
     n = np.linalg.norm(r, axis=1, keepdims=True)
     if np.any(n < 1e-9 * chain.size):
         return np.full((p, 2), np.nan)
     return np.column_stack([-r[:, 1], r[:, 0]]) / n
 
 
-def _quality(link_dir: Array, free: Array | None) -> Array:
-    """Sine of the transmission angle on every profile (signed), 1 when there is no neighbour."""
+def _transmitting(
+    chain: ShapeChain,
+    body: str,
+    via: str | None,
+    m: Array,
+    kind: str,
+    acting: Array,
+    options: MechanizeOptions,
+) -> Array | None:
+    """Signed sine of the transmission angle on every profile of a link with moving pivot ``m`` on ``body``
+    (1 when there is no neighbour ``via``), or ``None`` when the link is dropped: its pivot on the neighbour's
+    joint, a transmission angle below the limit, or a change of assembly mode (:func:`_accepts`).
+
+    ``acting`` ``(p, 2)`` is the direction in the world of an RR link (``kind`` ``"RR"``), or of a slider's guide
+    (``"PR"``), which reacts along its normal (:func:`linkwork.mechanization.sliders.transmission`).
+    """
+    free = _free_directions(chain, body, via, m)
     if free is None:
-        return np.ones(len(link_dir))
-    return np.sum(link_dir * free, axis=1)
+        return np.ones(chain.count)
+    if np.any(~np.isfinite(free)):
+        return None
+    s = np.sum(acting * free, axis=1) if kind == "RR" else sliders.transmission(acting, free)
+    return s if _accepts(s, options) else None
 
 
 def body_candidates(
@@ -131,13 +147,11 @@ def body_candidates(
 ) -> list[Candidate]:
     """Ranked binary links guiding ``body`` relative to each anchor (best first): RR dyads and, as
     ``options.binary_links`` allows, PR sliders."""
-    p = chain.count
     region = options.region_of(chain.targets, chain.size)
     out: list[Candidate] = []
     g_body = chain.body(body).displacements
     for anchor in anchors:
-        g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
-        rel = relative(g_anchor, g_body)
+        rel = relative(chain.motion(anchor), g_body)
         if options.binary_links in ("revolute", "both"):
             pivots = _pivot_candidates(chain, body, rel, options)
             if anchor == "ground":
@@ -149,12 +163,15 @@ def body_candidates(
     return out
 
 
-def _accepts(s: Array | None, options: MechanizeOptions) -> bool:
+def _accepts(s: Array, options: MechanizeOptions) -> bool:
     """Transmission above the limit on every profile, one assembly mode throughout (one sign)."""
-    if s is None:
-        return True
     limit = math.sin(options.min_transmission)
     return not (np.any(np.abs(s) < limit) or not (np.all(s > 0) or np.all(s < 0)))
+
+
+def _smallest_angle(s: Array) -> float:
+    """The smallest transmission angle (radians) of the sines ``s`` on every profile."""
+    return float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
 
 
 def _rr_candidates(
@@ -168,9 +185,7 @@ def _rr_candidates(
     name: str,
 ) -> list[Candidate]:
     """RR dyads from their pivots: long, short, outside the region or badly transmitting ones dropped."""
-    p = chain.count
-    g_body = chain.body(body).displacements
-    g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+    g_body, g_anchor = chain.body(body).displacements, chain.motion(anchor)
     out = []
     for m, dyad in pivots:
         c = dyad.centre_point
@@ -179,17 +194,12 @@ def _rr_candidates(
             continue
         if anchor == "ground" and not bool(region.contains(c)[0]):
             continue
-        world_m = np.array([apply(x, m) for x in g_body])
-        world_c = np.array([apply(x, c) for x in g_anchor])
-        u = world_m - world_c
+        u = track(g_body, m) - track(g_anchor, c)
         u /= np.linalg.norm(u, axis=1, keepdims=True)
-        free = _free_directions(chain, body, via, m)
-        if free is not None and np.any(~np.isfinite(free)):
+        s = _transmitting(chain, body, via, m, "RR", u, options)
+        if s is None:
             continue
-        s = _quality(u, free)
-        if not _accepts(None if free is None else s, options):
-            continue
-        mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+        mu = _smallest_angle(s)
         ratio = abs(math.log(r / (0.5 * chain.size)))
         score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
         link = BinaryLink(name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via)
@@ -209,8 +219,7 @@ def _slider_candidates(
 ) -> list[Candidate]:
     """PR sliders: slider points of the body (exact for three profiles), guides fitted through their positions,
     kept when the slider moves one way, its guide lies in the region (on the ground) and it transmits well."""
-    p = chain.count
-    g_anchor = np.zeros((p, 3)) if anchor == "ground" else chain.body(anchor).displacements
+    g_anchor = chain.motion(anchor)
     grid = _moving_pivots(chain, body, max(3, options.candidates // 2), options.link_offset)
     out = []
     for g in grid:
@@ -222,14 +231,10 @@ def _slider_candidates(
                 ends = start + np.outer([travel[0], travel[-1]], u)
                 if anchor == "ground" and not np.all(region.contains(ends)):
                     continue
-                free = _free_directions(chain, body, via, m)
-                if free is not None and np.any(~np.isfinite(free)):
+                s = _transmitting(chain, body, via, m, "PR", track_direction(g_anchor, u), options)
+                if s is None:
                     continue
-                world_u = np.array([apply(np.array([0.0, 0.0, x[2]]), u) for x in g_anchor])
-                s = sliders.transmission(world_u, free) if free is not None else np.ones(p)
-                if not _accepts(None if free is None else s, options):
-                    continue
-                mu = float(np.arcsin(min(1.0, float(np.min(np.abs(s))))))
+                mu = _smallest_angle(s)
                 score = math.degrees(mu) - 1e3 * error / chain.size
                 link = BinaryLink(name, "PR", anchor, body, start, np.asarray(m, float), error, mu, via, u)
                 out.append(Candidate(link, score, s))
@@ -290,12 +295,7 @@ def _pivots_from_region(
 
 def _adjacent(chain: ShapeChain, body: str) -> list[tuple[str, str]]:
     """``(joint, other body)`` for every chain joint of ``body``."""
-    out = []
-    for j in chain.joints:
-        if body in j.bodies:
-            other = j.bodies[1] if j.bodies[0] == body else j.bodies[0]
-            out.append((j.name, other))
-    return out
+    return [(j.name, j.other(body)) for j in chain.joints if body in j.bodies]
 
 
 def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
@@ -307,7 +307,7 @@ def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
         )
     pinned = [j for j in chain.joints if "ground" in j.bodies]
     if pinned:
-        return [pinned[0].bodies[1] if pinned[0].bodies[0] == "ground" else pinned[0].bodies[0]]
+        return [pinned[0].other("ground")]
     if options.root is not None:
         return [options.root]
     return sorted(
@@ -330,6 +330,27 @@ def plan(chain: ShapeChain, root: str, options: MechanizeOptions) -> Plan:
 
 def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: MechanizeOptions) -> Plan:
     """The plan with ``root`` guided first."""
+    order, paired = _build_up(chain, root)
+    # (dof - 1) bodies at the far end stay without a link: their chain joints are the extra inputs
+    extra = max(0, options.dof - 1)
+    free = tuple(b for b, _ in order[len(order) - extra :]) if extra else ()
+    order = order[: len(order) - extra] if extra else order
+    steps = _steps(chain, root, order, options)
+    pairs: list[tuple[Candidate, Candidate, float]] = []
+    if pinned_root is None:
+        pairs = _root_pairs(chain, root, options)
+        if not pairs:
+            raise MechanizationError(
+                f"mechanize: no four-bar guides the root body {root} through the profiles with its crank turning "
+                f"one way and transmission angles above {math.degrees(options.min_transmission):.0f} deg "
+                "(try another root, a larger ground region or link offset)"
+            )
+    return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
+
+
+def _build_up(chain: ShapeChain, root: str) -> tuple[list[tuple[str, str]], list[str]]:
+    """The bodies in build-up order from ``root`` (breadth first) as ``(body, chain joint reached through)``,
+    and the bodies joined to two placed bodies, which need no link."""
     placed = ["ground", root]
     order: list[tuple[str, str]] = []
     paired: list[str] = []
@@ -347,10 +368,20 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
                 paired.append(other)
                 continue
             order.append((other, joint))
-    # (dof - 1) bodies at the far end stay without a link: their chain joints are the extra inputs
-    extra = max(0, options.dof - 1)
-    free = tuple(b for b, _ in order[len(order) - extra :]) if extra else ()
-    order = order[: len(order) - extra] if extra else order
+    return order, paired
+
+
+def _steps(
+    chain: ShapeChain, root: str, order: list[tuple[str, str]], options: MechanizeOptions
+) -> list[Step]:
+    """Every body's ranked candidates in build-up order; a body no single dyad can guide is placed together
+    with the next body placed from it, which then takes two links.
+
+    Raises
+    ------
+    MechanizationError
+        When a body has no acceptable dyad, nor the body placed from it two.
+    """
     steps = []
     done = ["ground", root]
     deferred: list[str] = []  # bodies no single dyad can guide: a body placed from each takes two
@@ -360,7 +391,7 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
         if options.anchors == "any":
             adjacent = {o for _, o in _adjacent(chain, body)}
             anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
-        parent = next(b for b in joints[via].bodies if b != body)
+        parent = joints[via].other(body)
         if parent in deferred:
             # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)
@@ -387,16 +418,7 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
             f"(transmission angle below {math.degrees(options.min_transmission):.0f} deg or a change of "
             "assembly mode between profiles; try a larger ground region or link offset)"
         )
-    pairs: list[tuple[Candidate, Candidate, float]] = []
-    if pinned_root is None:
-        pairs = _root_pairs(chain, root, options)
-        if not pairs:
-            raise MechanizationError(
-                f"mechanize: no four-bar guides the root body {root} through the profiles with its crank turning "
-                f"one way and transmission angles above {math.degrees(options.min_transmission):.0f} deg "
-                "(try another root, a larger ground region or link offset)"
-            )
-    return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
+    return steps
 
 
 def _root_pairs(
@@ -405,10 +427,9 @@ def _root_pairs(
     """Four-bars guiding the root: pairs of dyads ranked by the smaller transmission angle and link ratio."""
     singles = body_candidates(chain, root, None, ["ground"], options)[:60]
     g = chain.body(root).displacements
-    limit = math.sin(options.min_transmission)
     out = []
     for i, a in enumerate(singles):
-        wa = np.array([apply(x, a.link.circle) for x in g])
+        wa = track(g, a.link.circle)
         if a.link.kind == "RR":
             ca = a.link.centre
             phi = np.unwrap(np.arctan2(wa[:, 1] - ca[1], wa[:, 0] - ca[0]))
@@ -416,7 +437,7 @@ def _root_pairs(
             if not (np.all(dphi > 1e-6) or np.all(dphi < -1e-6)):
                 continue  # the crank must turn one way through the profiles (order); a slider does by choice
         for b in singles[i + 1 :]:
-            wb = np.array([apply(x, b.link.circle) for x in g])
+            wb = track(g, b.link.circle)
             coupler = wb - wa
             n = np.linalg.norm(coupler, axis=1)
             if np.any(n < 0.05 * chain.size):
@@ -424,10 +445,9 @@ def _root_pairs(
             perp = np.column_stack([-coupler[:, 1], coupler[:, 0]]) / n[:, None]
             s_b = np.sum(_pull(b.link, wb) * perp, axis=1)  # transmission at the rocker
             s_a = np.sum(_pull(a.link, wa) * perp, axis=1)  # crank against coupler: away from its dead centre
-            ok = all(np.all(np.abs(s) >= limit) and (np.all(s > 0) or np.all(s < 0)) for s in (s_a, s_b))
-            if not ok:
+            if not (_accepts(s_a, options) and _accepts(s_b, options)):
                 continue
-            mu = math.degrees(float(np.arcsin(min(1.0, float(min(np.abs(s_a).min(), np.abs(s_b).min()))))))
+            mu = math.degrees(_smallest_angle(np.concatenate([s_a, s_b])))
             lengths = [link.length for link in (a.link, b.link) if link.kind == "RR"] + [float(n[0])]
             ratio = max(lengths) / min(lengths)
             out.append((a, b, mu - 10.0 * math.log(ratio)))
@@ -460,7 +480,7 @@ def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) 
     g = chain.body(body).displacements
     best, best_score = None, -math.inf
     for m in _moving_pivots(chain, body, options.candidates, options.link_offset):
-        w = np.array([apply(x, m) for x in g])
+        w = track(g, m)
         travel = np.diff(w, axis=0)
         for c in grid:
             length = np.linalg.norm(w - c, axis=1)

@@ -22,13 +22,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import AssemblyError
+from linkwork.geometry.angles import wrap
+from linkwork.geometry.se2 import apply, pose_of
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.tracer import trace
 from linkwork.mechanization.assemble import Design, spec_text
-from linkwork.mechanization.chain import pose_of, wrap
+from linkwork.mechanization.chain import turned
 
 Array = NDArray[np.float64]
 
@@ -107,6 +109,60 @@ def _difference(mech: Mechanism, a: Array, b: Array, size: float) -> Array:
     return np.abs(d)
 
 
+#: A defect found on the way: ``(defect, reason, culprit)``.
+_Defect = tuple[str, str, str | None]
+
+
+@dataclass(frozen=True)
+class _Checker:
+    """What every check of one design needs: the mechanism as ``linkwork trace`` reads it, every joint's value
+    on every profile (the chain's), the Jacobian's rank and the DOF at profile 1, and the drive's index."""
+
+    design: Design
+    mech: Mechanism
+    ideal: Array
+    rank: int
+    dof: int
+    d: int
+
+    @classmethod
+    def of(cls, design: Design, mech: Mechanism) -> _Checker:
+        """The checker of ``design`` assembled as ``mech``; rank from the Jacobian's singular values."""
+        sigma = np.linalg.svd(jacobian(mech, np.zeros(mech.n_joints)), compute_uv=False)
+        rank = numerical_rank(sigma)
+        d = list(mech.joint_names).index(design.drive)
+        return cls(design, mech, design.ideal_values(), rank, mech.n_unknowns - rank, d)
+
+    def state(self, values: Array, j: int) -> ProfileState:
+        """The mechanism at joint values ``values`` measured against profile ``j``."""
+        chain = self.design.chain
+        disp = chain_displacements(self.design, self.mech, values)
+        e = float(np.max(chain.errors(disp, j)))
+        dev = float(np.max(_difference(self.mech, values, self.ideal[j], chain.size)))
+        return ProfileState(float(values[self.d]), np.asarray(values, dtype=float), e, dev)
+
+    def show(self, value: float) -> str:
+        """A drive value as printed: degrees for a revolute drive, the length for a prismatic one."""
+        return f"{math.degrees(value):.4g} deg" if self.mech.joint_types[self.d] == "R" else f"{value:.4g}"
+
+    def failed(
+        self,
+        defect: str,
+        reason: str,
+        *,
+        states: tuple[ProfileState, ...] = (),
+        max_condition: float = float("nan"),
+        culprit: str | None = None,
+        paths: tuple[Trace, ...] = (),
+        traced: bool = True,
+    ) -> Verification:
+        """A failed verification, with what was found before the defect."""
+        drive = self.design.drive
+        return Verification(
+            False, defect, reason, self.dof, self.rank, drive, states, max_condition, culprit, paths, traced
+        )
+
+
 def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: int = 1500) -> Verification:
     """Check a design: DOF from the Jacobian rank; for one DOF, trace the drive through every profile in order.
 
@@ -129,151 +185,157 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
         # the spec reader's assembly check: the links make the chain rigid but for a hair (a near-singular design)
         reason = str(exc).split(": ", 2)[-1].split("; ")[0]
         return Verification(False, "branch", f"branch defect: {reason}", 0, 0, design.drive)
-    chain = design.chain
-    ideal = design.ideal_values()
-    names = list(mech.joint_names)
-    sigma = np.linalg.svd(jacobian(mech, np.zeros(mech.n_joints)), compute_uv=False)
-    rank = numerical_rank(sigma)
-    dof = mech.n_unknowns - rank
-    drive = design.drive
-    d = names.index(drive)
-    v = ideal[:, d]
-
-    def state(values: Array, j: int) -> ProfileState:
-        disp = chain_displacements(design, mech, values)
-        e = float(np.max(chain.errors(disp, j)))
-        dev = float(np.max(_difference(mech, values, ideal[j], chain.size)))
-        return ProfileState(float(values[d]), np.asarray(values, dtype=float), e, dev)
-
-    if dof != design.dof:
-        return Verification(
-            False,
+    check = _Checker.of(design, mech)
+    if check.dof != design.dof:
+        return check.failed(
             "dof",
-            f"the mechanism has {dof} degrees of freedom (Jacobian rank {rank}), expected {design.dof}",
-            dof,
-            rank,
-            drive,
+            f"the mechanism has {check.dof} degrees of freedom (Jacobian rank {check.rank}), expected {design.dof}",
         )
-    if dof != 1:
-        # the tracer follows one-parameter paths: with several inputs nothing is traced, and the report says so;
-        # what is checked is that every profile's configuration closes the loops with the Jacobian's full rank
-        max_cond = 1.0
-        for j in range(chain.count):
-            residual = float(np.linalg.norm(closure_residual(mech, ideal[j])))
-            if residual > CLOSES * max(chain.size, 1.0):
-                return Verification(
-                    False,
-                    "closure",
-                    f"the configuration of profile {j + 1} does not close the loops (residual {residual:.3g}): "
-                    "least-squares links are only verified by tracing, with one DOF",
-                    dof,
-                    rank,
-                    drive,
-                    traced=False,
-                )
-            spectrum = np.linalg.svd(jacobian(mech, ideal[j]), compute_uv=False)
-            at = numerical_rank(spectrum)
-            if at > 0:
-                max_cond = max(max_cond, float(spectrum[0] / spectrum[at - 1]))
-            if at < rank:
-                return Verification(
-                    False,
-                    "branch",
-                    f"branch defect: the Jacobian loses rank at profile {j + 1} ({at} < {rank})",
-                    dof,
-                    rank,
-                    drive,
-                    traced=False,
-                )
-        fixed = tuple(state(ideal[j], j) for j in range(chain.count))
-        note = (
-            f"not traced: dof {dof} (the tracer follows one-parameter paths; checked: every profile's "
-            "configuration closes the loops with full Jacobian rank)"
-        )
-        return Verification(True, None, note, dof, rank, drive, fixed, max_cond, traced=False)
+    if check.dof != 1:
+        return _untraced(check)
+    return _traced(check, max_step, max_steps)
+
+
+def _untraced(check: _Checker) -> Verification:
+    """Several DOF: the tracer follows one-parameter paths, so nothing is traced, and the report says so; what
+    is checked is that every profile's configuration closes the loops with the Jacobian's full rank."""
+    chain, mech, rank = check.design.chain, check.mech, check.rank
+    max_cond = 1.0
+    for j in range(chain.count):
+        residual = float(np.linalg.norm(closure_residual(mech, check.ideal[j])))
+        if residual > CLOSES * max(chain.size, 1.0):
+            return check.failed(
+                "closure",
+                f"the configuration of profile {j + 1} does not close the loops (residual {residual:.3g}): "
+                "least-squares links are only verified by tracing, with one DOF",
+                traced=False,
+            )
+        spectrum = np.linalg.svd(jacobian(mech, check.ideal[j]), compute_uv=False)
+        at = numerical_rank(spectrum)
+        if at > 0:
+            max_cond = max(max_cond, float(spectrum[0] / spectrum[at - 1]))
+        if at < rank:
+            return check.failed(
+                "branch",
+                f"branch defect: the Jacobian loses rank at profile {j + 1} ({at} < {rank})",
+                traced=False,
+            )
+    fixed = tuple(check.state(check.ideal[j], j) for j in range(chain.count))
+    note = (
+        f"not traced: dof {check.dof} (the tracer follows one-parameter paths; checked: every profile's "
+        "configuration closes the loops with full Jacobian rank)"
+    )
+    return Verification(True, None, note, check.dof, rank, check.design.drive, fixed, max_cond, traced=False)
+
+
+def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
+    """One DOF: the drive must be monotonic over the profiles; trace it from each profile's drive value to the
+    next's, and stop at the first order, branch or circuit defect."""
+    design, mech, d = check.design, check.mech, check.d
+    v = check.ideal[:, d]
     steps = np.diff(v)
     if not (np.all(steps > 0) or np.all(steps < 0)):
         order = ", ".join(f"{x:.4g}" for x in (np.degrees(v) if mech.joint_types[d] == "R" else v))
-        return Verification(
-            False,
+        return check.failed(
             "order",
-            f"order defect: the drive {drive} is not monotonic over the profiles ({order})",
-            dof,
-            rank,
-            drive,
+            f"order defect: the drive {design.drive} is not monotonic over the profiles ({order})",
             culprit="drive",
         )
-    states: list[ProfileState] = [state(np.zeros(mech.n_joints), 0)]
+    states: list[ProfileState] = [check.state(np.zeros(mech.n_joints), 0)]
     paths: list[Trace] = []
     max_cond = 1.0
-
-    def reject(defect: str, reason: str, culprit: str | None) -> Verification:
-        """A failed verification with everything traced so far."""
-        return Verification(
-            False, defect, reason, dof, rank, drive, tuple(states), max_cond, culprit, tuple(paths)
+    for j in range(1, design.chain.count):
+        path = trace(
+            mech,
+            drive=design.drive,
+            until=(design.drive, float(v[j])),
+            max_step=max_step,
+            max_steps=max_steps,
         )
-
-    for j in range(1, chain.count):
-        path = trace(mech, drive=drive, until=(drive, float(v[j])), max_step=max_step, max_steps=max_steps)
         paths.append(path)
-        max_cond = max(max_cond, path.max_condition_raw)  # raw, like the untraced check above
-        where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
-        end = path.branches[0].end_reason
-        if path.bifurcations:
-            b = path.bifurcations[0]
-            return reject(
-                "branch",
-                f"branch defect: a singular configuration (rank {b.rank}) {where}, "
-                f"drive {drive} = {_show(mech, d, b.angles[d])}",
-                _culprit(design, mech, path),
-            )
-        if np.any(path.rank < rank):
-            k = int(np.flatnonzero(path.rank < rank)[0])
-            return reject(
-                "branch",
-                f"branch defect: the Jacobian loses rank {where}, drive {drive} = "
-                f"{_show(mech, d, path.angles[k, d])}",
-                _culprit(design, mech, path),
-            )
-        dv = np.diff(path.angles[:, d])
-        if np.any(dv * np.sign(v[j]) < -1e-12):
-            # a dead centre on the way: the drive turns back (the trace may then wander until its budget)
-            k = int(np.flatnonzero(dv * np.sign(v[j]) < -1e-12)[0])
-            return reject(
-                "order",
-                f"order defect: the drive {drive} turns back {where} at "
-                f"{_show(mech, d, path.angles[k, d])} (a dead centre)"
-                + (f"; the trace then {end}" if end != "reached target" else ""),
-                _culprit(design, mech, path),
-            )
-        if end != "reached target":
-            defect = "order" if "turning" in end else "branch"
-            return reject(
+        max_cond = max(max_cond, path.max_condition_raw)  # raw, like the untraced check
+        st = None
+        found = _path_defect(check, path, j)
+        if found is None:
+            st = check.state(path.angles[-1], j)
+            found = _circuit_defect(check, path, st, j)
+        if found is not None:
+            defect, reason, culprit = found
+            return check.failed(
                 defect,
-                f"{defect} defect: the trace {where} stopped ({end}) before the drive "
-                f"{drive} reached {_show(mech, d, v[j])}",
-                _culprit(design, mech, path),
+                reason,
+                states=tuple(states),
+                max_condition=max_cond,
+                culprit=culprit,
+                paths=tuple(paths),
             )
-        st = state(path.angles[-1], j)
-        structural = max((link.structural_error for link in design.links), default=0.0)
-        if structural <= 1e-9 * chain.size:
-            wrong = st.deviation > SAME_CONFIGURATION
-        else:  # least-squares links: the profile's configuration is not on the mechanism; judge by the shape
-            wrong = st.e_max > chain.joined_errors[j] + 5.0 * structural + 1e-9 * chain.size
-        if wrong:
-            worst = names[int(np.argmax(_difference(mech, path.angles[-1], ideal[j], chain.size)))]
-            return reject(
-                "circuit",
-                f"circuit defect: at the drive value of profile {j + 1} the "
-                f"mechanism is in another assembly mode (joint {worst} differs)",
-                _circuit_culprit(design, mech, path.angles[-1], j),
-            )
+        assert st is not None
         states.append(st)
-    return Verification(True, None, "", dof, rank, drive, tuple(states), max_cond, None, tuple(paths))
+    return Verification(
+        True, None, "", check.dof, check.rank, design.drive, tuple(states), max_cond, None, tuple(paths)
+    )
 
 
-def _show(mech: Mechanism, d: int, value: float) -> str:
-    return f"{math.degrees(value):.4g} deg" if mech.joint_types[d] == "R" else f"{value:.4g}"
+def _path_defect(check: _Checker, path: Trace, j: int) -> _Defect | None:
+    """A branch or order defect on the path from profile ``j`` to ``j + 1`` (0-based ``j - 1`` to ``j``)."""
+    design, d, drive = check.design, check.d, check.design.drive
+    target = float(check.ideal[j, d])
+    where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
+    end = path.branches[0].end_reason
+    if path.bifurcations:
+        b = path.bifurcations[0]
+        return (
+            "branch",
+            f"branch defect: a singular configuration (rank {b.rank}) {where}, drive {drive} = {check.show(b.angles[d])}",
+            _culprit(design, check.mech, path),
+        )
+    if np.any(path.rank < check.rank):
+        k = int(np.flatnonzero(path.rank < check.rank)[0])
+        return (
+            "branch",
+            f"branch defect: the Jacobian loses rank {where}, drive {drive} = {check.show(path.angles[k, d])}",
+            _culprit(design, check.mech, path),
+        )
+    dv = np.diff(path.angles[:, d])
+    if np.any(dv * np.sign(target) < -1e-12):
+        # a dead centre on the way: the drive turns back (the trace may then wander until its budget)
+        k = int(np.flatnonzero(dv * np.sign(target) < -1e-12)[0])
+        return (
+            "order",
+            f"order defect: the drive {drive} turns back {where} at {check.show(path.angles[k, d])} (a dead centre)"
+            + (f"; the trace then {end}" if end != "reached target" else ""),
+            _culprit(design, check.mech, path),
+        )
+    if end != "reached target":
+        defect = "order" if "turning" in end else "branch"
+        return (
+            defect,
+            f"{defect} defect: the trace {where} stopped ({end}) before the drive {drive} reached {check.show(target)}",
+            _culprit(design, check.mech, path),
+        )
+    return None
+
+
+def _circuit_defect(check: _Checker, path: Trace, st: ProfileState, j: int) -> _Defect | None:
+    """A circuit defect at profile ``j``'s drive value: the mechanism in another assembly mode than the chain
+    (least-squares links: judged by the shape, as the profile's configuration is not on the mechanism)."""
+    design, chain = check.design, check.design.chain
+    structural = max((link.structural_error for link in design.links), default=0.0)
+    if structural <= 1e-9 * chain.size:
+        wrong = st.deviation > SAME_CONFIGURATION
+    else:
+        wrong = st.e_max > chain.joined_errors[j] + 5.0 * structural + 1e-9 * chain.size
+    if not wrong:
+        return None
+    worst = check.mech.joint_names[
+        int(np.argmax(_difference(check.mech, path.angles[-1], check.ideal[j], chain.size)))
+    ]
+    return (
+        "circuit",
+        f"circuit defect: at the drive value of profile {j + 1} the mechanism is in another assembly mode "
+        f"(joint {worst} differs)",
+        _circuit_culprit(design, check.mech, path.angles[-1], j),
+    )
 
 
 def _circuit_culprit(design: Design, mech: Mechanism, values: Array, j: int) -> str | None:
@@ -297,8 +359,6 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     The angle at the moving pivot between the link and the line to the point that, with the link, places the
     body: the body's chain joint ``via``, or the other root link's moving pivot.
     """
-    from linkwork.mechanization.chain import apply
-
     disp = chain_displacements(design, mech, values)
     joints = {jt.name: jt for jt in design.chain.joints}
     links = {link.name: link for link in design.links}
@@ -309,7 +369,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
         m = apply(disp[link.body], link.circle)
         if link.kind == "PR":  # the guide reacts along its normal
             assert link.direction is not None
-            d = apply(np.array([0.0, 0.0, disp[link.anchor][2]]), link.direction)
+            d = turned(disp[link.anchor], link.direction)
             u = np.array([-d[1], d[0]])
         else:
             c = apply(disp[link.name], link.centre)
@@ -317,8 +377,8 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
         if link.via in joints:
             jt = joints[link.via]
             if jt.kind == "P":
-                other = jt.bodies[0] if jt.bodies[1] == link.body else jt.bodies[1]
-                d = apply(np.array([0.0, 0.0, disp[other][2]]), jt.direction)  # type: ignore[arg-type]
+                assert jt.direction is not None
+                d = turned(disp[jt.other(link.body)], jt.direction)
                 out[link.name] = abs(float(u @ d))
                 continue
             pj = apply(disp[link.body], jt.point)

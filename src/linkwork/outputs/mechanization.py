@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -131,24 +130,3 @@ def print_mechanization(found: Mechanization) -> None:
     console.print(
         f"verified: no circuit, branch or order defect ({found.attempts} designs traced, {found.seconds:.1f} s)"
     )
-
-
-@contextmanager
-def progress_bar() -> Iterator[ProgressCallback]:
-    """A rich progress bar for a mechanization search, as a ``progress(done, total)`` callback."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    with Progress(
-        TextColumn("[bold]mechanizing[/]"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-    ) as bar:
-        task = bar.add_task("", total=None)
-
-        def update(done: int, total: int | None) -> None:
-            bar.update(task, completed=done, total=None if total is None else max(total, done))
-
-        yield update

@@ -20,6 +20,7 @@ from linkwork.outputs.staging import console, have_matplotlib, staged_output
 if TYPE_CHECKING:
     from rich.table import Table
 
+    from linkwork.synthesis.problem import Problem
     from linkwork.synthesis.result import SynthesisResult
 
 
@@ -93,23 +94,36 @@ def load_synthesis(folder: Path, problem: Path | None = None) -> SynthesisResult
     SpecError
         When ``chain.json`` or the problem file is missing, or the problem no longer gives the same chain.
     """
-    from linkwork.io.problem import load_problem
-    from linkwork.synthesis import synthesize
+    return rerun_synthesis(folder, synthesis_problem(folder, problem))
 
-    chain_file = folder / "chain.json"
-    if not chain_file.is_file():
+
+def synthesis_problem(folder: Path, problem: Path | None = None) -> Problem:
+    """The problem a ``linkwork synth`` output folder came from (``folder/problem/problem.toml`` unless
+    ``problem`` is given), read without running the synthesis; the folder must hold a valid ``chain.json``."""
+    from linkwork.io.problem import load_problem
+
+    if not (folder / "chain.json").is_file():
         raise SpecError(f"{folder}: no chain.json; expected a `linkwork synth` output folder")
+    _read_chain_json(folder / "chain.json")  # a broken chain.json is named before the problem is read
     problem = problem or folder / "problem" / "problem.toml"
     if not problem.is_file():
         raise SpecError(
             f"{folder}: no problem file at {problem}; pass the problem the chain came from with --problem"
         )
+    return load_problem(problem)
+
+
+def rerun_synthesis(folder: Path, spec: Problem) -> SynthesisResult:
+    """Run the (seeded) synthesis of ``spec`` again and check that it gives the chain of ``folder/chain.json``."""
+    from linkwork.synthesis import synthesize
+
+    chain_file = folder / "chain.json"
     design, e_max = _read_chain_json(chain_file)
-    result = synthesize(load_problem(problem))
+    result = synthesize(spec)
     same = design == result.design and math.isclose(e_max, result.joined_e_max, rel_tol=1e-9, abs_tol=1e-12)
     if not same:
         raise SpecError(
-            f"{chain_file}: the chain (design {show(design)}) is not what {problem} gives now "
+            f"{chain_file}: the chain (design {show(design)}) is not what {spec.source} gives now "
             f"(design {result.design}); run `linkwork synth` again"
         )
     return result
@@ -165,6 +179,16 @@ def _matrix_table(title: str, result: SynthesisResult, cells: np.ndarray, fmt: s
 
 def print_synthesis_summary(result: SynthesisResult) -> None:
     """Print the profiles, the design, the segment and error matrices and the compound merges."""
+    _print_profiles_and_design(result)
+    console.print(_matrix_table("Segment matrix (pieces)", result, result.segment_matrix, "d"))
+    console.print(_matrix_table("Error matrix after segmentation", result, result.error_matrix, ".4f"))
+    console.print(_matrix_table("Error matrix after joining", result, result.joined_error_matrix, ".4f"))
+    _print_errors(result)
+    _print_compound(result)
+
+
+def _print_profiles_and_design(result: SynthesisResult) -> None:
+    """The profiles' table, the design vector and how the search found it (with the designs it skipped)."""
     profiles = _table("Profiles")
     for column in ("profile", "arc length C", "pieces m", "target length s", "S / C"):
         profiles.add_column(column, justify="left" if column == "profile" else "right")
@@ -199,9 +223,11 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
         console.print(f"skipped {design}: {reason}", highlight=False, markup=False)
     if len(stats.skipped) > 5:
         console.print(f"... and {len(stats.skipped) - 5} more skipped (see chain.json search.skipped)")
-    console.print(_matrix_table("Segment matrix (pieces)", result, result.segment_matrix, "d"))
-    console.print(_matrix_table("Error matrix after segmentation", result, result.error_matrix, ".4f"))
-    console.print(_matrix_table("Error matrix after joining", result, result.joined_error_matrix, ".4f"))
+
+
+def _print_errors(result: SynthesisResult) -> None:
+    """E_max and E_mean after segmentation, after joining and with compound segments."""
+    compound = result.compound
     errors = _table("Errors")
     for column in ("stage", "E_max", "E_mean"):
         errors.add_column(column, justify="left" if column == "stage" else "right")
@@ -209,10 +235,14 @@ def print_synthesis_summary(result: SynthesisResult) -> None:
     errors.add_row(
         "joined", f"{result.joined_e_max:.4f}", f"{float(np.mean(result.joined_error_matrix)):.4f}"
     )
-    compound = result.compound
     if compound is not None and compound.merged:
         errors.add_row("compound", f"{compound.e_max:.4f}", f"{float(np.mean(compound.error_matrix)):.4f}")
     console.print(errors)
+
+
+def _print_compound(result: SynthesisResult) -> None:
+    """The joints' ranges of motion (Eq. 34) and which were merged into compound segments."""
+    compound = result.compound
     if compound is None:
         console.print("compound segments: off (merge_below = 0)")
         return

@@ -9,6 +9,9 @@ from typing import TYPE_CHECKING, Any
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 
 if TYPE_CHECKING:
+    import numpy as np
+    from rich.table import Table
+
     from linkwork.kinematics.chains import Assembly
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Trace
@@ -82,40 +85,10 @@ def _plain(value: Any) -> Any:
 
 def print_trace_summary(path: Trace) -> None:
     """Print the summary tables of a traced path: branches, rank and mobility, bifurcation points."""
-    import numpy as np
-    from rich.table import Table
-
     from linkwork.io.results import report_dict
 
     rep = report_dict(path)
-    mech = path.mechanism
-    revolute = [t == "R" for t in mech.joint_types]
-
-    def show(values: np.ndarray) -> list[str]:
-        return [f"{np.degrees(v):.4f}" if r else f"{v:.6f}" for v, r in zip(values, revolute, strict=True)]
-
-    def angles_text(values: np.ndarray) -> str:
-        return "  ".join(f"{n}={v}" for n, v in zip(mech.joint_names, show(values), strict=True))
-
-    table = Table(title="branches", title_justify="left")
-    table.add_column("branch", justify="right")
-    table.add_column("from")
-    table.add_column("steps", justify="right")
-    table.add_column("mob.", justify="right")
-    table.add_column("end")
-    table.add_column("joints at the end (deg)", overflow="fold")
-    for br in path.branches:
-        mask = path.of_branch(br.id)
-        origin = "start" if br.parent is None else f"bif {br.bifurcation} on {br.parent}"
-        table.add_row(
-            str(br.id),
-            origin,
-            str(br.steps),
-            str(br.mobility),
-            br.end_reason,
-            angles_text(path.angles[mask][-1]),
-        )
-    console.print(table)
+    console.print(_branch_table(path))
     mob = rep["mobility_along_path"]
     console.print(
         f"rank {rep['rank']} / mobility {rep['mobility']} at the start; mobility along the path "
@@ -134,20 +107,63 @@ def print_trace_summary(path: Trace) -> None:
             f"{fold['drive']} turns back at {fold['value']:.4f}"
         )
     if path.bifurcations:
-        bt = Table(title="bifurcation points", title_justify="left")
-        bt.add_column("id", justify="right")
-        bt.add_column("branch", justify="right")
-        bt.add_column("step", justify="right")
-        bt.add_column("rank", justify="right")
-        bt.add_column("σ_r/σ_1", justify="right")
-        bt.add_column("branches")
-        bt.add_column("joints (deg)", overflow="fold")
-        for b in path.bifurcations:
-            zero = b.sigma[b.rank] / b.sigma[0] if b.rank < len(b.sigma) else 0.0
-            what = f"{len(b.tangents)} ({b.method})"
-            if b.kind == "component":
-                what = f"none: meets a {b.dimension}-dimensional component"
-            bt.add_row(
-                str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}", what, angles_text(b.angles),
-            )  # fmt: skip
-        console.print(bt)
+        console.print(_bifurcation_table(path))
+
+
+def _joints_text(mech: Mechanism, values: np.ndarray) -> str:
+    """``A=12.3456  B=...``: joint values in file units (degrees, or lengths for a prismatic joint)."""
+    import numpy as np
+
+    return "  ".join(
+        f"{name}={np.degrees(v):.4f}" if kind == "R" else f"{name}={v:.6f}"
+        for name, v, kind in zip(mech.joint_names, values, mech.joint_types, strict=True)
+    )
+
+
+def _branch_table(path: Trace) -> Table:
+    """One row per branch: where it starts, its steps, its mobility, why it ended and its joints at the end."""
+    from rich.table import Table
+
+    table = Table(title="branches", title_justify="left")
+    table.add_column("branch", justify="right")
+    table.add_column("from")
+    table.add_column("steps", justify="right")
+    table.add_column("mob.", justify="right")
+    table.add_column("end")
+    table.add_column("joints at the end (deg)", overflow="fold")
+    for br in path.branches:
+        mask = path.of_branch(br.id)
+        origin = "start" if br.parent is None else f"bif {br.bifurcation} on {br.parent}"
+        table.add_row(
+            str(br.id),
+            origin,
+            str(br.steps),
+            str(br.mobility),
+            br.end_reason,
+            _joints_text(path.mechanism, path.angles[mask][-1]),
+        )
+    return table
+
+
+def _bifurcation_table(path: Trace) -> Table:
+    """One row per bifurcation point: where, the rank there, sigma_r / sigma_1 and the branches leaving it."""
+    from rich.table import Table
+
+    bt = Table(title="bifurcation points", title_justify="left")
+    bt.add_column("id", justify="right")
+    bt.add_column("branch", justify="right")
+    bt.add_column("step", justify="right")
+    bt.add_column("rank", justify="right")
+    bt.add_column("σ_r/σ_1", justify="right")
+    bt.add_column("branches")
+    bt.add_column("joints (deg)", overflow="fold")
+    for b in path.bifurcations:
+        zero = b.sigma[b.rank] / b.sigma[0] if b.rank < len(b.sigma) else 0.0
+        what = f"{len(b.tangents)} ({b.method})"
+        if b.kind == "component":
+            what = f"none: meets a {b.dimension}-dimensional component"
+        bt.add_row(
+            str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}", what,
+            _joints_text(path.mechanism, b.angles),
+        )  # fmt: skip
+    return bt
