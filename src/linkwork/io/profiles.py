@@ -1,5 +1,6 @@
 """Design-profile files: read a planar curve from CSV, Selig ``.dat``, SVG or DXF into an ``(N, 2)`` polyline,
-write one back, and write a synthesised chain's outline on every profile as SVG or DXF for CAD.
+and write one back. (A synthesised chain's outline on every profile, as SVG or DXF for CAD, is written by
+:mod:`linkwork.io.outlines`; its functions keep this module's import path too.)
 
 Every reader goes through one registry of formats keyed by file suffix (:data:`FORMATS`) behind
 :func:`load_profile`, and every polyline it returns has passed :func:`check_profile`: at least two finite,
@@ -16,11 +17,10 @@ vertex of the flattened polyline lies on the true curve (to rounding). The check
 
 from __future__ import annotations
 
-import re
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -41,11 +41,10 @@ from linkwork.io.curves import (
     find_self_crossing,
     is_closed,
 )
+from linkwork.io.drawing import LENGTH_UNITS, new_dxf, svg_d, svg_document, svg_path
+from linkwork.io.outlines import final_chain, write_outline_dxf, write_outline_svg
 from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
 from linkwork.io.toml_reader import escape_line
-
-if TYPE_CHECKING:
-    from linkwork.synthesis.result import JoinedProfile, SynthesisResult
 
 __all__ = [
     "COINCIDENT",
@@ -78,18 +77,6 @@ __all__ = [
 ]
 
 _CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier control points
-
-
-#: Length units a problem file may name (``units = "mm"``): DXF ``$INSUNITS`` code, and the SVG unit and factor
-#: that express one such length (SVG has no metre, foot or micrometre).
-LENGTH_UNITS: dict[str, tuple[int, str, float]] = {
-    "mm": (4, "mm", 1.0),
-    "cm": (5, "cm", 1.0),
-    "m": (6, "mm", 1000.0),
-    "um": (13, "mm", 0.001),
-    "in": (1, "in", 1.0),
-    "ft": (2, "in", 12.0),
-}
 
 
 # ---------------------------------------------------------------------------------------------------- CSV
@@ -244,54 +231,7 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 def write_profile_svg(path: str | Path, points: ArrayLike) -> None:
     """Write a profile as an SVG drawing: one path of straight pieces (y up, as :func:`read_profile_svg`)."""
     pts = np.asarray(points, dtype=float)
-    Path(path).write_text(_svg_document([_svg_path(_svg_d(pts), "#1f77b4")], [pts]), encoding="utf-8")
-
-
-def _svg_path(d: str, colour: str, *, dashed: bool = False, label: str | None = None) -> str:
-    dash = ' stroke-dasharray="4 3"' if dashed else ""
-    title = f"<title>{_xml_escape(label)}</title>" if label else ""
-    return (
-        f'<path d="{d}" fill="none" stroke="{colour}" stroke-width="1.5" '
-        f'vector-effect="non-scaling-stroke"{dash}>{title}</path>'
-    )
-
-
-def _svg_document(
-    body: Iterable[str], extents: Sequence[Points], pixels: float = 800.0, units: str | None = None
-) -> str:
-    """An SVG document whose viewBox holds every point of ``extents`` (profile coordinates, y up); with ``units``
-    (a key of :data:`LENGTH_UNITS`) its width and height are the drawing's true size in that unit, else
-    ``pixels`` across."""
-    everything = np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents])
-    lo, hi = everything.min(axis=0), everything.max(axis=0)
-    margin = 0.05 * _size(everything)
-    x0, y0 = lo[0] - margin, -hi[1] - margin
-    width, height = hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin
-    if units is None:
-        scale, unit = pixels / max(width, height), ""
-    else:
-        _code, unit, scale = LENGTH_UNITS[units]
-    lines = [
-        '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{width * scale:.6g}{unit}" '
-        f'height="{height * scale:.6g}{unit}" viewBox="{x0:.12g} {y0:.12g} {width:.12g} {height:.12g}">',
-        *body,
-        "</svg>",
-    ]
-    return "\n".join(lines) + "\n"
-
-
-def _xml_escape(text: str) -> str:
-    """``text`` as XML character data or attribute value: markup characters escaped, characters XML 1.0 does
-    not allow (control characters but tab, line feed and carriage return) replaced by U+FFFD."""
-    text = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]", "\ufffd", text)
-    return (
-        text.replace("&", "&amp;")
-        .replace("<", "&lt;")
-        .replace(">", "&gt;")
-        .replace('"', "&quot;")
-        .replace("'", "&apos;")
-    )
+    Path(path).write_text(svg_document([svg_path(svg_d(pts), "#1f77b4")], [pts]), encoding="utf-8")
 
 
 # ---------------------------------------------------------------------------------------------------- DXF
@@ -350,124 +290,6 @@ def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:
     document = ezdxf.new("R2010")
     document.modelspace().add_lwpolyline(pts[:-1] if closed else pts, format="xy", close=closed)
     document.saveas(str(path))
-
-
-# --------------------------------------------------------------------------------------- chain outlines
-
-
-def final_chain(result: SynthesisResult) -> tuple[JoinedProfile, ...]:
-    """The chain as built, posed on every profile: after merging joints into compound segments when any were
-    merged (Sec. 6 of the paper), else the joined chain (Sec. 5)."""
-    if result.compound is not None and result.compound.merged:
-        return result.compound.profiles
-    return result.joined
-
-
-def new_dxf(units: str | None = None) -> Any:
-    """A new ezdxf document (R2010) whose ``$INSUNITS`` says the drawing's length unit (0, unitless, when
-    ``units`` is ``None``) and whose ``$MEASUREMENT`` is metric or imperial to match."""
-    import ezdxf
-
-    document = ezdxf.new("R2010")
-    code = LENGTH_UNITS[units][0] if units is not None else 0
-    document.header["$INSUNITS"] = code
-    document.header["$MEASUREMENT"] = 0 if units in ("in", "ft") else 1
-    return document
-
-
-def write_outline_svg(path: str | Path, result: SynthesisResult) -> None:
-    """Write the chain's outline on every profile as one SVG drawing (y up, profile coordinates).
-
-    One group per profile (``id`` the profile's name) holds its target profile (dashed), the chain (solid) and
-    its joints and two ends (circles); the chain is the final one (:func:`final_chain`), without the joints
-    merged into compound segments.
-    """
-    chains = final_chain(result)
-    joints = _live_joints(result)
-    extents = [t.points for t in result.targets] + [c.points for c in chains]
-    radius = 0.006 * _size(np.vstack(extents))
-    body = []
-    for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
-        name = target.name or f"profile {j + 1}"
-        colour = _OUTLINE_COLOURS[j % len(_OUTLINE_COLOURS)]
-        body.append(f'<g id="{_xml_escape(name)}">')
-        body.append(_svg_path(_svg_d(target.points), "#7f7f7f", dashed=True, label=f"{name}: target profile"))
-        body.append(_svg_path(_svg_d(chain.points), colour, label=f"{name}: chain {result.design}"))
-        body += [
-            f'<circle cx="{x:.12g}" cy="{-y:.12g}" r="{radius:.6g}" fill="white" stroke="black" '
-            f'stroke-width="1" vector-effect="non-scaling-stroke"/>'
-            for x, y in chain.joints[joints]
-        ]
-        body.append("</g>")
-    units = result.problem.units
-    Path(path).write_text(_svg_document(body, extents, units=units), encoding="utf-8")
-
-
-def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
-    """Write the chain's outline on every profile as one DXF drawing for CAD.
-
-    Per profile ``NAME``: layer ``NAME-target`` holds the target profile, ``NAME-chain`` the chain (an
-    LWPOLYLINE through the chain's points) and ``NAME-joints`` a circle at every joint and at both ends; the
-    chain is the final one (:func:`final_chain`), without the joints merged into compound segments. Lengths are
-    in the problem's ``units`` (``$INSUNITS``).
-    """
-    chains = final_chain(result)
-    joints = _live_joints(result)
-    radius = 0.006 * _size(np.vstack([t.points for t in result.targets]))
-    document = new_dxf(result.problem.units)
-    space = document.modelspace()
-    layers = _dxf_layer_names([t.name or f"profile {j + 1}" for j, t in enumerate(result.targets)])
-    for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
-        name = layers[j]
-        colour = j % 6 + 1  # AutoCAD colour index 1..6
-        for suffix in ("target", "chain", "joints"):
-            document.layers.add(f"{name}-{suffix}", color=8 if suffix == "target" else colour)
-        space.add_lwpolyline(target.points, format="xy", dxfattribs={"layer": f"{name}-target"})
-        space.add_lwpolyline(chain.points, format="xy", dxfattribs={"layer": f"{name}-chain"})
-        for x, y in chain.joints[joints]:
-            space.add_circle((float(x), float(y)), radius, dxfattribs={"layer": f"{name}-joints"})
-    document.saveas(str(path))
-
-
-def _live_joints(result: SynthesisResult) -> list[int]:
-    """Rows of ``JoinedProfile.joints`` that are joints of the final chain: the two ends and every revolute
-    joint not merged into a compound segment."""
-    merged = set(result.compound.merged) if result.compound is not None else set()
-    count = len(result.joined[0].joints)
-    return [k for k in range(count) if k in (0, count - 1) or (k - 1) not in merged]
-
-
-_OUTLINE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b")
-
-
-def _svg_d(points: Points) -> str:
-    return "M " + " L ".join(f"{x:.12g},{-y:.12g}" for x, y in points)
-
-
-def _dxf_layer_name(name: str) -> str:
-    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) and control characters become
-    underscores, leading and trailing spaces go."""
-    cleaned = "".join("_" if ch in _DXF_FORBIDDEN or ord(ch) < 32 or ord(ch) == 127 else ch for ch in name)
-    return cleaned.strip()[:200] or "profile"
-
-
-def _dxf_layer_names(names: Sequence[str]) -> list[str]:
-    """One distinct layer name per profile: DXF layer names ignore case, and :func:`_dxf_layer_name` can map two
-    names onto one, so a repeat gets ``-2``, ``-3``, ... appended."""
-    out: list[str] = []
-    taken: set[str] = set()
-    for name in names:
-        base = candidate = _dxf_layer_name(name)
-        number = 1
-        while candidate.casefold() in taken:
-            number += 1
-            candidate = f"{base}-{number}"
-        taken.add(candidate.casefold())
-        out.append(candidate)
-    return out
-
-
-_DXF_FORBIDDEN = frozenset('<>/\\":;?*|=`')
 
 
 # ------------------------------------------------------------------------------------------- registry

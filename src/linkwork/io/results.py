@@ -13,15 +13,22 @@ from typing import Any
 
 import numpy as np
 
-from linkwork.kinematics.trace_result import Trace
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
 
 
-def _display(path: Trace, values: np.ndarray) -> np.ndarray:
-    """Joint values in file units: degrees for revolute joints, lengths as they are for prismatic ones."""
-    revolute = np.array([t == "R" for t in path.mechanism.joint_types])
+def file_units(mech: Mechanism, values: np.ndarray) -> np.ndarray:
+    """Joint values (radians, any leading shape) in file units: degrees for revolute joints, lengths as they are
+    for prismatic ones; a copy."""
+    revolute = np.array([t == "R" for t in mech.joint_types])
     out = np.array(values, dtype=float, copy=True)
     out[..., revolute] = np.degrees(out[..., revolute])
     return out
+
+
+def _display(path: Trace, values: np.ndarray) -> np.ndarray:
+    """Joint values of ``path``'s mechanism in file units (:func:`file_units`)."""
+    return file_units(path.mechanism, values)
 
 
 def path_rows(path: Trace) -> tuple[list[str], list[list[Any]]]:
@@ -74,11 +81,6 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
     """The content of ``report.json``."""
     mech = path.mechanism
     names = list(mech.joint_names)
-    start_rank = int(path.stats.get("start_rank", path.rank[0]))
-    regular = np.ones(len(path.rank), dtype=bool)
-    for b in path.bifurcations:
-        regular &= np.linalg.norm(path.angles - b.angles, axis=1) > 1e-6
-    ranks = path.rank[regular] if np.any(regular) else path.rank
     cond = path.condition()
     out: dict[str, Any] = {
         "name": mech.name,
@@ -91,13 +93,7 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         "couplings": [[names[j] for j in group] for group in mech.group_members() if len(group) > 1],
         "fixed": [names[j] for j in np.flatnonzero(mech.groups < 0)],
         "equations": mech.n_equations,
-        "rank": start_rank,
-        "mobility": mech.n_unknowns - start_rank,
-        "rank_along_path": {"min": int(ranks.min()), "max": int(ranks.max())},
-        "mobility_along_path": {
-            "min": int(mech.n_unknowns - ranks.max()),
-            "max": int(mech.n_unknowns - ranks.min()),
-        },
+        **_rank_entries(path),
         "points": len(path.branch),
         "max_residual": float(path.residual.max()),
         "closure_tol": float(path.stats.get("closure_tol", 1e-12)),
@@ -107,63 +103,96 @@ def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
         "max_condition": path.max_condition,
         "max_condition_raw": path.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
-        "bifurcations": [
-            {
-                "id": b.id,
-                "branch": b.branch,
-                "step": b.step,
-                "angles": dict(zip(names, map(float, _display(path, b.angles)), strict=True)),
-                "rank": b.rank,
-                "singular_values": [float(x) for x in b.sigma],
-                "tangents": [[float(x) for x in t] for t in b.tangents],
-                "method": b.method,
-                "residual": b.residual,
-                "accuracy": b.bracket,
-                "kind": b.kind,
-                "dimension": b.dimension,
-            }
-            for b in path.bifurcations
-        ],
-        "folds": [
-            {
-                "branch": f.branch,
-                "step": f.step,
-                "drive": path.drive,
-                "value": float(_display(path, f.angles)[mech.index(path.drive)]),
-                "angles": dict(zip(names, map(float, _display(path, f.angles)), strict=True)),
-            }
-            for f in path.folds
-        ],
-        "branches": [
-            {
-                "id": br.id,
-                "parent": br.parent,
-                "bifurcation": br.bifurcation,
-                "direction": br.direction,
-                "steps": br.steps,
-                "end_reason": br.end_reason,
-                "mobility": br.mobility,
-                "range": branch_range(path, br.id),
-                "start": dict(
-                    zip(names, map(float, _display(path, path.angles[path.branch == br.id][0])), strict=True)
-                ),
-                "end": dict(
-                    zip(names, map(float, _display(path, path.angles[path.branch == br.id][-1])), strict=True)
-                ),
-            }
-            for br in path.branches
-        ],
+        "bifurcations": [_bifurcation_entry(path, b) for b in path.bifurcations],
+        "folds": [_fold_entry(path, f) for f in path.folds],
+        "branches": [_branch_entry(path, br) for br in path.branches],
         "seconds": path.stats.get("seconds"),
     }
     if assembly is not None:
-        out["assembly"] = {
-            "residual_before": float(assembly.residual_before),
-            "residual_after": float(assembly.residual_after),
-            "misfit": float(getattr(assembly, "misfit", assembly.residual_after)),
-            "closure_tol": float(getattr(assembly, "closure_tol", 1e-12)),
-            "correction_deg": dict(zip(names, map(float, np.degrees(assembly.correction)), strict=True)),
-        }
+        out["assembly"] = _assembly_entry(assembly, names)
     return out
+
+
+def _rank_entries(path: Trace) -> dict[str, Any]:
+    """``rank`` and ``mobility`` at the start, and their ranges along the path away from the bifurcation points
+    (where the rank drops by definition)."""
+    mech = path.mechanism
+    start_rank = int(path.stats.get("start_rank", path.rank[0]))
+    regular = np.ones(len(path.rank), dtype=bool)
+    for b in path.bifurcations:
+        regular &= np.linalg.norm(path.angles - b.angles, axis=1) > 1e-6
+    ranks = path.rank[regular] if np.any(regular) else path.rank
+    return {
+        "rank": start_rank,
+        "mobility": mech.n_unknowns - start_rank,
+        "rank_along_path": {"min": int(ranks.min()), "max": int(ranks.max())},
+        "mobility_along_path": {
+            "min": int(mech.n_unknowns - ranks.max()),
+            "max": int(mech.n_unknowns - ranks.min()),
+        },
+    }
+
+
+def _named(path: Trace, angles: np.ndarray) -> dict[str, float]:
+    """One configuration as ``{joint: value}`` in file units."""
+    return dict(zip(path.mechanism.joint_names, map(float, _display(path, angles)), strict=True))
+
+
+def _bifurcation_entry(path: Trace, b: Bifurcation) -> dict[str, Any]:
+    """One entry of ``bifurcations``."""
+    return {
+        "id": b.id,
+        "branch": b.branch,
+        "step": b.step,
+        "angles": _named(path, b.angles),
+        "rank": b.rank,
+        "singular_values": [float(x) for x in b.sigma],
+        "tangents": [[float(x) for x in t] for t in b.tangents],
+        "method": b.method,
+        "residual": b.residual,
+        "accuracy": b.bracket,
+        "kind": b.kind,
+        "dimension": b.dimension,
+    }
+
+
+def _fold_entry(path: Trace, f: Fold) -> dict[str, Any]:
+    """One entry of ``folds``: where the drive turns back, and its value there."""
+    return {
+        "branch": f.branch,
+        "step": f.step,
+        "drive": path.drive,
+        "value": float(_display(path, f.angles)[path.mechanism.index(path.drive)]),
+        "angles": _named(path, f.angles),
+    }
+
+
+def _branch_entry(path: Trace, br: Branch) -> dict[str, Any]:
+    """One entry of ``branches``: how it was found and ended, its range, first and last configurations."""
+    on_branch = path.angles[path.branch == br.id]
+    return {
+        "id": br.id,
+        "parent": br.parent,
+        "bifurcation": br.bifurcation,
+        "direction": br.direction,
+        "steps": br.steps,
+        "end_reason": br.end_reason,
+        "mobility": br.mobility,
+        "range": branch_range(path, br.id),
+        "start": _named(path, on_branch[0]),
+        "end": _named(path, on_branch[-1]),
+    }
+
+
+def _assembly_entry(assembly: Any, names: list[str]) -> dict[str, Any]:
+    """``assembly``: how a ``dh`` or ``rods`` start was closed onto its loop."""
+    return {
+        "residual_before": float(assembly.residual_before),
+        "residual_after": float(assembly.residual_after),
+        "misfit": float(getattr(assembly, "misfit", assembly.residual_after)),
+        "closure_tol": float(getattr(assembly, "closure_tol", 1e-12)),
+        "correction_deg": dict(zip(names, map(float, np.degrees(assembly.correction)), strict=True)),
+    }
 
 
 def write_report_json(path: Trace, file: Path, assembly: Any | None = None) -> None:

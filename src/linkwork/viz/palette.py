@@ -14,3 +14,8 @@ TAB10 = (
 def colour(index: int) -> str:
     """The palette's colour for item ``index`` (cycling)."""
     return TAB10[index % len(TAB10)]
+
+
+PROFILE_COLORS = tuple(TAB10[i] for i in (0, 3, 2, 1, 4, 5, 6, 9))
+"""The colours of target profiles 1, 2, 3, ... in the synthesis figures: eight of the tab10 colours, in the order
+those figures use (blue, red, green, orange, purple, brown, pink, cyan)."""

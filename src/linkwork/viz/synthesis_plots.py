@@ -23,8 +23,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.synthesis.result import JoinedProfile, SynthesisResult
+from linkwork.synthesis.result import JoinedProfile, Segment, SynthesisResult
 from linkwork.viz.labels import plain
+from linkwork.viz.palette import PROFILE_COLORS
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -40,8 +41,8 @@ DPI = 100
 
 
 def _colour(j: int) -> str:
-    palette = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
-    return palette[j % len(palette)]
+    """Profile ``j``'s colour (:data:`linkwork.viz.palette.PROFILE_COLORS`, cycling)."""
+    return PROFILE_COLORS[j % len(PROFILE_COLORS)]
 
 
 def _name(result: SynthesisResult, j: int) -> str:
@@ -113,6 +114,35 @@ def _draw_chain(
         ax.plot(*interior[list(merged)].T, "x", color="black", markersize=4, zorder=5)
 
 
+def _segment_figure(
+    result: SynthesisResult, index: int, kind: str, panels: int
+) -> tuple[Segment, list[Array], Figure, Any]:
+    """Segment ``index``, checked to be of ``kind`` (``ValueError`` if not), its piece of every target profile,
+    and a figure of ``panels`` axes framed on the pieces and the segment's instances."""
+    segment = result.segments[index]
+    if segment.kind != kind:
+        article = "an" if kind == "M" else "a"
+        raise ValueError(
+            f"Expected {article} {kind}-segment, segment {index + 1} is a {segment.kind}-segment"
+        )
+    pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
+    figure, axes = _figure(panels, _extent(pieces + list(segment.instances)), unit=length_unit(result))
+    return segment, pieces, figure, axes
+
+
+def _draw_fit(ax: Axes, piece: Array, instance: Array, j: int, piece_label: str | None, label: str) -> None:
+    """Profile ``j``'s target points (dots) and the segment placed on them (a line)."""
+    ax.plot(*piece.T, ".", color=_colour(j), markersize=3, label=piece_label)
+    ax.plot(*instance.T, "-", color=_colour(j), linewidth=1.5, label=label)
+
+
+def _titles_and_legends(axes: Any, *titles: str) -> None:
+    """Each panel's title (one per axes, in order), then its legend."""
+    for ax, title in zip(axes, titles, strict=True):
+        ax.set_title(title, fontsize="medium")
+        _legend(ax)
+
+
 def _draw_targets(ax: Axes, result: SynthesisResult, *, label: bool = True) -> None:
     for j, target in enumerate(result.targets):
         ax.plot(
@@ -175,13 +205,9 @@ def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
     """
     from linkwork.geometry.fit import register
 
-    segment = result.segments[index]
-    if segment.kind != "M":
-        raise ValueError(f"Expected an M-segment, segment {index + 1} is a {segment.kind}-segment")
-    pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
+    segment, pieces, figure, axes = _segment_figure(result, index, "M", 4)
     moved = [pieces[0]] + [register(piece, pieces[0]).apply(piece) for piece in pieces[1:]]
     mean = np.mean(moved, axis=0)
-    figure, axes = _figure(4, _extent(pieces + list(segment.instances)), unit=length_unit(result))
     panels = (
         "(a) pieces on the target profiles",
         "(b) registered onto profile 1",
@@ -192,18 +218,10 @@ def plot_mean_segment(result: SynthesisResult, index: int) -> Figure:
         axes[0].plot(*piece.T, ".-", color=_colour(j), linewidth=1.0, markersize=3, label=_name(result, j))
         axes[1].plot(*moved[j].T, ".-", color=_colour(j), linewidth=1.0, markersize=3, label=_name(result, j))
         axes[2].plot(*moved[j].T, "-", color=_colour(j), linewidth=0.6, alpha=0.5)
-        axes[3].plot(*piece.T, ".", color=_colour(j), markersize=3, label=f"{_name(result, j)} target")
-        axes[3].plot(
-            *segment.instances[j].T,
-            "-",
-            color=_colour(j),
-            linewidth=1.5,
-            label=f"mean on {_name(result, j)}: E = {segment.errors[j]:.3g}",
-        )
+        fitted = f"mean on {_name(result, j)}: E = {segment.errors[j]:.3g}"
+        _draw_fit(axes[3], piece, segment.instances[j], j, f"{_name(result, j)} target", fitted)
     axes[2].plot(*mean.T, "k.-", linewidth=1.5, markersize=3, label="mean segment")
-    for ax, title in zip(axes, panels, strict=True):
-        ax.set_title(title, fontsize="medium")
-        _legend(ax)
+    _titles_and_legends(axes, *panels)
     figure.suptitle(f"M-segment {index + 1}: {int(segment.pieces[0])} pieces on every profile")
     return figure
 
@@ -217,11 +235,7 @@ def plot_arc_segment(result: SynthesisResult, index: int) -> Figure:
     ValueError
         If segment ``index`` is not a C-segment.
     """
-    segment = result.segments[index]
-    if segment.kind != "C":
-        raise ValueError(f"Expected a C-segment, segment {index + 1} is a {segment.kind}-segment")
-    pieces = [_segment_piece(result, index, j) for j in range(len(result.targets))]
-    figure, axes = _figure(2, _extent(pieces + list(segment.instances)), unit=length_unit(result))
+    segment, pieces, figure, axes = _segment_figure(result, index, "C", 2)
     lengths = segment.lengths
     for j, piece in enumerate(pieces):
         axes[0].plot(
@@ -232,20 +246,11 @@ def plot_arc_segment(result: SynthesisResult, index: int) -> Figure:
             markersize=3,
             label=f"{_name(result, j)}: {int(segment.pieces[j])} pieces",
         )
-        axes[1].plot(*piece.T, ".", color=_colour(j), markersize=3)
-        axes[1].plot(
-            *segment.instances[j].T,
-            "-",
-            color=_colour(j),
-            linewidth=1.5,
-            label=f"L = {lengths[j]:.3g}, E = {segment.errors[j]:.3g}",
-        )
+        fitted = f"L = {lengths[j]:.3g}, E = {segment.errors[j]:.3g}"
+        _draw_fit(axes[1], piece, segment.instances[j], j, None, fitted)
     radius = segment.radius
     shown = "straight (r = inf)" if radius is None or math.isinf(radius) else f"r = {radius:.4g}"
-    axes[0].set_title("(a) pieces on the target profiles", fontsize="medium")
-    axes[1].set_title(f"(b) arcs of one radius, {shown}", fontsize="medium")
-    for ax in axes:
-        _legend(ax)
+    _titles_and_legends(axes, "(a) pieces on the target profiles", f"(b) arcs of one radius, {shown}")
     figure.suptitle(f"C-segment {index + 1}: mean piece length {segment.piece_length:.4g}")
     return figure
 
@@ -268,16 +273,12 @@ def plot_chain(result: SynthesisResult) -> Figure:
             axes[0].plot(*instance[[0, -1]].T, "|", color="black", markersize=7)
     for j, chain in enumerate(result.joined):
         _draw_chain(axes[1], chain, _colour(j), f"chain on {_name(result, j)}")
-    axes[0].set_title(
-        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
+    unit = length_unit(result)
+    _titles_and_legends(
+        axes,
+        f"(a) segments {result.design}, before joining: E_max = {result.e_max:.3g} {unit}",
+        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g} {unit}",
     )
-    axes[1].set_title(
-        f"(b) joined by revolute joints (o): E_max = {result.joined_e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
-    )
-    for ax in axes:
-        _legend(ax)
     return figure
 
 
@@ -312,18 +313,14 @@ def plot_compound(result: SynthesisResult) -> Figure:
             color="black" if is_merged else "dimgray",
             weight="bold" if is_merged else "normal",
         )
-    axes[0].set_title(
-        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
-    )
+    unit = length_unit(result)
     merged_list = ", ".join(str(i + 1) for i in compound.merged) or "none"
-    axes[1].set_title(
+    _titles_and_legends(
+        axes,
+        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {unit}",
         f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; "
-        f"E_max = {compound.e_max:.3g} {length_unit(result)}",
-        fontsize="medium",
+        f"E_max = {compound.e_max:.3g} {unit}",
     )
-    for ax in axes:
-        _legend(ax)
     return figure
 
 

@@ -4,33 +4,37 @@
 a slider along the path, a play button, a branch selector, and the hinge-angle and singular-value plots linked to
 the slider. :func:`write_synthesis_viewer` shows a synthesised chain posed on every target profile.
 
-Everything the page needs is inlined: the script and style from ``viewer_assets/``, and the data as JSON with the
-bulky arrays as little-endian base64. The page fetches nothing, from no host. The trace viewer sends each body's
-mesh once (reference configuration) and its 3x4 pose per path point, so a path of ``N`` points over ``b`` bodies
-costs ``48 N b`` bytes before base64.
+Everything the page needs is inlined (:mod:`linkwork.viz.viewer_page`): the script and style from
+``viewer_assets/``, and the data as JSON with the bulky arrays as little-endian base64. The page fetches nothing,
+from no host. The trace viewer sends each body's mesh once (reference configuration) and its 3x4 pose per path
+point, so a path of ``N`` points over ``b`` bodies costs ``48 N b`` bytes before base64. This module holds the
+trace viewer; the synthesis viewer is :mod:`linkwork.viz.synthesis_viewer` (its names are importable from here).
 """
 
 from __future__ import annotations
 
-import base64
-import json
-import math
-import re
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.geometry.angles import wrap
+from linkwork.io.results import file_units
 from linkwork.kinematics.closure import body_poses
 from linkwork.viz.palette import TAB10
+from linkwork.viz.synthesis_viewer import (
+    joint_turns,
+    synthesis_viewer_data,
+    synthesis_viewer_page,
+    write_synthesis_viewer,
+)
+from linkwork.viz.viewer_page import DATA_ID, _packed, _page, _Viewer, _write, script_json, unpack
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Bifurcation, Trace
-    from linkwork.synthesis.result import SynthesisResult
 
 #: Joint colours of the plots and labels (the one palette, so the viewer matches the PNG figures).
 JOINT_COLORS = TAB10
@@ -42,8 +46,26 @@ MAX_POINTS = 20000
 #: a branch leaves a located point after a polish that may move it by a few 1e-6.
 SAME_POINT = 1e-5
 
-DATA_ID = "linkwork-data"
-"""The ``id`` of the ``<script type="application/json">`` element holding a viewer's data."""
+__all__ = [
+    "DATA_ID",
+    "JOINT_COLORS",
+    "MAX_POINTS",
+    "SAME_POINT",
+    "Part",
+    "joint_labels",
+    "joint_turns",
+    "linkage_parts",
+    "script_json",
+    "synthesis_viewer_data",
+    "synthesis_viewer_page",
+    "trace_viewer_data",
+    "trace_viewer_page",
+    "unpack",
+    "write_synthesis_viewer",
+    "write_trace_viewer",
+]
+
+_TRACE = _Viewer("trace.html", ("common.js", "scene.js", "trace.js"), "position along the branch")
 
 
 @dataclass(frozen=True)
@@ -55,70 +77,6 @@ class Part:
     vertices: NDArray[np.float64]
     faces: NDArray[np.int64]
     color: str
-
-
-# ----------------------------------------------------------------------------------------------- encoding
-
-
-def _packed(values: Any, dtype: str) -> dict[str, Any]:
-    """A numpy array as ``{"dtype", "shape", "b64"}``, little-endian, for ``decode`` in the page's script."""
-    arr = np.ascontiguousarray(np.asarray(values), dtype=np.dtype(dtype).newbyteorder("<"))
-    return {"dtype": dtype, "shape": list(arr.shape), "b64": base64.b64encode(arr.tobytes()).decode("ascii")}
-
-
-def unpack(entry: dict[str, Any]) -> NDArray[Any]:
-    """Inverse of the page's packing: the numpy array of a ``{"dtype", "shape", "b64"}`` entry (for tests)."""
-    raw = base64.b64decode(entry["b64"])
-    return np.frombuffer(raw, dtype=np.dtype(entry["dtype"]).newbyteorder("<")).reshape(entry["shape"])
-
-
-def _asset(name: str) -> str:
-    return (resources.files("linkwork.viz") / "viewer_assets" / name).read_text(encoding="utf-8")
-
-
-def _page(template: str, title: str, data: dict[str, Any], scripts: list[str]) -> str:
-    """Fill an HTML template: ``{{TITLE}}``, ``{{CSS}}``, ``{{DATA}}`` and ``{{JS}}``, in one pass."""
-    from linkwork import __version__
-
-    payload = script_json(data)
-    values = {
-        "TITLE": _escape(title),
-        "CSS": _asset("viewer.css"),
-        "DATA": payload,
-        "JS": "\n".join(_asset(s) for s in scripts).replace("</script", "<\\/script"),
-        "VERSION": __version__,
-    }
-    return re.sub(r"\{\{([A-Z]+)\}\}", lambda m: values[m.group(1)], _asset(template))
-
-
-#: Characters of JSON text that must not appear raw inside an HTML <script> element: "<" and ">" could open
-#: "</script>" or "<!--" (which changes how the element ends), "&" for symmetry with HTML escaping, and U+2028
-#: / U+2029, which older JavaScript parsers treat as line breaks. Each is written as its JSON \\u escape, so the
-#: data parse back to the same strings.
-_SCRIPT_UNSAFE = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
-
-
-def script_json(data: Any) -> str:
-    """``data`` as JSON text safe to embed inside ``<script type="application/json">`` (no NaN or inf)."""
-    payload = json.dumps(data, separators=(",", ":"), allow_nan=False)
-    return re.sub("[<>&\u2028\u2029]", lambda m: _SCRIPT_UNSAFE[m.group(0)], payload)
-
-
-def _escape(text: str) -> str:
-    return (
-        text.replace("&", "&amp;")
-        .replace("<", "&lt;")
-        .replace(">", "&gt;")
-        .replace('"', "&quot;")
-        .replace("'", "&#x27;")
-    )
-
-
-def _write(file: str | Path, text: str) -> Path:
-    file = Path(file)
-    file.parent.mkdir(parents=True, exist_ok=True)
-    file.write_text(text, encoding="utf-8")
-    return file
 
 
 # ----------------------------------------------------------------------------------------------- geometry
@@ -274,7 +232,7 @@ def _difference(
 ) -> NDArray[np.float64]:
     """Rows of ``a`` minus configuration ``b``, revolute joints wrapped into [-pi, pi)."""
     d = a - b
-    d[:, revolute] = (d[:, revolute] + np.pi) % (2 * np.pi) - np.pi
+    d[:, revolute] = wrap(d[:, revolute])
     return d
 
 
@@ -316,11 +274,71 @@ def trace_viewer_data(
     visits_all = [_visits(path, b, revolute) for b in path.bifurcations]
     per_branch = _kept_points(path, max_points, {int(i) for v in visits_all for i in v})
     keep = np.concatenate(per_branch) if per_branch else np.zeros(0, dtype=np.int64)
-    # Where each kept point lands: (branch index, row within the branch).
-    where = {int(k): (bi, row) for bi, idx in enumerate(per_branch) for row, k in enumerate(idx)}
-    angles = path.angles[keep]
+    parts = linkage_parts(mech)
+    poses = _pose_rows(mech, path.angles[keep])
+    centres = _centres(parts, poses)
+    steady = _steady_rows(path, per_branch)
+    return {
+        "kind": "trace",
+        "title": title or mech.name,
+        "mechanism": mech.name,
+        "drive": mech.index(path.drive) if path.drive in mech.joint_names else 0,
+        "planar": bool(mech.planar),
+        "joints": _joint_entries(mech, joint_labels(mech, parts)),
+        "bodies": list(mech.bodies),
+        "parts": [_part_entry(p) for p in parts],
+        "bounds": {
+            "fixed": _bounds(parts, poses, np.zeros_like(centres)),
+            "centred": _bounds(parts, _compose(steady, poses), np.zeros_like(centres)),
+        },
+        "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
+        "centres": _packed(centres, "f4"),
+        "steady": _packed(steady, "f4"),
+        "points": len(keep),
+        "points_traced": len(path.branch),
+        "poses": _packed(poses, "f4"),
+        "angles": _packed(file_units(mech, path.angles[keep]), "f4"),
+        "sigma": _packed(path.sigma[keep], "f8"),
+        "rank": _packed(path.rank[keep], "i4"),
+        "step": _packed(path.step[keep], "i4"),
+        "arclength": _packed(np.degrees(path.arclength[keep]), "f4"),
+        "residual": _packed(path.residual[keep], "f4"),
+        "unknowns": mech.n_unknowns,
+        "branches": _branch_entries(path, per_branch),
+        "bifurcations": _bifurcation_entries(path, visits_all, per_branch),
+    }
+
+
+def _joint_entries(mech: Mechanism, labels: list[tuple[int, NDArray[np.float64]]]) -> list[dict[str, Any]]:
+    """Per joint: name, type, plot colour and dash (the one palette), and where its label sits on which body."""
+    return [
+        {
+            "name": name,
+            "type": kind,
+            "color": JOINT_COLORS[j % len(JOINT_COLORS)],
+            "dash": j // len(JOINT_COLORS) + (j % 4),
+            "body": labels[j][0],
+            "point": labels[j][1].tolist(),
+        }
+        for j, (name, kind) in enumerate(zip(mech.joint_names, mech.joint_types, strict=True))
+    ]
+
+
+def _part_entry(part: Part) -> dict[str, Any]:
+    """A part's mesh for the page: vertices as float32, faces as 16-bit indices when they fit."""
+    return {
+        "body": part.body,
+        "name": part.name,
+        "color": part.color,
+        "vertices": _packed(part.vertices, "f4"),
+        "faces": _packed(part.faces, "u2" if len(part.vertices) < 65536 else "u4"),
+    }
+
+
+def _branch_entries(path: Trace, per_branch: list[NDArray[np.int64]]) -> list[dict[str, Any]]:
+    """Per branch: how it was found and ended, and which run of the page's points (``start``, ``count``) it is."""
     starts = np.cumsum([0] + [len(idx) for idx in per_branch])
-    branches = [
+    return [
         {
             "id": br.id,
             "parent": br.parent,
@@ -333,86 +351,27 @@ def trace_viewer_data(
         }
         for bi, br in enumerate(path.branches)
     ]
-    bifurcations = []
-    for b, visits in zip(path.bifurcations, visits_all, strict=True):
-        seen = [list(where[int(k)]) for k in visits if int(k) in where]
-        bifurcations.append(
-            {
-                "id": b.id,
-                "branch": b.branch,
-                "step": b.step,
-                "rank": b.rank,
-                "method": b.method,
-                "tangents": len(b.tangents),
-                "angles": _display(mech, b.angles).tolist(),
-                "visits": seen,
-            }
-        )
-
-    parts = linkage_parts(mech)
-    poses = _pose_rows(mech, angles)
-    labels = joint_labels(mech, parts)
-    centres = _centres(parts, poses)
-    steady = _steady_rows(path, per_branch)
-    steadied = _compose(steady, poses)
-    display = _display(mech, angles)
-    drive = mech.index(path.drive) if path.drive in mech.joint_names else 0
-    return {
-        "kind": "trace",
-        "title": title or mech.name,
-        "mechanism": mech.name,
-        "drive": drive,
-        "planar": bool(mech.planar),
-        "joints": [
-            {
-                "name": name,
-                "type": kind,
-                "color": JOINT_COLORS[j % len(JOINT_COLORS)],
-                "dash": j // len(JOINT_COLORS) + (j % 4),
-                "body": labels[j][0],
-                "point": labels[j][1].tolist(),
-            }
-            for j, (name, kind) in enumerate(zip(mech.joint_names, mech.joint_types, strict=True))
-        ],
-        "bodies": list(mech.bodies),
-        "parts": [
-            {
-                "body": p.body,
-                "name": p.name,
-                "color": p.color,
-                "vertices": _packed(p.vertices, "f4"),
-                "faces": _packed(p.faces, "u2" if len(p.vertices) < 65536 else "u4"),
-            }
-            for p in parts
-        ],
-        "bounds": {
-            "fixed": _bounds(parts, poses, np.zeros_like(centres)),
-            "centred": _bounds(parts, steadied, np.zeros_like(centres)),
-        },
-        "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
-        "centres": _packed(centres, "f4"),
-        "steady": _packed(steady, "f4"),
-        "points": len(keep),
-        "points_traced": len(path.branch),
-        "poses": _packed(poses, "f4"),
-        "angles": _packed(display, "f4"),
-        "sigma": _packed(path.sigma[keep], "f8"),
-        "rank": _packed(path.rank[keep], "i4"),
-        "step": _packed(path.step[keep], "i4"),
-        "arclength": _packed(np.degrees(path.arclength[keep]), "f4"),
-        "residual": _packed(path.residual[keep], "f4"),
-        "unknowns": mech.n_unknowns,
-        "branches": branches,
-        "bifurcations": bifurcations,
-    }
 
 
-def _display(mech: Mechanism, values: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Joint values in the units users read: degrees for revolute joints, lengths for prismatic ones."""
-    out = np.array(values, dtype=float, copy=True)
-    revolute = np.array([t == "R" for t in mech.joint_types])
-    out[..., revolute] = np.degrees(out[..., revolute])
-    return out
+def _bifurcation_entries(
+    path: Trace, visits_all: list[NDArray[np.int64]], per_branch: list[NDArray[np.int64]]
+) -> list[dict[str, Any]]:
+    """Per bifurcation point: where it was found, its rank and tangents, its angles in file units, and its visits
+    as ``[branch index, row within the branch]`` among the page's points."""
+    where = {int(k): (bi, row) for bi, idx in enumerate(per_branch) for row, k in enumerate(idx)}
+    return [
+        {
+            "id": b.id,
+            "branch": b.branch,
+            "step": b.step,
+            "rank": b.rank,
+            "method": b.method,
+            "tangents": len(b.tangents),
+            "angles": file_units(path.mechanism, b.angles).tolist(),
+            "visits": [list(where[int(k)]) for k in visits if int(k) in where],
+        }
+        for b, visits in zip(path.bifurcations, visits_all, strict=True)
+    ]
 
 
 def write_trace_viewer(
@@ -445,104 +404,9 @@ def write_trace_viewer(
 
 def trace_viewer_page(path: Trace, *, title: str | None = None, max_points: int = MAX_POINTS) -> str:
     """The HTML text of :func:`write_trace_viewer`'s page (for an inline view in a notebook)."""
-    data = trace_viewer_data(path, title=title, max_points=max_points)
-    return _page("trace.html", data["title"], data, ["common.js", "scene.js", "trace.js"])
+    return _trace_page(trace_viewer_data(path, title=title, max_points=max_points))
 
 
-# ----------------------------------------------------------------------------------------------- synthesis viewer
-
-
-def joint_turns(points: NDArray[np.float64], joints: list[int]) -> NDArray[np.float64]:
-    """Relative angle (degrees) at each joint of a posed chain: the turn from the piece arriving at the joint
-    point to the piece leaving it (positive to the left)."""
-    pts = np.asarray(points, dtype=float)
-    out = []
-    for k in joints:
-        a, b = pts[k] - pts[k - 1], pts[k + 1] - pts[k]
-        out.append(math.degrees(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b)))
-    return np.array(out)
-
-
-def synthesis_viewer_data(result: SynthesisResult, *, title: str | None = None) -> dict[str, Any]:
-    """Everything the synthesis viewer page shows, as JSON-ready data (angles in degrees)."""
-
-    def chain(profiles: Any) -> list[dict[str, Any]]:
-        return [
-            {
-                "joints": np.asarray(prof.joints).tolist(),
-                "points": np.asarray(prof.points).tolist(),
-                "angles": np.degrees(prof.angles).tolist(),
-                "errors": np.asarray(prof.errors).tolist(),
-                "turns": joint_turns(
-                    prof.points, [int(seg.starts[j]) for seg in result.segments[1:]]
-                ).tolist(),
-            }
-            for j, prof in enumerate(profiles)
-        ]
-
-    segments = [
-        {
-            "kind": seg.kind,
-            "pieces": [int(m) for m in seg.pieces],
-            "starts": [int(k) for k in seg.starts],
-            "radius": None if seg.radius is None or math.isinf(seg.radius) else float(seg.radius),
-            "lengths": [float(v) for v in seg.lengths],
-        }
-        for seg in result.segments
-    ]
-    compound = result.compound
-    return {
-        "kind": "synthesis",
-        "joint_colors": list(TAB10),
-        "title": title or f"Shape-change synthesis: design {result.design}",
-        "profile_kind": result.problem.kind,
-        "design": result.design,
-        "e_max": float(result.e_max),
-        "e_mean": float(result.e_mean),
-        "joined_e_max": float(result.joined_e_max),
-        "piece_length": float(result.problem.piece_length),
-        "targets": [
-            {
-                "name": t.name or f"profile {j + 1}",
-                "points": np.asarray(t.points).tolist(),
-                "arc_length": float(t.arc_length),
-                "pieces": int(t.pieces),
-            }
-            for j, t in enumerate(result.targets)
-        ],
-        "segments": segments,
-        "joined": chain(result.joined),
-        "joined_errors": np.asarray(result.joined_error_matrix).tolist(),
-        "compound": None
-        if compound is None
-        else {
-            "merged": [int(i) for i in compound.merged],
-            "merge_below": math.degrees(compound.threshold),
-            "joint_ranges": np.degrees(compound.joint_ranges).tolist(),
-            "joint_angles": np.degrees(compound.joint_angles).tolist(),
-            "e_max": float(compound.e_max),
-            "errors": np.asarray(compound.error_matrix).tolist(),
-            "profiles": chain(compound.profiles),
-            "notes": list(compound.notes),
-        },
-    }
-
-
-def write_synthesis_viewer(result: SynthesisResult, file: str | Path, *, title: str | None = None) -> Path:
-    """Write the interactive viewer of a synthesis result: one self-contained HTML file that works offline.
-
-    The page draws the target profiles and the joined chain posed on one of them, with a slider (and a play
-    button) across the profiles, the segments coloured by type (M rigid, C constant curvature), the joints,
-    and the error of every segment on the profile shown. See ``docs/viewer.md``.
-
-    Returns
-    -------
-    The path of the file written.
-    """
-    return _write(file, synthesis_viewer_page(result, title=title))
-
-
-def synthesis_viewer_page(result: SynthesisResult, *, title: str | None = None) -> str:
-    """The HTML text of :func:`write_synthesis_viewer`'s page (for an inline view in a notebook)."""
-    data = synthesis_viewer_data(result, title=title)
-    return _page("synthesis.html", data["title"], data, ["common.js", "synthesis.js"])
+def _trace_page(data: dict[str, Any]) -> str:
+    """The trace viewer's page around ``data`` (:func:`trace_viewer_data`, or the mechanism viewer's)."""
+    return _page(_TRACE, data)
