@@ -16,65 +16,57 @@ Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
-@njit(cache=True)
-def _aligned_error(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
-    """Largest distance after the best rigid registration of ``src (n, 2)`` onto ``tgt (n, 2)``."""
-    n = src.shape[0]
-    msx = msy = mtx = mty = 0.0
+@njit(cache=True, inline="always")
+def _centroid(points: Array) -> tuple[float, float]:  # pragma: no cover - compiled
+    """Mean of ``points (n, 2)``, summed in order."""
+    n = points.shape[0]
+    mx = my = 0.0
     for i in range(n):
-        msx += src[i, 0]
-        msy += src[i, 1]
-        mtx += tgt[i, 0]
-        mty += tgt[i, 1]
-    msx /= n
-    msy /= n
-    mtx /= n
-    mty /= n
+        mx += points[i, 0]
+        my += points[i, 1]
+    return mx / n, my / n
+
+
+@njit(cache=True, inline="always")
+def _best_turn(
+    src: Array, tgt: Array, ms: tuple[float, float], mt: tuple[float, float]
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """``(cos, sin)`` of the rotation that best maps ``src`` onto ``tgt``, centred at ``ms`` and ``mt``.
+
+    The planar closed form of the rigid registration (Umeyama 1991; :func:`linkwork.geometry.fit.register`): the
+    angle of ``(sum a . b, sum a ^ b)``; coincident points give the identity.
+    """
     dot = cross = 0.0
-    for i in range(n):
-        ax, ay = src[i, 0] - msx, src[i, 1] - msy
-        bx, by = tgt[i, 0] - mtx, tgt[i, 1] - mty
+    for i in range(src.shape[0]):
+        ax, ay = src[i, 0] - ms[0], src[i, 1] - ms[1]
+        bx, by = tgt[i, 0] - mt[0], tgt[i, 1] - mt[1]
         dot += ax * bx + ay * by
         cross += ax * by - ay * bx
     h = math.hypot(dot, cross)
-    c, s = (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
-    worst = 0.0
-    for i in range(n):
-        ax, ay = src[i, 0] - msx, src[i, 1] - msy
-        rx = c * ax - s * ay - (tgt[i, 0] - mtx)
-        ry = s * ax + c * ay - (tgt[i, 1] - mty)
-        worst = max(worst, rx * rx + ry * ry)
-    return math.sqrt(worst)
+    return (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
 
 
-@njit(cache=True)
-def _aligned_rms(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
-    """Root mean square distance after the best rigid registration of ``src (n, 2)`` onto ``tgt (n, 2)``."""
-    n = src.shape[0]
-    msx = msy = mtx = mty = 0.0
-    for i in range(n):
-        msx += src[i, 0]
-        msy += src[i, 1]
-        mtx += tgt[i, 0]
-        mty += tgt[i, 1]
-    msx /= n
-    msy /= n
-    mtx /= n
-    mty /= n
-    dot = cross = total = 0.0
-    for i in range(n):
-        ax, ay = src[i, 0] - msx, src[i, 1] - msy
-        bx, by = tgt[i, 0] - mtx, tgt[i, 1] - mty
-        dot += ax * bx + ay * by
-        cross += ax * by - ay * bx
-    h = math.hypot(dot, cross)
-    c, s = (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
-    for i in range(n):
-        ax, ay = src[i, 0] - msx, src[i, 1] - msy
-        rx = c * ax - s * ay - (tgt[i, 0] - mtx)
-        ry = s * ax + c * ay - (tgt[i, 1] - mty)
-        total += rx * rx + ry * ry
-    return math.sqrt(total / n)
+@njit(cache=True, inline="always")
+def _aligned_distance(src: Array, tgt: Array, rms: bool) -> float:  # pragma: no cover - compiled
+    """Largest (or with ``rms`` the root mean square) distance after the best rigid registration of
+    ``src (n, 2)`` onto ``tgt (n, 2)``: the one kernel behind both the error (Eq. 21) and :func:`fit_bound`.
+
+    Inlined where it is called (as are :func:`_fit` and its own steps), so that numba compiles each caller with
+    ``rms`` known and the loop holds only the branch taken: one source, no cost over two separate kernels.
+    """
+    ms, mt = _centroid(src), _centroid(tgt)
+    c, s = _best_turn(src, tgt, ms, mt)
+    acc = 0.0
+    for i in range(src.shape[0]):
+        ax, ay = src[i, 0] - ms[0], src[i, 1] - ms[1]
+        rx = c * ax - s * ay - (tgt[i, 0] - mt[0])
+        ry = s * ax + c * ay - (tgt[i, 1] - mt[1])
+        d2 = rx * rx + ry * ry
+        if rms:
+            acc += d2
+        else:
+            acc = max(acc, d2)
+    return math.sqrt(acc / src.shape[0]) if rms else math.sqrt(acc)
 
 
 @njit(cache=True)
@@ -87,20 +79,26 @@ def fit_bound(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
     distances, so ``d_a + d_b >= | |S_a - S_b| - |T_a - T_b| |``).
     """
     n = src.shape[0]
-    best = _aligned_rms(src, tgt)
+    best = _aligned_distance(src, tgt, True)
     idx = np.array([0, n // 2, n - 1])
     s3 = np.empty((3, 2))
     t3 = np.empty((3, 2))
     for k in range(3):
         s3[k] = src[idx[k]]
         t3[k] = tgt[idx[k]]
-    best = max(best, _aligned_rms(s3, t3))
+    best = max(best, _aligned_distance(s3, t3, True))
     for a in range(3):
         for b in range(a + 1, 3):
             ds = math.hypot(s3[a, 0] - s3[b, 0], s3[a, 1] - s3[b, 1])
             dt = math.hypot(t3[a, 0] - t3[b, 0], t3[a, 1] - t3[b, 1])
             best = max(best, 0.5 * abs(ds - dt))
     return best
+
+
+@njit(cache=True, inline="always")
+def _fit(src: Array, tgt: Array, bound: bool) -> float:  # pragma: no cover - compiled
+    """The error of ``src`` registered onto ``tgt`` (Eq. 21), or with ``bound`` its :func:`fit_bound`."""
+    return fit_bound(src, tgt) if bound else _aligned_distance(src, tgt, False)
 
 
 @njit(cache=True)
@@ -112,54 +110,27 @@ def _mean_shape(points: Array, offsets: IntArray, starts: IntArray, pieces: int)
     for j in range(p):
         z[j] = points[offsets[j] + starts[j] : offsets[j] + starts[j] + n]
     mean = np.zeros((n, 2))
-    ref = z[0]
-    mrx = mry = 0.0
-    for i in range(n):
-        mrx += ref[i, 0]
-        mry += ref[i, 1]
-    mrx /= n
-    mry /= n
+    mr = _centroid(z[0])
     for j in range(p):
-        mx = my = 0.0
+        m = _centroid(z[j])
+        c, s = (1.0, 0.0) if j == 0 else _best_turn(z[j], z[0], m, mr)
         for i in range(n):
-            mx += z[j, i, 0]
-            my += z[j, i, 1]
-        mx /= n
-        my /= n
-        dot = cross = 0.0
-        for i in range(n):
-            ax, ay = z[j, i, 0] - mx, z[j, i, 1] - my
-            bx, by = ref[i, 0] - mrx, ref[i, 1] - mry
-            dot += ax * bx + ay * by
-            cross += ax * by - ay * bx
-        h = math.hypot(dot, cross)
-        c, s = (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
-        if j == 0:
-            c, s = 1.0, 0.0
-        for i in range(n):
-            ax, ay = z[j, i, 0] - mx, z[j, i, 1] - my
-            mean[i, 0] += (c * ax - s * ay + mrx) / p
-            mean[i, 1] += (s * ax + c * ay + mry) / p
+            ax, ay = z[j, i, 0] - m[0], z[j, i, 1] - m[1]
+            mean[i, 0] += (c * ax - s * ay + mr[0]) / p
+            mean[i, 1] += (s * ax + c * ay + mr[1]) / p
     return z, mean
 
 
 @njit(cache=True)
-def mean_errors(points: Array, offsets: IntArray, starts: IntArray, pieces: int) -> Array:  # pragma: no cover
-    """``(p,)`` errors of an M-segment (Eqs. 12-15, 21)."""
+def mean_fits(
+    points: Array, offsets: IntArray, starts: IntArray, pieces: int, bound: bool
+) -> Array:  # pragma: no cover - compiled
+    """``(p,)`` errors of an M-segment (Eqs. 12-15, 21), or with ``bound`` the :func:`fit_bound` of its shape
+    on each profile."""
     z, mean = _mean_shape(points, offsets, starts, pieces)
     out = np.empty(starts.shape[0])
     for j in range(starts.shape[0]):
-        out[j] = _aligned_error(mean, z[j])
-    return out
-
-
-@njit(cache=True)
-def mean_bound(points: Array, offsets: IntArray, starts: IntArray, pieces: int) -> Array:  # pragma: no cover
-    """``(p,)`` :func:`fit_bound` of the M-segment's shape on each profile."""
-    z, mean = _mean_shape(points, offsets, starts, pieces)
-    out = np.empty(starts.shape[0])
-    for j in range(starts.shape[0]):
-        out[j] = fit_bound(mean, z[j])
+        out[j] = _fit(mean, z[j], bound)
     return out
 
 
@@ -179,38 +150,22 @@ def _arc(pieces: IntArray, curvature: float, piece_length: float) -> Array:  # p
 
 
 @njit(cache=True)
-def arc_errors(
+def arc_fits(
     points: Array,
     offsets: IntArray,
     starts: IntArray,
     pieces: IntArray,
     curvature: float,
     piece_length: float,
+    bound: bool,
 ) -> Array:  # pragma: no cover - compiled
-    """``(p,)`` errors of the C-segment of ``curvature`` and ``piece_length`` (Eqs. 19, 21)."""
+    """``(p,)`` errors of the C-segment of ``curvature`` and ``piece_length`` (Eqs. 19, 21), or with ``bound``
+    the :func:`fit_bound` of its instance on each profile."""
     arc = _arc(pieces, curvature, piece_length)
     out = np.empty(starts.shape[0])
     for j in range(starts.shape[0]):
         lo = offsets[j] + starts[j]
-        out[j] = _aligned_error(arc[: pieces[j] + 1], points[lo : lo + pieces[j] + 1])
-    return out
-
-
-@njit(cache=True)
-def arc_bound(
-    points: Array,
-    offsets: IntArray,
-    starts: IntArray,
-    pieces: IntArray,
-    curvature: float,
-    piece_length: float,
-) -> Array:  # pragma: no cover - compiled
-    """``(p,)`` :func:`fit_bound` of the C-segment's instance on each profile."""
-    arc = _arc(pieces, curvature, piece_length)
-    out = np.empty(starts.shape[0])
-    for j in range(starts.shape[0]):
-        lo = offsets[j] + starts[j]
-        out[j] = fit_bound(arc[: pieces[j] + 1], points[lo : lo + pieces[j] + 1])
+        out[j] = _fit(arc[: pieces[j] + 1], points[lo : lo + pieces[j] + 1], bound)
     return out
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from linkwork.synthesis.compiled import arc_bound, arc_errors, mean_bound, mean_errors
+from linkwork.synthesis.compiled import arc_fits, mean_fits
 from linkwork.synthesis.error_kernels import ProfileTables
 from linkwork.synthesis.segment_matrix import MAX_ITERATIONS, PATIENCE, SearchOutcome
 
@@ -56,6 +56,28 @@ def _pairwise_sum(a: Array, lo: int, n: int) -> float:  # pragma: no cover - com
 
 
 @njit(cache=True)
+def _arc_parameters(
+    offsets: IntArray, chord_sum: Array, curvature_sum: Array, first: IntArray, pieces: IntArray
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """``(curvature, piece_length)`` of a C-segment of ``pieces[j]`` pieces from ``first[j]`` on profile ``j``:
+    the mean interior curvature (Eq. 18, averaging ``1/r``) and mean chord (Eq. 20 with its ``1/p``), from the
+    prefix sums as ``ProfileTables.arc_errors`` takes them."""
+    p = pieces.shape[0]
+    kappa_total = 0.0
+    interior = 0
+    s_bar = 0.0
+    for j in range(p):
+        s, m, o = first[j], pieces[j], offsets[j]
+        s_bar += (chord_sum[o + s + m] - chord_sum[o + s]) / m
+        if m > 1:
+            kappa_total += curvature_sum[o + s + m] - curvature_sum[o + s + 1]
+            interior += m - 1
+    s_bar /= p
+    kappa = kappa_total / interior if interior else 0.0
+    return kappa, s_bar
+
+
+@njit(cache=True)
 def _segment_matrix_table(
     sm: IntArray,
     is_m: NDArray[np.bool_],
@@ -74,26 +96,10 @@ def _segment_matrix_table(
     first = np.zeros(p, dtype=np.int64)
     for e in range(q):
         if is_m[e]:
-            if rms:
-                em[e] = mean_bound(points, offsets, first, sm[e, 0])
-            else:
-                em[e] = mean_errors(points, offsets, first, sm[e, 0])
+            em[e] = mean_fits(points, offsets, first, sm[e, 0], rms)
         else:
-            kappa_total = 0.0
-            interior = 0
-            s_bar = 0.0
-            for j in range(p):
-                s, m, o = first[j], sm[e, j], offsets[j]
-                s_bar += (chord_sum[o + s + m] - chord_sum[o + s]) / m
-                if m > 1:
-                    kappa_total += curvature_sum[o + s + m] - curvature_sum[o + s + 1]
-                    interior += m - 1
-            s_bar /= p
-            kappa = kappa_total / interior if interior else 0.0
-            if rms:
-                em[e] = arc_bound(points, offsets, first, sm[e].copy(), kappa, s_bar)
-            else:
-                em[e] = arc_errors(points, offsets, first, sm[e].copy(), kappa, s_bar)
+            kappa, s_bar = _arc_parameters(offsets, chord_sum, curvature_sum, first, sm[e])
+            em[e] = arc_fits(points, offsets, first, sm[e].copy(), kappa, s_bar, rms)
         for j in range(p):
             first[j] += sm[e, j]
     return em

@@ -78,39 +78,15 @@ def merge_joints(
     ranges = joint_ranges(sigma)
     target_sigma = target_joint_angles(targets, segment_matrix)
     target_ranges = joint_ranges(target_sigma)
-    merged: list[int] = []
-    notes: list[str] = []
-    for i, rng in enumerate(target_ranges if merge_on == "targets" else ranges):
-        if not rng < threshold:
-            continue
-        if design[i] == "M" and design[i + 1] == "M":
-            notes.append(
-                f"joint {i} between M-segments {i} and {i + 1} moves only {math.degrees(rng):.3g} deg "
-                f"(< {math.degrees(threshold):.3g}): consider a design vector with fewer segments"
-            )
-        else:
-            merged.append(i)
-    if not merged:
-        em = np.column_stack([prof.errors for prof in joined])
-        return Compound(
-            sigma,
-            ranges,
-            threshold,
-            (),
-            tuple(notes),
-            em,
-            float(em.max()),
-            tuple(joined),
-            target_sigma,
-            target_ranges,
-            merge_on,
-        )
-    mean = sigma.mean(axis=1)
-    ties = [
-        [(i, float(prof.angles[i + 1] - prof.angles[i] + (mean[i] - sigma[i, j]))) for i in merged]
-        for j, prof in enumerate(joined)
-    ]
-    profiles = join_chain(segments, targets, kind, ties=ties, initial=joined)
+    merged, notes = _joints_to_merge(design, target_ranges if merge_on == "targets" else ranges, threshold)
+    profiles = tuple(joined)
+    if merged:
+        mean = sigma.mean(axis=1)
+        ties = [
+            [(i, float(prof.angles[i + 1] - prof.angles[i] + (mean[i] - sigma[i, j]))) for i in merged]
+            for j, prof in enumerate(joined)
+        ]
+        profiles = join_chain(segments, targets, kind, ties=ties, initial=joined)
     em = np.column_stack([prof.errors for prof in profiles])
     return Compound(
         sigma,
@@ -125,3 +101,21 @@ def merge_joints(
         target_ranges,
         merge_on,
     )
+
+
+def _joints_to_merge(design: str, ranges: Array, threshold: float) -> tuple[list[int], list[str]]:
+    """``(merged, notes)``: the joints whose range is below ``threshold`` and that touch a C-segment, and a note
+    for each low-motion joint between two M-segments (left alone)."""
+    merged: list[int] = []
+    notes: list[str] = []
+    for i, rng in enumerate(ranges):
+        if not rng < threshold:
+            continue
+        if design[i] == "M" and design[i + 1] == "M":
+            notes.append(
+                f"joint {i} between M-segments {i} and {i + 1} moves only {math.degrees(rng):.3g} deg "
+                f"(< {math.degrees(threshold):.3g}): consider a design vector with fewer segments"
+            )
+        else:
+            merged.append(i)
+    return merged, notes

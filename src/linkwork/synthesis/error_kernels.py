@@ -19,6 +19,17 @@ from linkwork.synthesis.arc_segment import arc_points, discrete_curvature
 Array = NDArray[np.float64]
 
 
+def _best_turn(dot: Array, cross: Array) -> tuple[Array, Array]:
+    """``(cos, sin)``, each ``(p, 1)``, of the best rotation of centred point sets whose summed dot and cross
+    products are ``dot``, ``cross`` ``(p,)`` (the planar rigid registration); coincident points give the
+    identity."""
+    h = np.hypot(dot, cross)
+    safe = np.where(h > 0.0, h, 1.0)
+    c = np.where(h > 0.0, dot / safe, 1.0)[:, None]
+    s = np.where(h > 0.0, cross / safe, 0.0)[:, None]
+    return c, s
+
+
 def _aligned_errors(src: Array, tgt: Array) -> Array:
     """``(p,)`` largest distance after the best rigid registration of ``src (p, n, 2)`` onto ``tgt``."""
     a = src - src.mean(axis=1, keepdims=True)
@@ -26,10 +37,7 @@ def _aligned_errors(src: Array, tgt: Array) -> Array:
     ax, ay, bx, by = a[..., 0], a[..., 1], b[..., 0], b[..., 1]
     dot = np.einsum("pn,pn->p", ax, bx) + np.einsum("pn,pn->p", ay, by)
     cross = np.einsum("pn,pn->p", ax, by) - np.einsum("pn,pn->p", ay, bx)
-    h = np.hypot(dot, cross)
-    safe = np.where(h > 0.0, h, 1.0)
-    c = np.where(h > 0.0, dot / safe, 1.0)[:, None]
-    s = np.where(h > 0.0, cross / safe, 0.0)[:, None]
+    c, s = _best_turn(dot, cross)
     rx = c * ax - s * ay - bx
     ry = s * ax + c * ay - by
     return np.sqrt(np.max(rx * rx + ry * ry, axis=1))
@@ -63,8 +71,8 @@ class ProfileTables:
     def mean_errors(self, starts: Sequence[int], pieces: int) -> Array:
         """``(p,)`` errors of an M-segment of ``pieces`` pieces from ``starts`` (Eqs. 12-15, 21)."""
         if self.compiled:
-            return compiled.mean_errors(
-                self.stacked, self.offsets, np.asarray(starts, dtype=np.int64), int(pieces)
+            return compiled.mean_fits(
+                self.stacked, self.offsets, np.asarray(starts, dtype=np.int64), int(pieces), False
             )
         z = np.stack([pts[s : s + pieces + 1] for pts, s in zip(self.points, starts, strict=True)])
         first = np.broadcast_to(z[0], z.shape)
@@ -72,10 +80,7 @@ class ProfileTables:
         b = first - first.mean(axis=1, keepdims=True)
         dot = np.einsum("pni,pni->p", a, b)
         cross = np.einsum("pn,pn->p", a[..., 0], b[..., 1]) - np.einsum("pn,pn->p", a[..., 1], b[..., 0])
-        h = np.hypot(dot, cross)
-        safe = np.where(h > 0.0, h, 1.0)
-        c = np.where(h > 0.0, dot / safe, 1.0)[:, None]
-        s = np.where(h > 0.0, cross / safe, 0.0)[:, None]
+        c, s = _best_turn(dot, cross)
         # Eqs. (12)-(14): every piece moved onto profile 1 (centred there), then averaged
         shifted_x = c * a[..., 0] - s * a[..., 1]
         shifted_y = s * a[..., 0] + c * a[..., 1]
@@ -95,13 +100,14 @@ class ProfileTables:
         s_bar /= len(pieces)  # Eq. (20) with its 1/p
         kappa = kappa_total / interior if interior else 0.0  # Eq. (18), averaging 1/r
         if self.compiled:
-            return compiled.arc_errors(
+            return compiled.arc_fits(
                 self.stacked,
                 self.offsets,
                 np.asarray(starts, dtype=np.int64),
                 np.asarray(pieces, dtype=np.int64),
                 kappa,
                 s_bar,
+                False,
             )
         arc = arc_points(kappa, s_bar, int(max(pieces)))
         out = np.empty(len(pieces))

@@ -1,5 +1,5 @@
-"""The local frame of a segment (first point at the origin, chord along ``+x``); planar rotations are
-:func:`linkwork.geometry.se2.rotation`."""
+"""Planar geometry of segments and profiles: the local frame of a segment (first point at the origin, chord
+along ``+x``), chord angles and polyline lengths; planar rotations are :func:`linkwork.geometry.se2.rotation`."""
 
 from __future__ import annotations
 
@@ -10,7 +10,13 @@ from linkwork.geometry.se2 import rotation
 
 Array = NDArray[np.float64]
 
-__all__ = ["chord_angle", "rotation", "to_local_frame"]
+__all__ = ["arc_length", "chord_angle", "rotation", "to_local_frame"]
+
+
+def arc_length(polyline: ArrayLike) -> float:
+    """``C_j``, the arc length of a polyline ``(N, 2)`` (Eqs. 1, 2)."""
+    pts = np.asarray(polyline, dtype=float)
+    return float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
 
 
 def chord_angle(points: ArrayLike) -> Array:

@@ -92,38 +92,110 @@ def angle_map(q: int, ties: Sequence[tuple[int, float]]) -> tuple[Array, Array]:
     return t, b
 
 
-def _group_chords(chain: ChainPose, t_map: Array, b: Array) -> Array:
-    """``(k, 2)`` chord of each rigid group of segments (segments tied at fixed joints form one body)."""
-    chords = np.einsum("qab,qb->qa", rotation(b), chain.ends)
-    return t_map.T @ chords
+class _ChainFit:
+    """The least-squares problem of posing one chain on one profile (Eqs. 29-33), over the unknowns ``u``.
 
+    ``u`` holds the chain's first point (two entries, absent when the ends are pinned) and the free chord angles
+    ``phi``; the chord angles are ``theta = T @ phi + b`` (:func:`angle_map`, the ties of compound segments).
+    """
 
-def _check_reach(chain: ChainPose, t_map: Array, b: Array, span: float, closed: bool) -> None:
-    """Raise :class:`ConvergenceError` when no pose of the chain can meet Eq. 31 (closed) or Eq. 32."""
-    lengths = np.linalg.norm(_group_chords(chain, t_map, b), axis=1)
-    gap = reach_gap(lengths, span)
-    if gap <= 1e-9 * max(float(lengths.sum()), 1.0):
-        return
-    what = "close on itself" if closed else f"span its fixed ends {span:.6g} apart"
-    why = (
-        "the chain is shorter than that"
-        if span > lengths.sum()
-        else "one segment's chord is longer than all the others' together"
-    )
-    chords = ", ".join(f"{v:.4g}" for v in lengths)
-    raise ConvergenceError(f"joining: a chain of chords {chords} cannot {what} (short by {gap:.3g}): {why}")
+    def __init__(
+        self,
+        chain: ChainPose,
+        target: Array,
+        ties: Sequence[tuple[int, float]],
+        closed: bool,
+        ends: tuple[ArrayLike, ArrayLike] | None,
+    ) -> None:
+        self.chain = chain
+        self.target = target
+        self.t_map, self.b = angle_map(chain.q, ties)
+        self.closed = closed
+        self.fixed_start = None if ends is None else np.asarray(ends[0], dtype=float)
+        self.end_point = None if ends is None else np.asarray(ends[1], dtype=float)
+        self.nf = 0 if self.fixed_start is not None else 2  # unknowns of the first point
+        self.constrained = closed or ends is not None
 
+    def initial(self, start: ArrayLike, angles: ArrayLike) -> Array:
+        """The unknowns of a first point and chord angles ``(q,)``."""
+        theta0 = np.asarray(angles, dtype=float)
+        # the free angles: least squares through the tie map, exact when theta0 already satisfies the ties
+        phi0 = np.linalg.lstsq(self.t_map, theta0 - self.b, rcond=None)[0]
+        return np.concatenate([np.asarray(start, dtype=float) if self.nf else np.zeros(0), phi0])
 
-def _target_start(chain: ChainPose, z: Array, t_map: Array, b: Array, nf: int) -> Array:
-    """Unknowns that put every segment's chord along the target's chord between its segmentation points."""
-    first = chain.first_index
-    target_chords = z[first[1:]] - z[first[:-1]]
-    theta = np.arctan2(target_chords[:, 1], target_chords[:, 0]) - np.arctan2(
-        chain.ends[:, 1], chain.ends[:, 0]
-    )
-    theta = b + np.unwrap(theta - b)
-    phi = np.linalg.lstsq(t_map, theta - b, rcond=None)[0]
-    return np.concatenate([z[0] if nf else np.zeros(0), phi])
+    def unpack(self, u: Array) -> tuple[Array, Array]:
+        """``(start, theta)``: the chain's first point and its ``(q,)`` chord angles."""
+        s = self.fixed_start if self.fixed_start is not None else u[:2]
+        return s, self.t_map @ u[self.nf :] + self.b
+
+    def residual(self, u: Array) -> Array:
+        """Chain points minus target points, flattened (Eq. 33)."""
+        s, th = self.unpack(u)
+        return (self.chain.points(s, th) - self.target).ravel()  # Eq. (33)
+
+    def jac(self, u: Array) -> Array:
+        """Derivative of :meth:`residual`."""
+        _, th = self.unpack(u)
+        jt = self.chain.jacobian_theta(th).reshape(-1, self.chain.q) @ self.t_map
+        if self.nf == 0:
+            return jt
+        js = np.tile(np.eye(2), (len(self.target), 1))
+        return np.hstack([js, jt])
+
+    def constraint(self, u: Array) -> Array:
+        """The chain's end minus its start (closed, Eq. 31) or minus the pinned end point (Eq. 32)."""
+        s, th = self.unpack(u)
+        tip = self.chain.joints(s, th)[-1]
+        return tip - (s if self.closed else self.end_point)  # Eq. (31) / Eq. (32)
+
+    def constraint_jac(self, u: Array) -> Array:
+        """Derivative of :meth:`constraint`."""
+        _, th = self.unpack(u)
+        g = self.chain.closure_jacobian(th) @ self.t_map
+        return np.hstack([np.zeros((2, self.nf)), g]) if self.nf else g
+
+    def check_reach(self) -> None:
+        """Raise :class:`ConvergenceError` when no pose of the chain can meet Eq. 31 (closed) or Eq. 32.
+
+        Segments tied at fixed joints form one rigid body; each body's chord is a link of the polygon
+        inequality of :func:`reach_gap`.
+        """
+        chords = np.einsum("qab,qb->qa", rotation(self.b), self.chain.ends)
+        lengths = np.linalg.norm(self.t_map.T @ chords, axis=1)
+        span = 0.0 if self.closed else float(np.linalg.norm(self.end_point - self.fixed_start))  # type: ignore[operator]
+        gap = reach_gap(lengths, span)
+        if gap <= 1e-9 * max(float(lengths.sum()), 1.0):
+            return
+        what = "close on itself" if self.closed else f"span its fixed ends {span:.6g} apart"
+        why = (
+            "the chain is shorter than that"
+            if span > lengths.sum()
+            else "one segment's chord is longer than all the others' together"
+        )
+        text = ", ".join(f"{v:.4g}" for v in lengths)
+        raise ConvergenceError(f"joining: a chain of chords {text} cannot {what} (short by {gap:.3g}): {why}")
+
+    def target_start(self) -> Array:
+        """Unknowns that put every segment's chord along the target's chord between its segmentation points."""
+        chain, z, b = self.chain, self.target, self.b
+        first = chain.first_index
+        target_chords = z[first[1:]] - z[first[:-1]]
+        theta = np.arctan2(target_chords[:, 1], target_chords[:, 0]) - np.arctan2(
+            chain.ends[:, 1], chain.ends[:, 0]
+        )
+        theta = b + np.unwrap(theta - b)
+        phi = np.linalg.lstsq(self.t_map, theta - b, rcond=None)[0]
+        return np.concatenate([z[0] if self.nf else np.zeros(0), phi])
+
+    def joined(self, u: Array) -> JoinedProfile:
+        """The chain posed by ``u`` and each segment's largest point-to-point distance (Eq. 21)."""
+        chain = self.chain
+        s, th = self.unpack(u)
+        pts = chain.points(s, th)
+        dist = np.linalg.norm(pts - self.target, axis=1)
+        first = chain.first_index
+        errors = np.array([dist[first[e] : first[e + 1] + 1].max() for e in range(chain.q)])  # Eq. (21)
+        return JoinedProfile(joints=chain.joints(s, th), points=pts, angles=th, errors=errors)
 
 
 def join_profile(
@@ -162,66 +234,21 @@ def join_profile(
     z = np.asarray(target, dtype=float)
     if len(chain.local) != len(z):
         raise ValueError(f"Expected {len(chain.local)} target points for these segments, got {len(z)}")
-    t_map, b = angle_map(chain.q, ties)
-    theta0 = np.asarray(angles, dtype=float)
-    # the free angles: least squares through the tie map, exact when theta0 already satisfies the ties
-    phi0 = np.linalg.lstsq(t_map, theta0 - b, rcond=None)[0]
-    fixed_start = None if ends is None else np.asarray(ends[0], dtype=float)
-    end_point = None if ends is None else np.asarray(ends[1], dtype=float)
-    nf = 0 if fixed_start is not None else 2
-
-    def unpack(u: Array) -> tuple[Array, Array]:
-        s = fixed_start if fixed_start is not None else u[:2]
-        return s, t_map @ u[nf:] + b
-
-    def residual(u: Array) -> Array:
-        s, th = unpack(u)
-        return (chain.points(s, th) - z).ravel()  # Eq. (33)
-
-    def jac(u: Array) -> Array:
-        _, th = unpack(u)
-        jt = chain.jacobian_theta(th).reshape(-1, chain.q) @ t_map
-        if nf == 0:
-            return jt
-        js = np.tile(np.eye(2), (len(z), 1))
-        return np.hstack([js, jt])
-
-    def constraint(u: Array) -> Array:
-        s, th = unpack(u)
-        tip = chain.joints(s, th)[-1]
-        return tip - (s if closed else end_point)  # Eq. (31) / Eq. (32)
-
-    def constraint_jac(u: Array) -> Array:
-        _, th = unpack(u)
-        g = chain.closure_jacobian(th) @ t_map
-        return np.hstack([np.zeros((2, nf)), g]) if nf else g
-
-    u0 = np.concatenate([np.asarray(start, dtype=float) if nf else np.zeros(0), phi0])
-    constrained = closed or ends is not None
-    if not constrained:
-        sol = least_squares(residual, u0, jac=jac, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
-        u = _polish(residual, jac, None, None, sol.x)
-    else:
-        span = 0.0 if closed else float(np.linalg.norm(end_point - fixed_start))  # type: ignore[operator]
-        _check_reach(chain, t_map, b, span, closed)
-        starts = [u0, _target_start(chain, z, t_map, b, nf)]
-        free_angles = slice(nf, None)
-        feasible = _constrained(residual, jac, constraint, constraint_jac, starts, free_angles)
-        try:
-            u = _project(
-                constraint,
-                constraint_jac,
-                _polish(residual, jac, constraint, constraint_jac, feasible),
-                free_angles,
-            )
-        except ConvergenceError:
-            u = feasible  # the polish left the constraint for good: keep the optimiser's feasible point
-    s, th = unpack(u)
-    pts = chain.points(s, th)
-    dist = np.linalg.norm(pts - z, axis=1)
-    first = chain.first_index
-    errors = np.array([dist[first[e] : first[e + 1] + 1].max() for e in range(chain.q)])  # Eq. (21)
-    return JoinedProfile(joints=chain.joints(s, th), points=pts, angles=th, errors=errors)
+    fit = _ChainFit(chain, z, ties, closed, ends)
+    u0 = fit.initial(start, angles)
+    if not fit.constrained:
+        sol = least_squares(fit.residual, u0, jac=fit.jac, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
+        return fit.joined(_polish(fit.residual, fit.jac, None, None, sol.x))
+    fit.check_reach()
+    starts = [u0, fit.target_start()]
+    free_angles = slice(fit.nf, None)
+    feasible = _constrained(fit.residual, fit.jac, fit.constraint, fit.constraint_jac, starts, free_angles)
+    try:
+        polished = _polish(fit.residual, fit.jac, fit.constraint, fit.constraint_jac, feasible)
+        u = _project(fit.constraint, fit.constraint_jac, polished, free_angles)
+    except ConvergenceError:
+        u = feasible  # the polish left the constraint for good: keep the optimiser's feasible point
+    return fit.joined(u)
 
 
 def _polish(residual: Fn, jac: Fn, constraint: Fn | None, constraint_jac: Fn | None, u: Array) -> Array:

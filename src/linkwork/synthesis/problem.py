@@ -120,6 +120,12 @@ class Problem:
         """``p``, the number of design profiles."""
         return len(self.profiles)
 
+    @property
+    def auto_design(self) -> bool:
+        """Whether the search tries every design vector of ``segments`` segments (``design`` is ``None`` or
+        ``"auto"``) rather than one given design vector."""
+        return self.design is None or (isinstance(self.design, str) and self.design.strip().lower() == "auto")
+
 
 def _real(value: Any) -> bool:
     """A number (``True`` and ``False`` are not)."""
@@ -162,8 +168,7 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
                 f"expected a whole number of starts, 1 <= starts <= {MAX_STARTS}, got {show(p.starts)}",
             )
         ]
-    auto = p.design is None or (isinstance(p.design, str) and p.design.strip().lower() == "auto")
-    searches = (2 ** int(p.segments or 1) if auto else 1) * int(p.starts)
+    searches = (2 ** int(p.segments or 1) if p.auto_design else 1) * int(p.starts)
     if searches > MAX_SEARCHES:
         return [
             (
@@ -198,9 +203,9 @@ def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
         return [("e_max_tolerance", 'missing; rank_by = "joints" needs the largest acceptable E_max')]
     sm = p.initial_segment_matrix
     if sm is not None:
-        design = (p.design or "").strip()
-        if not design or design.lower() == "auto":
+        if p.auto_design:
             return [("initial_segment_matrix", 'needs a design vector, not design = "auto"')]
+        design = (p.design or "").strip()
         rows = np.asarray(sm).shape[0] if np.asarray(sm).ndim == 2 else -1
         if rows != len(design):
             return [
@@ -215,8 +220,7 @@ def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
 def _design_rules(p: Problem) -> list[tuple[str, str]]:
     """The design vector and the number of segments."""
     expected = 'a design vector of M and C letters such as "MCMC", or "auto"'
-    auto = p.design is None or (isinstance(p.design, str) and p.design.strip().lower() == "auto")
-    if auto:
+    if p.auto_design:
         if p.segments is None:
             return [("segments", 'missing; design = "auto" needs the number of segments q, e.g. 4')]
         if not _whole(p.segments, 1, MAX_AUTO_SEGMENTS):

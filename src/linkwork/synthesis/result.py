@@ -25,6 +25,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.synthesis.frames import arc_length, to_local_frame
 from linkwork.synthesis.problem import Problem
 
 Array = NDArray[np.float64]
@@ -33,11 +34,23 @@ SegmentKind = Literal["M", "C"]
 
 
 def _points(a: Array) -> list[list[float]]:
+    """JSON-ready ``[[x, y], ...]``."""
     return [[float(x), float(y)] for x, y in np.asarray(a, dtype=float)]
 
 
 def _matrix(a: NDArray[Any]) -> list[list[float]]:
+    """JSON-ready nested lists of a matrix."""
     return np.asarray(a).tolist()
+
+
+def _floats(values: Sequence[float] | Array) -> list[float]:
+    """JSON-ready list of numbers."""
+    return [float(v) for v in values]
+
+
+def _degrees(radians: Sequence[float] | Array) -> list[float]:
+    """JSON-ready list of angles in degrees (files and tables use degrees; the API radians)."""
+    return [math.degrees(float(v)) for v in radians]
 
 
 @dataclass(frozen=True)
@@ -67,7 +80,7 @@ class TargetProfile:
     @property
     def length(self) -> float:
         """``S_j``, the total length of the target polyline (Eq. 6)."""
-        return float(np.sum(np.linalg.norm(np.diff(self.points, axis=0), axis=1)))
+        return arc_length(self.points)
 
 
 @dataclass(frozen=True)
@@ -115,14 +128,10 @@ class Segment:
     @property
     def lengths(self) -> Array:
         """``(p,)`` polyline length of the segment on each profile (C: ``L_j^e = m_j^e s_bar^e``, Eq. 19)."""
-        return np.array(
-            [float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) for pts in self.instances]
-        )
+        return np.array([arc_length(pts) for pts in self.instances])
 
     def local_points(self, j: int) -> Array:
         """The ``(m_j^e + 1, 2)`` points of the instance on profile ``j`` in the segment's local frame."""
-        from linkwork.synthesis.frames import to_local_frame
-
         if self.shape is not None:
             return self.shape
         return to_local_frame(self.instances[j])
@@ -138,8 +147,8 @@ class Segment:
             out["curvature"] = float(self.curvature or 0.0)
             out["radius"] = None if radius is None or math.isinf(radius) else float(radius)
         out["piece_length"] = float(self.piece_length)
-        out["lengths"] = [float(v) for v in self.lengths]
-        out["errors"] = [float(v) for v in self.errors]
+        out["lengths"] = _floats(self.lengths)
+        out["errors"] = _floats(self.errors)
         return out
 
 
@@ -169,8 +178,8 @@ class JoinedProfile:
         return {
             "joints": _points(self.joints),
             "points": _points(self.points),
-            "angles": [math.degrees(float(a)) for a in self.angles],
-            "errors": [float(v) for v in self.errors],
+            "angles": _degrees(self.angles),
+            "errors": _floats(self.errors),
         }
 
 
@@ -223,13 +232,11 @@ class Compound:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, angles in degrees."""
         return {
-            "joint_ranges": [math.degrees(float(v)) for v in self.joint_ranges],
+            "joint_ranges": _degrees(self.joint_ranges),
             "joint_angles": _matrix(np.degrees(self.joint_angles)),
             "ranges": {
-                "targets": None
-                if self.target_ranges is None
-                else [math.degrees(float(v)) for v in self.target_ranges],
-                "chain": [math.degrees(float(v)) for v in self.joint_ranges],
+                "targets": None if self.target_ranges is None else _degrees(self.target_ranges),
+                "chain": _degrees(self.joint_ranges),
             },
             "merge_on": self.merge_on,
             "merge_below": math.degrees(self.threshold),

@@ -17,7 +17,7 @@ from linkwork.errors import RequestNotMetError, SpecError
 from linkwork.progress import Progress
 from linkwork.synthesis.compound import merge_joints
 from linkwork.synthesis.problem import Problem
-from linkwork.synthesis.result import DesignScore, SearchStats, SynthesisResult, TargetProfile
+from linkwork.synthesis.result import Compound, DesignScore, SearchStats, SynthesisResult, TargetProfile
 from linkwork.synthesis.search import (
     JoinedDesign,
     SegmentedDesign,
@@ -33,16 +33,16 @@ from linkwork.synthesis.targets import target_profiles
 SearchMethod = Literal["paper", "refined"]
 
 
-def _check_initial(problem: Problem, designs: list[str], pieces: list[int]) -> None:
-    """The given initial segment matrix fits the (single) design vector and the target profiles."""
+def _check_initial(problem: Problem, design: str, pieces: list[int]) -> None:
+    """The given initial segment matrix fits the design vector and the target profiles.
+
+    That it comes with one design vector (not ``design = "auto"``) is a rule of :class:`Problem`.
+    """
     sm = problem.initial_segment_matrix
     if sm is None:
         return
     key = "initial_segment_matrix"
     src = None if problem.source is None else str(problem.source)
-    if len(designs) != 1:
-        raise SpecError("needs a design vector, not design 'auto'", source=src, key=key)
-    design = designs[0]
     arr = np.asarray(sm)
     if arr.shape != (len(design), len(pieces)):
         raise SpecError(
@@ -130,8 +130,8 @@ def synthesize(
     Returns
     -------
     SynthesisResult
-        The design vector ranked first (``problem.rank_by``; by default the lowest ``E_max`` after joining), its segments, the joined chain on every
-        profile and, when ``merge_below > 0``, the compound segments.
+        The design vector ranked first (``problem.rank_by``; by default the lowest ``E_max`` after joining),
+        its segments, the joined chain on every profile and, when ``merge_below > 0``, the compound segments.
 
     Raises
     ------
@@ -151,27 +151,9 @@ def synthesize(
         raise SpecError(f"search must be 'paper' or 'refined', got {search!r}", key="search")
     t0 = time.perf_counter()
     targets = target_profiles(problem)
-    pieces = [t.pieces for t in targets]
-    if problem.design is not None and problem.design.strip().lower() != "auto":
-        designs = [check_design(problem.design)]
-    else:
-        if problem.segments is None:
-            raise SpecError("design 'auto' needs the number of segments", key="segments")
-        designs = design_vectors(problem.segments, pieces)
-    for design in designs:
-        check_feasible(design, pieces, problem.min_pieces)
-    _check_initial(problem, designs, pieces)
-
+    designs = _designs_to_try(problem, [t.pieces for t in targets])
     fitter = SegmentFitter(targets)
-    total = len(designs) * (problem.starts + 1)
-    done = 0
-
-    def tick() -> None:
-        nonlocal done
-        done += 1
-        if progress is not None:
-            progress(done, total)
-
+    tick = _ticker(progress, len(designs) * (problem.starts + 1))
     segmented = [
         segment_design(problem, design, targets, fitter, search=search, on_start_done=tick)
         for design in designs
@@ -181,39 +163,67 @@ def synthesize(
         reasons = "; ".join(s.reason for s in skipped[:3]) + ("; ..." if len(skipped) > 3 else "")
         raise RequestNotMetError(f"no design vector of the {len(designs)} tried could be joined: {reasons}")
     ranked = _ranked(joined, problem)
-    chosen = ranked[0]
+    compound = _compound(problem, targets, ranked[0])
+    seconds = time.perf_counter() - t0
+    stats = _search_stats(problem, search, segmented, fitter, (ranked, skipped, pruned), seconds)
+    return _result(problem, targets, ranked[0], compound, stats)
+
+
+def _designs_to_try(problem: Problem, pieces: list[int]) -> list[str]:
+    """The design vectors to search: the problem's own, or every one of ``segments`` letters (``design =
+    "auto"``; the rules of :class:`Problem` ensure ``segments`` then), each checked against the profiles' pieces
+    (and the initial segment matrix, which comes only with one design vector)."""
+    if problem.auto_design:
+        assert problem.segments is not None
+        designs = design_vectors(problem.segments, pieces)
+    else:
+        assert problem.design is not None
+        designs = [check_design(problem.design)]
+    for design in designs:
+        check_feasible(design, pieces, problem.min_pieces)
+    _check_initial(problem, designs[0], pieces)
+    return designs
+
+
+def _ticker(progress: Progress | None, total: int) -> Callable[[], None]:
+    """A function to call once per unit of work done; it reports ``progress(done, total)`` when given."""
+    done = 0
+
+    def tick() -> None:
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, total)
+
+    return tick
+
+
+def _compound(problem: Problem, targets: tuple[TargetProfile, ...], chosen: JoinedDesign) -> Compound | None:
+    """The chosen design's compound segments (Sec. 6), or ``None`` when merging is off (``merge_below == 0``)."""
+    if problem.merge_below <= 0.0:
+        return None
+    return merge_joints(
+        chosen.design,
+        chosen.segmentation.segment_matrix,
+        chosen.segments,
+        targets,
+        chosen.joined,
+        problem.merge_below,
+        problem.kind,
+        merge_on=problem.merge_on,
+    )
+
+
+def _result(
+    problem: Problem,
+    targets: tuple[TargetProfile, ...],
+    chosen: JoinedDesign,
+    compound: Compound | None,
+    stats: SearchStats,
+) -> SynthesisResult:
+    """The result for the design ranked first: its segmentation, joined chain and compound segments."""
     opt = chosen.segmentation
     joined_em = np.column_stack([prof.errors for prof in chosen.joined])
-    compound = None
-    if problem.merge_below > 0.0:
-        compound = merge_joints(
-            chosen.design,
-            opt.segment_matrix,
-            chosen.segments,
-            targets,
-            chosen.joined,
-            problem.merge_below,
-            problem.kind,
-            merge_on=problem.merge_on,
-        )
-    scores = [_score(c.segmented, c, problem) for c in ranked]
-    scores += [_score(s.segmented, None, problem) for s in skipped]
-    scores += [_score(p, None, problem) for p in pruned]
-    stats = SearchStats(
-        search=search,
-        designs=tuple(scores),
-        starts=problem.starts,
-        iterations=sum(d.iterations for d in segmented),
-        evaluations=fitter.evaluations,
-        cache_hits=fitter.hits,
-        seconds=time.perf_counter() - t0,
-        paper_e_max=chosen.segmented.paper_e_max,
-        designs_tried=len(designs),
-        skipped=tuple((s.design, s.reason) for s in skipped),
-        pruned=len(pruned),
-        rank_by=problem.rank_by,
-        e_max_tolerance=problem.e_max_tolerance,
-    )
     return SynthesisResult(
         problem=problem,
         targets=targets,
@@ -229,6 +239,37 @@ def synthesize(
         compound=compound,
         stats=stats,
         history=chosen.segmented.history,
+    )
+
+
+def _search_stats(
+    problem: Problem,
+    search: str,
+    segmented: list[SegmentedDesign],
+    fitter: SegmentFitter,
+    outcomes: tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign]],
+    seconds: float,
+) -> SearchStats:
+    """The search's statistics and its table of design vectors: ``outcomes`` are the joined designs in rank
+    order, the skipped and the pruned ones."""
+    ranked, skipped, pruned = outcomes
+    scores = [_score(c.segmented, c, problem) for c in ranked]
+    scores += [_score(s.segmented, None, problem) for s in skipped]
+    scores += [_score(p, None, problem) for p in pruned]
+    return SearchStats(
+        search=search,
+        designs=tuple(scores),
+        starts=problem.starts,
+        iterations=sum(d.iterations for d in segmented),
+        evaluations=fitter.evaluations,
+        cache_hits=fitter.hits,
+        seconds=seconds,
+        paper_e_max=ranked[0].segmented.paper_e_max,
+        designs_tried=len(segmented),
+        skipped=tuple((s.design, s.reason) for s in skipped),
+        pruned=len(pruned),
+        rank_by=problem.rank_by,
+        e_max_tolerance=problem.e_max_tolerance,
     )
 
 

@@ -8,10 +8,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
+from linkwork.synthesis.frames import arc_length
 from linkwork.synthesis.problem import Problem
 from linkwork.synthesis.result import TargetProfile
 
 Array = NDArray[np.float64]
+
+__all__ = ["arc_length", "mean_chord", "mean_piece_length", "resample", "target_profile", "target_profiles"]
 
 
 def _clean_polyline(polyline: ArrayLike, closed: bool) -> Array:
@@ -28,12 +31,6 @@ def _clean_polyline(polyline: ArrayLike, closed: bool) -> Array:
     if len(pts) < 2:
         raise SpecError("a profile needs at least two distinct points")
     return pts
-
-
-def arc_length(polyline: ArrayLike) -> float:
-    """``C_j``, the arc length of a polyline ``(N, 2)`` (Eqs. 1, 2)."""
-    pts = np.asarray(polyline, dtype=float)
-    return float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
 
 
 def resample(polyline: ArrayLike, pieces: int) -> Array:
