@@ -1,4 +1,9 @@
-"""``linkwork demo``: both halves of linkwork on bundled examples, written into one folder a newcomer can open."""
+"""``linkwork demo``: both halves of linkwork on bundled examples, written into one folder a newcomer can open.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (10).
+"""
 
 from __future__ import annotations
 

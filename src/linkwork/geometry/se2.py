@@ -2,6 +2,10 @@
 
 Convention: a pose ``g = (x, y, angle)`` maps body coordinates into the frame it is expressed in,
 ``p_world = R(angle) p_body + (x, y)``; so ``g_A_C = g_A_B g_B_C`` and :func:`relative` gives ``g_before^-1 g_after``.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eq. (13).
 """
 
 from __future__ import annotations

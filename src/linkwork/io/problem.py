@@ -28,6 +28,10 @@ Example
     e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
     initial_segment_matrix = [[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]]  # Eq. 11: a row per profile
     units = "mm"                        # optional: length unit of the profile files, carried into DXF/SVG
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eq. (11).
 """
 
 from __future__ import annotations

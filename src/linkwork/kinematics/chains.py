@@ -8,6 +8,10 @@ but not equal to, the identity: :func:`assemble_chain` corrects the angles onto 
 as written (Gauss-Newton on the serial product itself), recomputes the twists there, and reports the correction.
 Link parameters that close no loop (an over-constrained loop typed with rounded lengths) leave a least-squares
 closure misfit: accepted up to ``closure_tol`` (play in the hinges), an :class:`AssemblyError` above it.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (1)-(2), (12), (28).
 """
 
 from __future__ import annotations

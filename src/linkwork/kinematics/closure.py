@@ -10,6 +10,10 @@ For a loop with factors ``exp(s_1 xi_1 q_1) ... exp(s_k xi_k q_k)`` (product ``P
   ``i`` in the loop, from the Lie bracket (Baker-Campbell-Hausdorff), exact and without finite differences.
 
 The compiled kernels in :mod:`linkwork.kinematics.kernels` compute the same quantities; tests check they agree.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (21), (27).
 """
 
 from __future__ import annotations

@@ -5,6 +5,10 @@ The closure kernels do, one joint at a time and without temporaries, what :mod:`
 does with numpy; tests check that both agree. Arrays are laid out as in :class:`linkwork.kinematics.mechanism.Mechanism`:
 ``twists (n, 6)`` as ``(omega, v)``; loops flattened into ``loop_joint``, ``loop_sign`` and ``loop_ptr``;
 ``groups (n,)`` maps each joint to its unknown (``-1`` = fixed); ``rows`` are the twist rows kept per loop.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (21), (23).
 """
 
 from __future__ import annotations

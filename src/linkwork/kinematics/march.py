@@ -8,6 +8,10 @@ Jacobian restricted to its range (basis kept continuous) and bordered by the tan
 point: a sign change brackets a bifurcation.
 
 Stop codes returned by :func:`march`: see :data:`STOP_REASONS`.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (28).
 """
 
 from __future__ import annotations

@@ -1,4 +1,9 @@
-"""Numerical rank of a Jacobian from its singular values, with a gap-based tolerance and an absolute floor."""
+"""Numerical rank of a Jacobian from its singular values, with a gap-based tolerance and an absolute floor.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (28).
+"""
 
 from __future__ import annotations
 

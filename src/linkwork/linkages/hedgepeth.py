@@ -6,6 +6,10 @@ its rods is :mod:`linkwork.linkages.hedgepeth_rods`.
 The rods are the paper's isosceles-triangle rods (Eqs. (7)-(9)), each described by the transform
 ``[Rz(phi) Rx(omega) Rz(psi), v]`` with ``v = [cos a3, 0, sin a3]`` (unit rod length along the apex line), and the
 loop is ``T1 T_A T2 T_B ... = I`` (Eq. (12)) with joint angles zero in the folded bundle.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (7)-(10), (12).
 """
 
 from __future__ import annotations

@@ -1,5 +1,10 @@
 """The files of a synthesised chain (chain.json, target_profiles.csv, outline.svg/.dxf, figures), its printed
-summary, a bundled example run end to end, and a ``linkwork synth`` output folder read back."""
+summary, a bundled example run end to end, and a ``linkwork synth`` output folder read back.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eq. (34).
+"""
 
 from __future__ import annotations
 

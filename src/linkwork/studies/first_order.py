@@ -11,6 +11,10 @@ held: ``J_k`` annihilates the tangent, so both reach the same range) leaves the 
 range of ``T J_k``: with ``N_k`` an orthonormal basis of the left null space of ``T J_k``, the predicted misfit is
 ``|N_k^T T B_k delta|``. The paper's Sec. 5 ratio measures how close
 ``J_k`` is to losing rank; ``N_k`` is exactly what the hinge errors project on.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (21).
 """
 
 from __future__ import annotations

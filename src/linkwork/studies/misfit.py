@@ -8,6 +8,10 @@ holding the drive it stays well posed at a fold of the drive, where the path tur
 of :mod:`linkwork.studies.scale`, so the misfit is a length in the linkage's units. It is solved by Gauss-Newton
 (normal equations, Cholesky, with backtracking), warm-started along the path from the previous drive value's
 solution shifted by the nominal step. The compiled batch kernel runs many samples and all drive values in one call.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (21), (23).
 """
 
 from __future__ import annotations

@@ -5,6 +5,10 @@ bounded on nearly straight pieces. Eq. (20) lacks its ``1/p``: the mean piece le
 An instance with ``m_j`` pieces is the polyline of ``m_j`` equal chords ``s_bar`` inscribed in the circle of
 curvature ``kappa``, so its length is ``L_j = m_j s_bar`` (Eq. 19) and it matches a target profile sampled on
 a circle exactly.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (15)-(21).
 """
 
 from __future__ import annotations

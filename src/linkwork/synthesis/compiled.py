@@ -2,6 +2,11 @@
 
 The same arithmetic as :mod:`~linkwork.synthesis.error_kernels` (the numpy reference), point by point. All
 profiles' target points are stacked in one ``(N, 2)`` array; profile ``j`` starts at row ``offsets[j]``.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (12)-(15), (19), (21).
 """
 
 from __future__ import annotations

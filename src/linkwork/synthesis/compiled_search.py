@@ -4,6 +4,11 @@ It makes the same decisions as :func:`~linkwork.synthesis.segment_matrix.search_
 :class:`~linkwork.synthesis.segment_fit.SegmentFitter` (same error kernels, same arithmetic order, numpy's
 pairwise summation for ``E_bar``), without the Python overhead of each iteration; it is what makes the
 exhaustive design search over ``2^q - 1`` design vectors affordable. The tests check that both agree.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (18), (20)-(24), (26).
 """
 
 from __future__ import annotations

@@ -1,4 +1,9 @@
-"""Compound segments (Sec. 6): find revolute joints that barely move across the profiles and clamp them."""
+"""Compound segments (Sec. 6): find revolute joints that barely move across the profiles and clamp them.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (17), (34).
+"""
 
 from __future__ import annotations
 

@@ -4,6 +4,10 @@ They compute exactly what :func:`~linkwork.synthesis.mean_segment.fit_mean_segme
 :func:`~linkwork.synthesis.arc_segment.fit_arc_segment` compute, without building the fitted shapes: curvature
 and chord sums come from per-profile prefix sums, every C-instance is a prefix of one arc, and registration
 error is evaluated in centred coordinates (the translation cancels).
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (12)-(21).
 """
 
 from __future__ import annotations

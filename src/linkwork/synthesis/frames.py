@@ -1,5 +1,10 @@
 """Planar geometry of segments and profiles: the local frame of a segment (first point at the origin, chord
-along ``+x``), chord angles and polyline lengths; planar rotations are :func:`linkwork.geometry.se2.rotation`."""
+along ``+x``), chord angles and polyline lengths; planar rotations are :func:`linkwork.geometry.se2.rotation`.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (1)-(2).
+"""
 
 from __future__ import annotations
 

@@ -4,6 +4,11 @@ Per profile the unknowns are the chain's first point and one chord angle per seg
 the shapes are fixed. The objective is the sum of squared distances between the chain's points and the target
 points (Eq. 33). A closed profile adds ``end = start`` (Eq. 31), a fixed-end profile pins both ends (Eq. 32).
 Joints held at a fixed relative angle (compound segments, Sec. 6) tie one angle to the one before it.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (21), (29)-(33).
 """
 
 from __future__ import annotations

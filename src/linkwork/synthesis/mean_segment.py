@@ -1,4 +1,10 @@
-"""M-segments (Sec. 3.3): one rigid shape, the mean of a segment's pieces on every profile."""
+"""M-segments (Sec. 3.3): one rigid shape, the mean of a segment's pieces on every profile.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (12)-(15), (21).
+"""
 
 from __future__ import annotations
 

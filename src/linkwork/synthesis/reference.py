@@ -2,6 +2,10 @@
 
 The readable twin of :mod:`~linkwork.synthesis.mean_segment` and :mod:`~linkwork.synthesis.arc_segment`; tests
 check that both agree, and the benchmark times the search with it as the non-vectorised baseline.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (12)-(21).
 """
 
 from __future__ import annotations

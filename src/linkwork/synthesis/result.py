@@ -11,6 +11,11 @@ Layout conventions
 * Joint ``i`` (0-based) is the revolute joint between segments ``i`` and ``i + 1``; there are ``q - 1``.
 * A segment's *local frame* puts its first point at the origin and its chord (first point to last point) along
   ``+x``.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (1)-(7), (11), (15), (19)-(22), (24)-(25), (29), (31), (34).
 """
 
 from __future__ import annotations

@@ -5,6 +5,11 @@ then joins them in the order of :func:`joined_error_bound` and stops joining onc
 exceeds the best joined ``E_max`` found (it cannot win). :func:`evaluate_design` does both steps for one
 design vector as a plain function of ``(problem, design)`` so that a scheduler may run designs in other
 processes.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (11), (21)-(22), (24), (31)-(32).
 """
 
 from __future__ import annotations

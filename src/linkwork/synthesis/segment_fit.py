@@ -2,6 +2,10 @@
 
 A segment's errors depend only on its kind, its first point on every profile and its pieces on every profile,
 so the search (which revisits the same segments many times) looks them up by that key.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (8)-(9), (21).
 """
 
 from __future__ import annotations

@@ -4,6 +4,11 @@ A segment matrix ``SM`` here has shape ``(q, p)``: ``SM[e, j] = m_j^e``, pieces 
 ``j`` (the transpose of the paper's printed layout).
 It is valid when column ``j`` sums to ``m_j*``, every M-segment row is constant, and every entry is at least
 ``alpha`` (``min_pieces``).
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013),
+Eqs. (11), (22)-(24), (26).
 """
 
 from __future__ import annotations

@@ -1,4 +1,9 @@
-"""Target profiles (Sec. 2): design polylines resampled at equal arc-length steps near ``piece_length``."""
+"""Target profiles (Sec. 2): design polylines resampled at equal arc-length steps near ``piece_length``.
+
+References
+----------
+S. A. Shamsudin, A. P. Murray, D. H. Myszka, J. P. Schmiedeler, Mech. Mach. Theory (2013), Eqs. (3)-(5), (7).
+"""
 
 from __future__ import annotations
 
