@@ -147,14 +147,14 @@ def _nominal_path(
     return path
 
 
-def _check_reached(mech: Mechanism, path: Trace, last: float, target: tuple[str, float]) -> None:
+def _check_reached(mech: Mechanism, trace: Trace, last: float, target: tuple[str, float]) -> None:
     """Exit 3 (after everything is written) when the nominal path stopped short of ``--until``; ``last`` is the
     drive's value (radians or a length) where it stopped."""
     import numpy as np
 
     from linkwork.errors import RequestNotMetError
 
-    end = path.branches[0].end_reason if path.branches else ""
+    end = trace.branches[0].end_reason if trace.branches else ""
     if end == "reached target":
         return
     reached = float(np.degrees(last)) if mech.joint_types[mech.index(target[0])] == "R" else last

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from linkwork.deprecation import trace_keyword
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
 
@@ -26,36 +27,38 @@ def file_units(mech: Mechanism, values: np.ndarray) -> np.ndarray:
     return out
 
 
-def _display(path: Trace, values: np.ndarray) -> np.ndarray:
-    """Joint values of ``path``'s mechanism in file units (:func:`file_units`)."""
-    return file_units(path.mechanism, values)
+def _display(trace: Trace, values: np.ndarray) -> np.ndarray:
+    """Joint values of ``trace``'s mechanism in file units (:func:`file_units`)."""
+    return file_units(trace.mechanism, values)
 
 
-def path_rows(path: Trace) -> tuple[list[str], list[list[Any]]]:
+@trace_keyword
+def path_rows(trace: Trace) -> tuple[list[str], list[list[Any]]]:
     """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual``."""
-    names = list(path.mechanism.joint_names)
-    k = path.sigma.shape[1]
+    names = list(trace.mechanism.joint_names)
+    k = trace.sigma.shape[1]
     header = ["branch", "step", "s", *names, *[f"sigma_{i + 1}" for i in range(k)], "residual"]
-    angles = _display(path, path.angles)
-    s_deg = np.degrees(path.arclength)
+    angles = _display(trace, trace.angles)
+    s_deg = np.degrees(trace.arclength)
     rows = []
-    for i in range(len(path.branch)):
+    for i in range(len(trace.branch)):
         rows.append(
             [
-                int(path.branch[i]),
-                int(path.step[i]),
+                int(trace.branch[i]),
+                int(trace.step[i]),
                 float(s_deg[i]),
                 *map(float, angles[i]),
-                *map(float, path.sigma[i]),
-                float(path.residual[i]),
+                *map(float, trace.sigma[i]),
+                float(trace.residual[i]),
             ]
         )
     return header, rows
 
 
-def write_path_csv(path: Trace, file: Path) -> None:
+@trace_keyword
+def write_path_csv(trace: Trace, file: Path) -> None:
     """Write ``path.csv`` (floats with 17 significant digits, so nothing is lost)."""
-    header, rows = path_rows(path)
+    header, rows = path_rows(trace)
     with open(file, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
@@ -63,65 +66,67 @@ def write_path_csv(path: Trace, file: Path) -> None:
             writer.writerow([f"{v:.17g}" if isinstance(v, float) else v for v in row])
 
 
-def branch_range(path: Trace, branch: int) -> dict[str, list[float]]:
+@trace_keyword
+def branch_range(trace: Trace, branch: int) -> dict[str, list[float]]:
     """``{joint: [min, max]}`` over one branch, in file units (degrees, or lengths for prismatic joints); the
     located folds of the drive count, so the drive's range is exact to ``Tolerances.locate``."""
     on_branch = [
-        path.angles[path.branch == branch],
-        *[f.angles[None, :] for f in path.folds if f.branch == branch],
+        trace.angles[trace.branch == branch],
+        *[f.angles[None, :] for f in trace.folds if f.branch == branch],
     ]
-    values = _display(path, np.concatenate(on_branch))
+    values = _display(trace, np.concatenate(on_branch))
     return {
         name: [float(values[:, j].min()), float(values[:, j].max())]
-        for j, name in enumerate(path.mechanism.joint_names)
+        for j, name in enumerate(trace.mechanism.joint_names)
     }
 
 
-def report_dict(path: Trace, assembly: Any | None = None) -> dict[str, Any]:
+@trace_keyword
+def report_dict(trace: Trace, assembly: Any | None = None) -> dict[str, Any]:
     """The content of ``report.json``."""
-    mech = path.mechanism
+    mech = trace.mechanism
     names = list(mech.joint_names)
-    cond = path.condition()
+    cond = trace.condition()
     out: dict[str, Any] = {
         "name": mech.name,
         "joints": names,
         "joint_types": list(mech.joint_types),
         "units": {"angles": "deg", "s": "deg (arclength in the unknowns)"},
-        "drive": path.drive,
-        "mode": path.stats.get("mode"),
+        "drive": trace.drive,
+        "mode": trace.stats.get("mode"),
         "unknowns": mech.n_unknowns,
         "couplings": [[names[j] for j in group] for group in mech.group_members() if len(group) > 1],
         "fixed": [names[j] for j in np.flatnonzero(mech.groups < 0)],
         "equations": mech.n_equations,
-        **_rank_entries(path),
-        "points": len(path.branch),
-        "max_residual": float(path.residual.max()),
-        "closure_tol": float(path.stats.get("closure_tol", 1e-12)),
-        "max_misfit": float(path.stats.get("max_misfit", path.residual.max())),
-        "target_reached": ("unmet" not in path.stats) if path.stats.get("has_target") else None,
-        "unmet": path.stats.get("unmet"),
-        "max_condition": path.max_condition,
-        "max_condition_raw": path.max_condition_raw,
+        **_rank_entries(trace),
+        "points": len(trace.branch),
+        "max_residual": float(trace.residual.max()),
+        "closure_tol": float(trace.stats.get("closure_tol", 1e-12)),
+        "max_misfit": float(trace.stats.get("max_misfit", trace.residual.max())),
+        "target_reached": ("unmet" not in trace.stats) if trace.stats.get("has_target") else None,
+        "unmet": trace.stats.get("unmet"),
+        "max_condition": trace.max_condition,
+        "max_condition_raw": trace.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
-        "bifurcations": [_bifurcation_entry(path, b) for b in path.bifurcations],
-        "folds": [_fold_entry(path, f) for f in path.folds],
-        "branches": [_branch_entry(path, br) for br in path.branches],
-        "seconds": path.stats.get("seconds"),
+        "bifurcations": [_bifurcation_entry(trace, b) for b in trace.bifurcations],
+        "folds": [_fold_entry(trace, f) for f in trace.folds],
+        "branches": [_branch_entry(trace, br) for br in trace.branches],
+        "seconds": trace.stats.get("seconds"),
     }
     if assembly is not None:
         out["assembly"] = _assembly_entry(assembly, names)
     return out
 
 
-def _rank_entries(path: Trace) -> dict[str, Any]:
+def _rank_entries(trace: Trace) -> dict[str, Any]:
     """``rank`` and ``mobility`` at the start, and their ranges along the path away from the bifurcation points
     (where the rank drops by definition)."""
-    mech = path.mechanism
-    start_rank = int(path.stats.get("start_rank", path.rank[0]))
-    regular = np.ones(len(path.rank), dtype=bool)
-    for b in path.bifurcations:
-        regular &= np.linalg.norm(path.angles - b.angles, axis=1) > 1e-6
-    ranks = path.rank[regular] if np.any(regular) else path.rank
+    mech = trace.mechanism
+    start_rank = int(trace.stats.get("start_rank", trace.rank[0]))
+    regular = np.ones(len(trace.rank), dtype=bool)
+    for b in trace.bifurcations:
+        regular &= np.linalg.norm(trace.angles - b.angles, axis=1) > 1e-6
+    ranks = trace.rank[regular] if np.any(regular) else trace.rank
     return {
         "rank": start_rank,
         "mobility": mech.n_unknowns - start_rank,
@@ -133,18 +138,18 @@ def _rank_entries(path: Trace) -> dict[str, Any]:
     }
 
 
-def _named(path: Trace, angles: np.ndarray) -> dict[str, float]:
+def _named(trace: Trace, angles: np.ndarray) -> dict[str, float]:
     """One configuration as ``{joint: value}`` in file units."""
-    return dict(zip(path.mechanism.joint_names, map(float, _display(path, angles)), strict=True))
+    return dict(zip(trace.mechanism.joint_names, map(float, _display(trace, angles)), strict=True))
 
 
-def _bifurcation_entry(path: Trace, b: Bifurcation) -> dict[str, Any]:
+def _bifurcation_entry(trace: Trace, b: Bifurcation) -> dict[str, Any]:
     """One entry of ``bifurcations``."""
     return {
         "id": b.id,
         "branch": b.branch,
         "step": b.step,
-        "angles": _named(path, b.angles),
+        "angles": _named(trace, b.angles),
         "rank": b.rank,
         "singular_values": [float(x) for x in b.sigma],
         "tangents": [[float(x) for x in t] for t in b.tangents],
@@ -156,20 +161,20 @@ def _bifurcation_entry(path: Trace, b: Bifurcation) -> dict[str, Any]:
     }
 
 
-def _fold_entry(path: Trace, f: Fold) -> dict[str, Any]:
+def _fold_entry(trace: Trace, f: Fold) -> dict[str, Any]:
     """One entry of ``folds``: where the drive turns back, and its value there."""
     return {
         "branch": f.branch,
         "step": f.step,
-        "drive": path.drive,
-        "value": float(_display(path, f.angles)[path.mechanism.index(path.drive)]),
-        "angles": _named(path, f.angles),
+        "drive": trace.drive,
+        "value": float(_display(trace, f.angles)[trace.mechanism.index(trace.drive)]),
+        "angles": _named(trace, f.angles),
     }
 
 
-def _branch_entry(path: Trace, br: Branch) -> dict[str, Any]:
+def _branch_entry(trace: Trace, br: Branch) -> dict[str, Any]:
     """One entry of ``branches``: how it was found and ended, its range, first and last configurations."""
-    on_branch = path.angles[path.branch == br.id]
+    on_branch = trace.angles[trace.branch == br.id]
     return {
         "id": br.id,
         "parent": br.parent,
@@ -178,9 +183,9 @@ def _branch_entry(path: Trace, br: Branch) -> dict[str, Any]:
         "steps": br.steps,
         "end_reason": br.end_reason,
         "mobility": br.mobility,
-        "range": branch_range(path, br.id),
-        "start": _named(path, on_branch[0]),
-        "end": _named(path, on_branch[-1]),
+        "range": branch_range(trace, br.id),
+        "start": _named(trace, on_branch[0]),
+        "end": _named(trace, on_branch[-1]),
     }
 
 
@@ -195,22 +200,24 @@ def _assembly_entry(assembly: Any, names: list[str]) -> dict[str, Any]:
     }
 
 
-def write_report_json(path: Trace, file: Path, assembly: Any | None = None) -> None:
+@trace_keyword
+def write_report_json(trace: Trace, file: Path, assembly: Any | None = None) -> None:
     """Write ``report.json``."""
     with open(file, "w") as fh:
-        json.dump(report_dict(path, assembly), fh, indent=2)
+        json.dump(report_dict(trace, assembly), fh, indent=2)
         fh.write("\n")
 
 
-def write_points_csv(path: Trace, file: Path) -> None:
+@trace_keyword
+def write_points_csv(trace: Trace, file: Path) -> None:
     """Write ``points.csv``: ``branch,step``, then ``<name>_x,<name>_y,<name>_z`` for every joint and every named
     point (world coordinates, the mechanism's length unit), then ``transmission`` (degrees) when the mechanism
     declares a transmission angle (four-bar, slider-crank)."""
     from linkwork.kinematics.points import points_columns, positions, transmission_angles
 
-    mech = path.mechanism
-    joints, named = positions(mech, path.angles)
-    xyz = np.concatenate([joints, named], axis=1).reshape(len(path.angles), -1)
+    mech = trace.mechanism
+    joints, named = positions(mech, trace.angles)
+    xyz = np.concatenate([joints, named], axis=1).reshape(len(trace.angles), -1)
     header = ["branch", "step", *[f"{name}_{c}" for name in points_columns(mech) for c in "xyz"]]
     mu = transmission_angles(mech, joints)
     if mu is not None:
@@ -219,5 +226,5 @@ def write_points_csv(path: Trace, file: Path) -> None:
     with open(file, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
-        for b, s, row in zip(path.branch, path.step, xyz, strict=True):
+        for b, s, row in zip(trace.branch, trace.step, xyz, strict=True):
             writer.writerow([int(b), int(s), *(f"{v:.17g}" for v in row)])

@@ -276,47 +276,47 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
     )
 
 
-def _path_defect(check: _Checker, path: Trace, j: int) -> _Defect | None:
+def _path_defect(check: _Checker, trace: Trace, j: int) -> _Defect | None:
     """A branch or order defect on the path from profile ``j`` to ``j + 1`` (0-based ``j - 1`` to ``j``)."""
     design, d, drive = check.design, check.d, check.design.drive
     target = float(check.ideal[j, d])
     where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
-    end = path.branches[0].end_reason
-    if path.bifurcations:
-        b = path.bifurcations[0]
+    end = trace.branches[0].end_reason
+    if trace.bifurcations:
+        b = trace.bifurcations[0]
         return (
             "branch",
             f"branch defect: a singular configuration (rank {b.rank}) {where}, drive {drive} = {check.show(b.angles[d])}",
-            _culprit(design, check.mech, path),
+            _culprit(design, check.mech, trace),
         )
-    if np.any(path.rank < check.rank):
-        k = int(np.flatnonzero(path.rank < check.rank)[0])
+    if np.any(trace.rank < check.rank):
+        k = int(np.flatnonzero(trace.rank < check.rank)[0])
         return (
             "branch",
-            f"branch defect: the Jacobian loses rank {where}, drive {drive} = {check.show(path.angles[k, d])}",
-            _culprit(design, check.mech, path),
+            f"branch defect: the Jacobian loses rank {where}, drive {drive} = {check.show(trace.angles[k, d])}",
+            _culprit(design, check.mech, trace),
         )
-    dv = np.diff(path.angles[:, d])
+    dv = np.diff(trace.angles[:, d])
     if np.any(dv * np.sign(target) < -1e-12):
         # a dead centre on the way: the drive turns back (the trace may then wander until its budget)
         k = int(np.flatnonzero(dv * np.sign(target) < -1e-12)[0])
         return (
             "order",
-            f"order defect: the drive {drive} turns back {where} at {check.show(path.angles[k, d])} (a dead centre)"
+            f"order defect: the drive {drive} turns back {where} at {check.show(trace.angles[k, d])} (a dead centre)"
             + (f"; the trace then {end}" if end != "reached target" else ""),
-            _culprit(design, check.mech, path),
+            _culprit(design, check.mech, trace),
         )
     if end != "reached target":
         defect = "order" if "turning" in end else "branch"
         return (
             defect,
             f"{defect} defect: the trace {where} stopped ({end}) before the drive {drive} reached {check.show(target)}",
-            _culprit(design, check.mech, path),
+            _culprit(design, check.mech, trace),
         )
     return None
 
 
-def _circuit_defect(check: _Checker, path: Trace, st: ProfileState, j: int) -> _Defect | None:
+def _circuit_defect(check: _Checker, trace: Trace, st: ProfileState, j: int) -> _Defect | None:
     """A circuit defect at profile ``j``'s drive value: the mechanism in another assembly mode than the chain
     (least-squares links: judged by the shape, as the profile's configuration is not on the mechanism)."""
     design, chain = check.design, check.design.chain
@@ -328,13 +328,13 @@ def _circuit_defect(check: _Checker, path: Trace, st: ProfileState, j: int) -> _
     if not wrong:
         return None
     worst = check.mech.joint_names[
-        int(np.argmax(_difference(check.mech, path.angles[-1], check.ideal[j], chain.size)))
+        int(np.argmax(_difference(check.mech, trace.angles[-1], check.ideal[j], chain.size)))
     ]
     return (
         "circuit",
         f"circuit defect: at the drive value of profile {j + 1} the mechanism is in another assembly mode "
         f"(joint {worst} differs)",
-        _circuit_culprit(design, check.mech, path.angles[-1], j),
+        _circuit_culprit(design, check.mech, trace.angles[-1], j),
     )
 
 
@@ -391,15 +391,15 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     return out
 
 
-def _culprit(design: Design, mech: Mechanism, path: Trace) -> str | None:
+def _culprit(design: Design, mech: Mechanism, trace: Trace) -> str | None:
     """The RR link nearest a dead centre on the path (at the drive's turning point when there is one)."""
     d = mech.index(design.drive)
-    drive = path.angles[:, d]
+    drive = trace.angles[:, d]
     turn = np.flatnonzero(np.diff(np.sign(np.diff(drive))) != 0)
     rows = [int(turn[0]) + 1] if turn.size else range(0, len(drive), max(1, len(drive) // 40))
     worst, name = math.inf, None
     for k in rows:
-        for link, s in link_transmissions(design, mech, path.angles[k]).items():
+        for link, s in link_transmissions(design, mech, trace.angles[k]).items():
             if s < worst:
                 worst, name = s, link
     return name

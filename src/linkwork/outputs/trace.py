@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from linkwork.deprecation import trace_keyword
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 
 if TYPE_CHECKING:
@@ -17,8 +18,9 @@ if TYPE_CHECKING:
     from linkwork.kinematics.trace_result import Trace
 
 
+@trace_keyword
 def write_trace_outputs(
-    path: Trace,
+    trace: Trace,
     out: Path,
     assembly: Assembly | None = None,
     plots: bool = True,
@@ -33,28 +35,28 @@ def write_trace_outputs(
 
     figures: list[Path] = []
     with staged_output(out) as stage:
-        write_path_csv(path, stage / "path.csv")
-        write_report_json(path, stage / "report.json", assembly)
-        write_points_csv(path, stage / "points.csv")
-        write_trace_mechanism(path.mechanism, stage)
+        write_path_csv(trace, stage / "path.csv")
+        write_report_json(trace, stage / "report.json", assembly)
+        write_points_csv(trace, stage / "points.csv")
+        write_trace_mechanism(trace.mechanism, stage)
         if plots:
             if have_matplotlib():
                 from linkwork.viz.snapshots import deployment_sequence
                 from linkwork.viz.trace_plots import write_trace_figures
 
-                figures = write_trace_figures(path, stage)
-                figures.append(deployment_sequence(path, stage / "sequence.png"))
+                figures = write_trace_figures(trace, stage)
+                figures.append(deployment_sequence(trace, stage / "sequence.png"))
                 if animate:
                     from linkwork.viz.animate import animate_path
 
-                    motion = animate_path(path, stage / "motion.gif")
+                    motion = animate_path(trace, stage / "motion.gif")
                     figures += [f for f in (motion.gif, motion.mp4) if f is not None]
             else:
                 console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
         if html:
             from linkwork.viz.viewer import write_trace_viewer
 
-            figures.append(write_trace_viewer(path, stage / "viewer.html"))
+            figures.append(write_trace_viewer(trace, stage / "viewer.html"))
     return [Path(out) / f.name for f in figures]
 
 
@@ -83,12 +85,13 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def print_trace_summary(path: Trace) -> None:
+@trace_keyword
+def print_trace_summary(trace: Trace) -> None:
     """Print the summary tables of a traced path: branches, rank and mobility, bifurcation points."""
     from linkwork.io.results import report_dict
 
-    rep = report_dict(path)
-    console.print(_branch_table(path))
+    rep = report_dict(trace)
+    console.print(_branch_table(trace))
     mob = rep["mobility_along_path"]
     console.print(
         f"rank {rep['rank']} / mobility {rep['mobility']} at the start; mobility along the path "
@@ -106,8 +109,8 @@ def print_trace_summary(path: Trace) -> None:
             f"fold of the drive on branch {fold['branch']} (after step {fold['step']}): "
             f"{fold['drive']} turns back at {fold['value']:.4f}"
         )
-    if path.bifurcations:
-        console.print(_bifurcation_table(path))
+    if trace.bifurcations:
+        console.print(_bifurcation_table(trace))
 
 
 def _joints_text(mech: Mechanism, values: np.ndarray) -> str:
@@ -120,7 +123,7 @@ def _joints_text(mech: Mechanism, values: np.ndarray) -> str:
     )
 
 
-def _branch_table(path: Trace) -> Table:
+def _branch_table(trace: Trace) -> Table:
     """One row per branch: where it starts, its steps, its mobility, why it ended and its joints at the end."""
     from rich.table import Table
 
@@ -131,8 +134,8 @@ def _branch_table(path: Trace) -> Table:
     table.add_column("mob.", justify="right")
     table.add_column("end")
     table.add_column("joints at the end (deg)", overflow="fold")
-    for br in path.branches:
-        mask = path.of_branch(br.id)
+    for br in trace.branches:
+        mask = trace.of_branch(br.id)
         origin = "start" if br.parent is None else f"bif {br.bifurcation} on {br.parent}"
         table.add_row(
             str(br.id),
@@ -140,12 +143,12 @@ def _branch_table(path: Trace) -> Table:
             str(br.steps),
             str(br.mobility),
             br.end_reason,
-            _joints_text(path.mechanism, path.angles[mask][-1]),
+            _joints_text(trace.mechanism, trace.angles[mask][-1]),
         )
     return table
 
 
-def _bifurcation_table(path: Trace) -> Table:
+def _bifurcation_table(trace: Trace) -> Table:
     """One row per bifurcation point: where, the rank there, sigma_r / sigma_1 and the branches leaving it."""
     from rich.table import Table
 
@@ -157,13 +160,13 @@ def _bifurcation_table(path: Trace) -> Table:
     bt.add_column("σ_r/σ_1", justify="right")
     bt.add_column("branches")
     bt.add_column("joints (deg)", overflow="fold")
-    for b in path.bifurcations:
+    for b in trace.bifurcations:
         zero = b.sigma[b.rank] / b.sigma[0] if b.rank < len(b.sigma) else 0.0
         what = f"{len(b.tangents)} ({b.method})"
         if b.kind == "component":
             what = f"none: meets a {b.dimension}-dimensional component"
         bt.add_row(
             str(b.id), str(b.branch), str(b.step), str(b.rank), f"{zero:.1e}", what,
-            _joints_text(path.mechanism, b.angles),
+            _joints_text(trace.mechanism, b.angles),
         )  # fmt: skip
     return bt

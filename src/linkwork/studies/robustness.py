@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.deprecation import trace_keyword
 from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
@@ -82,21 +83,22 @@ class ChunkResult:
     drive_max: Array
 
 
+@trace_keyword
 def prepare(
     mech: Mechanism,
-    path: Trace,
+    trace: Trace,
     model: ImperfectionModel,
     seed: int = 0,
 ) -> RobustnessSetup:
-    """The set-up of a study of ``mech`` along the first branch of ``path`` (its nominal motion)."""
+    """The set-up of a study of ``mech`` along the first branch of ``trace`` (its nominal motion)."""
     if model.spatial and mech.planar:
         mech = replace(mech, planar=False)
-    first = path.branch == (path.branches[0].id if path.branches else 0)
-    q = mech.q_from_angles(path.angles[first])
+    first = trace.branch == (trace.branches[0].id if trace.branches else 0)
+    q = mech.q_from_angles(trace.angles[first])
     u_path = np.ascontiguousarray(mech.u_from_q(q))
     if u_path.shape[0] < 1:
         raise SpecError("the nominal path has no points")
-    drive_joint = mech.index(path.drive)
+    drive_joint = mech.index(trace.drive)
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
@@ -111,11 +113,11 @@ def prepare(
         scale=scale,
         u_path=u_path,
         drive=mech.joint_names[drive_joint],
-        drive_values=path.angles[first, drive_joint],
+        drive_values=trace.angles[first, drive_joint],
         drive_unknown=drive_unknown,
         normal=normal,
         G=G,
-        ratio_normalised=path.condition()[first],
+        ratio_normalised=trace.condition()[first],
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,
     )
 
@@ -245,25 +247,27 @@ def run_study(
     return merge_chunks(setup, results, ratio_paper, sink)
 
 
-def nominal_ratio(path: Trace) -> Array:
+@trace_keyword
+def nominal_ratio(trace: Trace) -> Array:
     """``(K,)`` the paper's Sec. 5 ratio at the points of the path's first branch."""
-    first = path.branch == (path.branches[0].id if path.branches else 0)
-    return path.condition_raw()[first]  # the raw ratio, as printed in the paper (condition() is normalised)
+    first = trace.branch == (trace.branches[0].id if trace.branches else 0)
+    return trace.condition_raw()[first]  # the raw ratio, as printed in the paper (condition() is normalised)
 
 
+@trace_keyword
 def robustness(
     mech: Mechanism,
-    path: Trace,
+    trace: Trace,
     model: ImperfectionModel,
     samples: int,
     *,
     seed: int = 0,
     **engine: Any,
 ) -> RobustnessResult:
-    """Monte Carlo of ``samples`` imperfect copies of ``mech`` along the nominal ``path`` (from
+    """Monte Carlo of ``samples`` imperfect copies of ``mech`` along the nominal ``trace`` (from
     :func:`linkwork.trace`), on the Dask engine; ``engine`` are the keywords of :func:`run_study`
     (``scheduler``, ``workers``, ``client``, ``chunk``, ``progress``, ``sink``)."""
     if samples < 1:
         raise SpecError(f"samples must be at least 1, got {samples}")
-    setup = prepare(mech, path, model, seed)
-    return run_study(setup, samples, nominal_ratio(path), **engine)
+    setup = prepare(mech, trace, model, seed)
+    return run_study(setup, samples, nominal_ratio(trace), **engine)

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from linkwork.deprecation import trace_keyword
 from linkwork.errors import LinkworkError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
@@ -43,11 +44,12 @@ class Animation:
     mp4_skipped: str = ""
 
 
-def path_frames(path: Trace, branch: int | None = None, max_frames: int = 120) -> NDArray[np.int64]:
+@trace_keyword
+def path_frames(trace: Trace, branch: int | None = None, max_frames: int = 120) -> NDArray[np.int64]:
     """Indices of the path points to animate: one branch, or every branch in turn (id order), at most
     ``max_frames`` in all, spread over the branches in proportion to their number of points."""
-    branches = sorted({int(b) for b in path.branch}) if branch is None else [branch]
-    orders = [branch_indices(path, b, 0) for b in branches]
+    branches = sorted({int(b) for b in trace.branch}) if branch is None else [branch]
+    orders = [branch_indices(trace, b, 0) for b in branches]
     total = sum(len(o) for o in orders)
     if total == 0:
         raise LinkworkError("the path has no points to animate")
@@ -59,8 +61,9 @@ def path_frames(path: Trace, branch: int | None = None, max_frames: int = 120) -
     return np.concatenate(picks)
 
 
+@trace_keyword
 def animate_path(
-    path: Trace,
+    trace: Trace,
     out_file: str | Path,
     branch: int | None = None,
     fps: int = 20,
@@ -73,7 +76,7 @@ def animate_path(
 
     Parameters
     ----------
-    path
+    trace
         A traced path.
     out_file
         ``name.gif`` (a ``name.mp4`` is written next to it when ffmpeg is available) or ``name.mp4`` (then a GIF
@@ -85,24 +88,24 @@ def animate_path(
     size
         Frame width and height in pixels.
     """
-    idx = path_frames(path, branch, max_frames)
+    idx = path_frames(trace, branch, max_frames)
     labels = []
-    several = len({int(path.branch[i]) for i in idx}) > 1
+    several = len({int(trace.branch[i]) for i in idx}) > 1
     for i in idx:
-        text = drive_label(path, int(i))
-        labels.append(f"branch {int(path.branch[i])}   {text}" if several else text)
+        text = drive_label(trace, int(i))
+        labels.append(f"branch {int(trace.branch[i])}   {text}" if several else text)
     # Steady the drawing on every point of the drawn branches (consecutive points are close), then subsample.
     moves = np.zeros((len(idx), 4, 4))
-    for b in sorted({int(path.branch[i]) for i in idx}):
-        every = branch_indices(path, b, 0)
-        T = steady_transforms(path.mechanism, path.angles[every])
+    for b in sorted({int(trace.branch[i]) for i in idx}):
+        every = branch_indices(trace, b, 0)
+        T = steady_transforms(trace.mechanism, trace.angles[every])
         at = {int(j): k for k, j in enumerate(every)}
         for k, i in enumerate(idx):
-            if int(path.branch[i]) == b:
+            if int(trace.branch[i]) == b:
                 moves[k] = T[at[int(i)]]
     return animate_configurations(
-        path.mechanism,
-        path.angles[idx],
+        trace.mechanism,
+        trace.angles[idx],
         out_file,
         fps=fps,
         labels=labels,

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from linkwork.deprecation import trace_keyword
 from linkwork.errors import LinkworkError
 from linkwork.geometry.fit import kabsch
 from linkwork.kinematics.mechanism import Mechanism
@@ -35,16 +36,17 @@ def default_view(mech: Mechanism) -> tuple[float, float]:
     return VIEWS.get(str(mech.meta.get("linkage", "")), DEFAULT_VIEW)
 
 
-def branch_indices(path: Trace, branch: int, frames: int) -> NDArray[np.int64]:
+@trace_keyword
+def branch_indices(trace: Trace, branch: int, frames: int) -> NDArray[np.int64]:
     """Indices of ``frames`` points of ``branch`` equally spaced in arclength, first and last included (all if 0)."""
-    idx = np.flatnonzero(path.of_branch(branch))
+    idx = np.flatnonzero(trace.of_branch(branch))
     if idx.size == 0:
-        known = sorted({int(b) for b in path.branch})
+        known = sorted({int(b) for b in trace.branch})
         raise LinkworkError(f"no branch {branch} in this path; branches are {known}")
-    order = idx[np.argsort(path.step[idx], kind="stable")]
+    order = idx[np.argsort(trace.step[idx], kind="stable")]
     if frames <= 0:  # every point
         return order
-    s = np.abs(path.arclength[order] - path.arclength[order[0]])
+    s = np.abs(trace.arclength[order] - trace.arclength[order[0]])
     if frames <= 1 or s[-1] <= 0:
         return order[np.linspace(0, len(order) - 1, max(frames, 1)).round().astype(np.int64)]
     targets = np.linspace(0.0, s[-1], frames)
@@ -172,23 +174,25 @@ def bounds(frames: Sequence[Sequence[Mesh]]) -> tuple[Array, Array]:
     return pts.min(axis=0), pts.max(axis=0)
 
 
-def label_joint(path: Trace, branch: int) -> int:
+@trace_keyword
+def label_joint(trace: Trace, branch: int) -> int:
     """The joint to label a branch's frames with: the drive, or, where the drive stays put along the branch
     (Guest's frame leaves its bifurcation at a fixed theta_A), the joint that moves the most."""
-    mech = path.mechanism
-    d = mech.index(path.drive)
-    values = path.angles[path.of_branch(branch)]
+    mech = trace.mechanism
+    d = mech.index(trace.drive)
+    values = trace.angles[trace.of_branch(branch)]
     spans = np.ptp(values, axis=0) if len(values) else np.zeros(mech.n_joints)
     return d if spans[d] > 1e-6 * max(float(spans.max()), 1e-300) else int(np.argmax(spans))
 
 
-def drive_label(path: Trace, i: int, joint: int | None = None) -> str:
+@trace_keyword
+def drive_label(trace: Trace, i: int, joint: int | None = None) -> str:
     """``"theta_A = 12.3°"``: a joint's value at point ``i`` (degrees, or length for a slider); default the
     joint :func:`label_joint` picks for the point's branch."""
-    mech = path.mechanism
-    d = label_joint(path, int(path.branch[i])) if joint is None else joint
+    mech = trace.mechanism
+    d = label_joint(trace, int(trace.branch[i])) if joint is None else joint
     name = mech.joint_names[d]
-    value = path.angles[i, d]
+    value = trace.angles[i, d]
     from linkwork.viz.labels import number
 
     if mech.joint_types[d] == "P":
@@ -196,8 +200,9 @@ def drive_label(path: Trace, i: int, joint: int | None = None) -> str:
     return f"{subscript(chr(92) + 'theta', name)} = {number(np.degrees(value), '.1f')}°"
 
 
+@trace_keyword
 def deployment_sequence(
-    path: Trace,
+    trace: Trace,
     out_file: str | Path,
     frames: int = 6,
     branch: int = 0,
@@ -212,14 +217,14 @@ def deployment_sequence(
 
     Parameters
     ----------
-    path
-        A traced path (:func:`linkwork.kinematics.tracer.trace`).
+    trace
+        The traced result (:func:`linkwork.kinematics.tracer.trace`).
     out_file
         The figure; PNG, SVG or PDF by its suffix.
     frames
         Number of panels, equally spaced in arclength along the branch.
     branch
-        Which branch of ``path`` to draw.
+        Which branch of ``trace`` to draw.
     view
         Camera ``(elevation, azimuth)`` in degrees, the same in every panel (default per linkage style).
 
@@ -232,15 +237,15 @@ def deployment_sequence(
     out = Path(out_file)
     if out.suffix.lower() not in {".png", ".svg", ".pdf"}:
         raise LinkworkError(f"deployment_sequence writes .png, .svg or .pdf, got {out.name!r}")
-    mech = path.mechanism
+    mech = trace.mechanism
     view = view or default_view(mech)
-    idx = branch_indices(path, branch, frames)
-    every = branch_indices(path, branch, 0)  # the whole branch in order, for a steady fit
-    moves = steady_transforms(mech, path.angles[every])
+    idx = branch_indices(trace, branch, frames)
+    every = branch_indices(trace, branch, 0)  # the whole branch in order, for a steady fit
+    moves = steady_transforms(mech, trace.angles[every])
     at = {int(i): k for k, i in enumerate(every)}
     posed = [
         [m.transformed(moves[at[int(i)]]) for m in frame]
-        for i, frame in zip(idx, configuration_meshes(mech, path.angles[idx], steady=False), strict=True)
+        for i, frame in zip(idx, configuration_meshes(mech, trace.angles[idx], steady=False), strict=True)
     ]
     low, high = bounds(posed)
     cols = columns or min(len(idx), 3)
@@ -250,7 +255,7 @@ def deployment_sequence(
         ax = fig.add_subplot(rows, cols, k + 1, projection="3d")
         draw_meshes(ax, meshes, view)
         set_limits(ax, low, high, view)
-        ax.set_title(f"({chr(ord('a') + k)}) " + drive_label(path, int(i)), fontsize=9, pad=-2)
+        ax.set_title(f"({chr(ord('a') + k)}) " + drive_label(trace, int(i)), fontsize=9, pad=-2)
     if title:
         fig.suptitle(plain(title), fontsize=10)
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.93 if title else 0.97, wspace=0.0, hspace=0.08)

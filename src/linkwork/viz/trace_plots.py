@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from linkwork.deprecation import trace_keyword
 from linkwork.kinematics.trace_result import Trace
 from linkwork.viz.labels import plain
 
@@ -18,19 +19,21 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-def branch_degrees(path: Trace, mask: np.ndarray) -> np.ndarray:
+@trace_keyword
+def branch_degrees(trace: Trace, mask: np.ndarray) -> np.ndarray:
     """Joint values of the points ``mask`` for plotting: revolute joints in degrees wrapped into [-180, 180)
     (:func:`linkwork.geometry.angles.wrap`), prismatic joints as they are. Guest's 13 branches, which turn
     hinges through whole revolutions, stay in one window."""
-    return display_degrees(path, path.angles[mask])
+    return display_degrees(trace, trace.angles[mask])
 
 
-def display_degrees(path: Trace, values: np.ndarray) -> np.ndarray:
+@trace_keyword
+def display_degrees(trace: Trace, values: np.ndarray) -> np.ndarray:
     """``values`` (radians, ``(..., n)``) with the revolute joints wrapped into [-180, 180) deg."""
     from linkwork.geometry.angles import wrap
 
     out = np.array(values, dtype=float)
-    revolute = np.array([t == "R" for t in path.mechanism.joint_types])
+    revolute = np.array([t == "R" for t in trace.mechanism.joint_types])
     out[..., revolute] = np.degrees(wrap(out[..., revolute]))
     return out
 
@@ -50,24 +53,26 @@ def _save(fig: Figure, file: Path) -> Path:
     return Path(file)
 
 
-def plot_angles(path: Trace, file: Path) -> Path:
+@trace_keyword
+def plot_angles(trace: Trace, file: Path) -> Path:
     """Write :func:`angles_figure` to ``file`` (PNG) and next to it as SVG; returns ``file``."""
-    return _save(angles_figure(path), file)
+    return _save(angles_figure(trace), file)
 
 
-def angles_figure(path: Trace) -> Figure:
+@trace_keyword
+def angles_figure(trace: Trace) -> Figure:
     """Every hinge angle against the drive angle, one colour per joint, one line style per branch."""
     import matplotlib
     from matplotlib.figure import Figure
 
-    mech = path.mechanism
-    d = mech.index(path.drive)
+    mech = trace.mechanism
+    d = mech.index(trace.drive)
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     ax = fig.subplots()
     colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     styles = ["-", "--", ":", "-."]
-    for br in path.branches:
-        deg = branch_degrees(path, path.of_branch(br.id))
+    for br in trace.branches:
+        deg = branch_degrees(trace, trace.of_branch(br.id))
         for j, name in enumerate(mech.joint_names):
             if j == d:
                 continue
@@ -80,40 +85,42 @@ def angles_figure(path: Trace) -> Figure:
                 alpha=1.0 if br.id == 0 else 0.45,
                 label=f"θ{plain(name)}" if br.id == 0 else None,
             )
-    for b in path.bifurcations:
-        a = display_degrees(path, b.angles)
+    for b in trace.bifurcations:
+        a = display_degrees(trace, b.angles)
         ax.plot(np.full(len(a) - 1, a[d]), np.delete(a, d), "ko", ms=4)
-    ax.set_xlabel(f"θ{plain(str(path.drive))} (deg, wrapped to [-180, 180))")
+    ax.set_xlabel(f"θ{plain(str(trace.drive))} (deg, wrapped to [-180, 180))")
     ax.set_ylabel("hinge angle (deg, wrapped to [-180, 180))")
     title = f"{plain(mech.name)}: hinge angles"
-    if len(path.branches) > 1:
-        title += f" ({len(path.branches)} branches, {len(path.bifurcations)} bifurcation points ●)"
+    if len(trace.branches) > 1:
+        title += f" ({len(trace.branches)} branches, {len(trace.bifurcations)} bifurcation points ●)"
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(ncol=2, fontsize=8)
     return fig
 
 
-def plot_singular_values(path: Trace, file: Path, branch: int = 0) -> Path:
+@trace_keyword
+def plot_singular_values(trace: Trace, file: Path, branch: int = 0) -> Path:
     """Write :func:`singular_values_figure` to ``file`` (PNG) and next to it as SVG; returns ``file``."""
-    return _save(singular_values_figure(path, branch), file)
+    return _save(singular_values_figure(trace, branch), file)
 
 
-def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
+@trace_keyword
+def singular_values_figure(trace: Trace, branch: int = 0) -> Figure:
     """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
     from matplotlib.figure import Figure
 
     from linkwork.viz.labels import number
 
-    mech = path.mechanism
-    d = mech.index(path.drive)
-    mask = path.of_branch(branch)
-    x = branch_degrees(path, mask)[:, d]
-    s = path.sigma[mask]
+    mech = trace.mechanism
+    d = mech.index(trace.drive)
+    mask = trace.of_branch(branch)
+    x = branch_degrees(trace, mask)[:, d]
+    s = trace.sigma[mask]
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     axes = fig.subplots(1, 2)
-    steps = path.step[mask]
-    rank = int(path.stats.get("start_rank", s.shape[1]))
+    steps = trace.step[mask]
+    rank = int(trace.stats.get("start_rank", s.shape[1]))
     # Left: the non-zero singular values on a linear scale against the step (as the paper's Fig. 15);
     # right: all of them on a log scale, the null ones at round-off.
     for i in range(min(rank, s.shape[1])):
@@ -125,12 +132,12 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
     unit = "°" if mech.joint_types[d] == "R" else ""
     span = float(np.ptp(x)) if len(x) else 1.0
     low, high = (number(v, scale=max(span, 1.0)) for v in (x[0], x[-1]))
-    axes[1].set_xlabel(f"step (θ{plain(str(path.drive))} from {low}{unit} to {high}{unit})")
+    axes[1].set_xlabel(f"step (θ{plain(str(trace.drive))} from {low}{unit} to {high}{unit})")
     axes[1].set_ylim(1e-17, None)
     for ax in axes:
         ax.set_ylabel("singular value (1 and length per rad)")
         ax.grid(alpha=0.3, which="both")
-    for b in path.bifurcations:
+    for b in trace.bifurcations:
         if b.branch == branch:
             axes[0].axvline(b.step, color="k", lw=0.8, ls="--")
             axes[1].axvline(b.step, color="k", lw=0.8, ls="--")
@@ -139,7 +146,8 @@ def singular_values_figure(path: Trace, branch: int = 0) -> Figure:
     return fig
 
 
-def plot_points(path: Trace, file: Path) -> Path:
+@trace_keyword
+def plot_points(trace: Trace, file: Path) -> Path:
     """Paths of the named points (a four-bar's coupler curve) and of the joints in the plane, and the transmission
     angle against the drive angle when the mechanism declares one."""
     import matplotlib
@@ -149,8 +157,8 @@ def plot_points(path: Trace, file: Path) -> Path:
 
     from linkwork.kinematics.points import named_points, positions, transmission_angles
 
-    mech = path.mechanism
-    joints, named = positions(mech, path.angles)
+    mech = trace.mechanism
+    joints, named = positions(mech, trace.angles)
     mu = transmission_angles(mech, joints)
     fig, axes = plt.subplots(
         1, 2 if mu is not None else 1, figsize=(10.0, 4.4), layout="constrained", squeeze=False
@@ -169,12 +177,12 @@ def plot_points(path: Trace, file: Path) -> Path:
         ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     if mu is not None:
-        d = mech.index(path.drive)
-        for br in path.branches:
-            mask = path.of_branch(br.id)
-            axes[0, 1].plot(np.degrees(path.angles[mask, d]), np.degrees(mu[mask]), lw=1.4)
+        d = mech.index(trace.drive)
+        for br in trace.branches:
+            mask = trace.of_branch(br.id)
+            axes[0, 1].plot(np.degrees(trace.angles[mask, d]), np.degrees(mu[mask]), lw=1.4)
         axes[0, 1].axhline(40.0, color="k", lw=0.8, ls="--", label="40 deg, a common lower limit")
-        axes[0, 1].set_xlabel(f"θ{path.drive} (deg)")
+        axes[0, 1].set_xlabel(f"θ{trace.drive} (deg)")
         axes[0, 1].set_ylabel("transmission angle (deg)")
         axes[0, 1].set_title("transmission angle", fontsize=10)
         axes[0, 1].legend(fontsize=8)
@@ -186,11 +194,15 @@ def plot_points(path: Trace, file: Path) -> Path:
     return Path(file)
 
 
-def write_trace_figures(path: Trace, out: Path) -> list[Path]:
+@trace_keyword
+def write_trace_figures(trace: Trace, out: Path) -> list[Path]:
     """All trace figures into folder ``out``; returns the PNG paths (``points.png`` for a planar mechanism or one
     with named points)."""
     out = Path(out)
-    figures = [plot_angles(path, out / "angles.png"), plot_singular_values(path, out / "singular_values.png")]
-    if path.mechanism.planar or path.mechanism.meta.get("points"):
-        figures.append(plot_points(path, out / "points.png"))
+    figures = [
+        plot_angles(trace, out / "angles.png"),
+        plot_singular_values(trace, out / "singular_values.png"),
+    ]
+    if trace.mechanism.planar or trace.mechanism.meta.get("points"):
+        figures.append(plot_points(trace, out / "points.png"))
     return figures

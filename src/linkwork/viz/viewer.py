@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.deprecation import trace_keyword
 from linkwork.geometry.angles import wrap
 from linkwork.io.results import file_units
 from linkwork.kinematics.closure import body_poses
@@ -169,7 +170,7 @@ def _bounds(parts: list[Part], poses: NDArray[np.float64], shift: NDArray[np.flo
 # ----------------------------------------------------------------------------------------------- trace viewer
 
 
-def _steady_rows(path: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[np.float64]:
+def _steady_rows(trace: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[np.float64]:
     """``(N, 12)`` per point sent to the page, the rigid motion of the whole mechanism that keeps the drawing
     steady (rotation rows, then translation): each branch fitted point by point
     (:func:`linkwork.viz.snapshots.follow`), a branch leaving a bifurcation point starting from the pose its
@@ -177,20 +178,20 @@ def _steady_rows(path: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[np
     mechanism (a body called ``ground``) is held by its ground: no motion at all."""
     from linkwork.viz.snapshots import follow, leveling, mesh_clouds
 
-    mech = path.mechanism
+    mech = trace.mechanism
     if "ground" in mech.bodies:
         count = sum(len(idx) for idx in per_branch)
         return np.tile(np.array([1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0, 0, 0, 0]), (count, 1))
     revolute = np.array([t == "R" for t in mech.joint_types])
-    index = {br.id: bi for bi, br in enumerate(path.branches)}
+    index = {br.id: bi for bi, br in enumerate(trace.branches)}
     done: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}  # branch index -> (clouds, moves)
     for bi, idx in enumerate(per_branch):
-        clouds = mesh_clouds(mech, path.angles[idx])
+        clouds = mesh_clouds(mech, trace.angles[idx])
         reference = None
-        parent = path.branches[bi].parent
+        parent = trace.branches[bi].parent
         if parent is not None and index.get(parent) in done and len(idx):
             pbi = index[parent]
-            d = _difference(path.angles[per_branch[pbi]], path.angles[idx[0]], revolute)
+            d = _difference(trace.angles[per_branch[pbi]], trace.angles[idx[0]], revolute)
             k = int(np.argmin(np.linalg.norm(d, axis=1)))
             p_clouds, p_moves = done[pbi]
             reference = p_clouds[k] @ p_moves[k][:3, :3].T + p_moves[k][:3, 3]
@@ -212,13 +213,13 @@ def _compose(steady: NDArray[np.float64], poses: NDArray[np.float64]) -> NDArray
     return out
 
 
-def _kept_points(path: Trace, max_points: int, must: set[int]) -> list[NDArray[np.int64]]:
+def _kept_points(trace: Trace, max_points: int, must: set[int]) -> list[NDArray[np.int64]]:
     """Per branch, the indices of its points sent to the page, in path order: all of them, or thinned evenly
     when the path has more than ``max_points`` (ends and the points in ``must`` kept)."""
-    n = len(path.branch)
+    n = len(trace.branch)
     out = []
-    for br in path.branches:
-        idx = np.flatnonzero(path.of_branch(br.id))
+    for br in trace.branches:
+        idx = np.flatnonzero(trace.of_branch(br.id))
         if n > max_points and len(idx) > 2:
             share = max(2, round(max_points * len(idx) / n))
             chosen = set(idx[np.unique(np.linspace(0, len(idx) - 1, share).round().astype(int))].tolist())
@@ -241,48 +242,49 @@ def _same(a: NDArray[np.float64], b: NDArray[np.float64], revolute: NDArray[np.b
     return np.all(np.abs(_difference(a, b, revolute)) < SAME_POINT, axis=1)
 
 
-def _visits(path: Trace, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArray[np.int64]:
+def _visits(trace: Trace, bif: Bifurcation, revolute: NDArray[np.bool_]) -> NDArray[np.int64]:
     """Indices of the points at a bifurcation point: where branches leave or reach it, and the point of the
     branch it was found on at its step (the point is located between two steps, not inserted into it)."""
-    same = set(np.flatnonzero(_same(path.angles, bif.angles, revolute)).tolist())
-    on = np.flatnonzero(path.of_branch(bif.branch) & (path.step == bif.step))
+    same = set(np.flatnonzero(_same(trace.angles, bif.angles, revolute)).tolist())
+    on = np.flatnonzero(trace.of_branch(bif.branch) & (trace.step == bif.step))
     same |= set(on[:1].tolist())
-    for br in path.branches:
+    for br in trace.branches:
         if br.bifurcation == bif.id:
-            same |= set(np.flatnonzero(path.of_branch(br.id))[:1].tolist())
+            same |= set(np.flatnonzero(trace.of_branch(br.id))[:1].tolist())
     return np.array(sorted(same), dtype=np.int64)
 
 
+@trace_keyword
 def trace_viewer_data(
-    path: Trace, *, title: str | None = None, max_points: int = MAX_POINTS
+    trace: Trace, *, title: str | None = None, max_points: int = MAX_POINTS
 ) -> dict[str, Any]:
     """Everything the trace viewer page shows, as JSON-ready data (angles in degrees).
 
     Parameters
     ----------
-    path
+    trace
         A traced path, one branch or several.
     title
         Heading of the page; the mechanism's name by default.
     max_points
         Above this many points, each branch is thinned evenly (its ends and bifurcation points are kept).
     """
-    mech = path.mechanism
+    mech = trace.mechanism
     revolute = np.array([t == "R" for t in mech.joint_types])
     # Every place the path passes through each bifurcation point: where it was found, where branches leave
     # it and where branches end on it. The page offers a jump between them.
-    visits_all = [_visits(path, b, revolute) for b in path.bifurcations]
-    per_branch = _kept_points(path, max_points, {int(i) for v in visits_all for i in v})
+    visits_all = [_visits(trace, b, revolute) for b in trace.bifurcations]
+    per_branch = _kept_points(trace, max_points, {int(i) for v in visits_all for i in v})
     keep = np.concatenate(per_branch) if per_branch else np.zeros(0, dtype=np.int64)
     parts = linkage_parts(mech)
-    poses = _pose_rows(mech, path.angles[keep])
+    poses = _pose_rows(mech, trace.angles[keep])
     centres = _centres(parts, poses)
-    steady = _steady_rows(path, per_branch)
+    steady = _steady_rows(trace, per_branch)
     return {
         "kind": "trace",
         "title": title or mech.name,
         "mechanism": mech.name,
-        "drive": mech.index(path.drive) if path.drive in mech.joint_names else 0,
+        "drive": mech.index(trace.drive) if trace.drive in mech.joint_names else 0,
         "planar": bool(mech.planar),
         "joints": _joint_entries(mech, joint_labels(mech, parts)),
         "bodies": list(mech.bodies),
@@ -295,17 +297,17 @@ def trace_viewer_data(
         "centres": _packed(centres, "f4"),
         "steady": _packed(steady, "f4"),
         "points": len(keep),
-        "points_traced": len(path.branch),
+        "points_traced": len(trace.branch),
         "poses": _packed(poses, "f4"),
-        "angles": _packed(file_units(mech, path.angles[keep]), "f4"),
-        "sigma": _packed(path.sigma[keep], "f8"),
-        "rank": _packed(path.rank[keep], "i4"),
-        "step": _packed(path.step[keep], "i4"),
-        "arclength": _packed(np.degrees(path.arclength[keep]), "f4"),
-        "residual": _packed(path.residual[keep], "f4"),
+        "angles": _packed(file_units(mech, trace.angles[keep]), "f4"),
+        "sigma": _packed(trace.sigma[keep], "f8"),
+        "rank": _packed(trace.rank[keep], "i4"),
+        "step": _packed(trace.step[keep], "i4"),
+        "arclength": _packed(np.degrees(trace.arclength[keep]), "f4"),
+        "residual": _packed(trace.residual[keep], "f4"),
         "unknowns": mech.n_unknowns,
-        "branches": _branch_entries(path, per_branch),
-        "bifurcations": _bifurcation_entries(path, visits_all, per_branch),
+        "branches": _branch_entries(trace, per_branch),
+        "bifurcations": _bifurcation_entries(trace, visits_all, per_branch),
     }
 
 
@@ -335,7 +337,7 @@ def _part_entry(part: Part) -> dict[str, Any]:
     }
 
 
-def _branch_entries(path: Trace, per_branch: list[NDArray[np.int64]]) -> list[dict[str, Any]]:
+def _branch_entries(trace: Trace, per_branch: list[NDArray[np.int64]]) -> list[dict[str, Any]]:
     """Per branch: how it was found and ended, and which run of the page's points (``start``, ``count``) it is."""
     starts = np.cumsum([0] + [len(idx) for idx in per_branch])
     return [
@@ -349,12 +351,12 @@ def _branch_entries(path: Trace, per_branch: list[NDArray[np.int64]]) -> list[di
             "start": int(starts[bi]),
             "count": len(per_branch[bi]),
         }
-        for bi, br in enumerate(path.branches)
+        for bi, br in enumerate(trace.branches)
     ]
 
 
 def _bifurcation_entries(
-    path: Trace, visits_all: list[NDArray[np.int64]], per_branch: list[NDArray[np.int64]]
+    trace: Trace, visits_all: list[NDArray[np.int64]], per_branch: list[NDArray[np.int64]]
 ) -> list[dict[str, Any]]:
     """Per bifurcation point: where it was found, its rank and tangents, its angles in file units, and its visits
     as ``[branch index, row within the branch]`` among the page's points."""
@@ -367,15 +369,16 @@ def _bifurcation_entries(
             "rank": b.rank,
             "method": b.method,
             "tangents": len(b.tangents),
-            "angles": file_units(path.mechanism, b.angles).tolist(),
+            "angles": file_units(trace.mechanism, b.angles).tolist(),
             "visits": [list(where[int(k)]) for k in visits if int(k) in where],
         }
-        for b, visits in zip(path.bifurcations, visits_all, strict=True)
+        for b, visits in zip(trace.bifurcations, visits_all, strict=True)
     ]
 
 
+@trace_keyword
 def write_trace_viewer(
-    path: Trace, file: str | Path, *, title: str | None = None, max_points: int = MAX_POINTS
+    trace: Trace, file: str | Path, *, title: str | None = None, max_points: int = MAX_POINTS
 ) -> Path:
     """Write the interactive viewer of a traced path: one self-contained HTML file that works offline.
 
@@ -386,7 +389,7 @@ def write_trace_viewer(
 
     Parameters
     ----------
-    path
+    trace
         A traced path (:func:`linkwork.trace`).
     file
         The HTML file to write (its folder is created).
@@ -399,12 +402,13 @@ def write_trace_viewer(
     -------
     The path of the file written.
     """
-    return _write(file, trace_viewer_page(path, title=title, max_points=max_points))
+    return _write(file, trace_viewer_page(trace, title=title, max_points=max_points))
 
 
-def trace_viewer_page(path: Trace, *, title: str | None = None, max_points: int = MAX_POINTS) -> str:
+@trace_keyword
+def trace_viewer_page(trace: Trace, *, title: str | None = None, max_points: int = MAX_POINTS) -> str:
     """The HTML text of :func:`write_trace_viewer`'s page (for an inline view in a notebook)."""
-    return _trace_page(trace_viewer_data(path, title=title, max_points=max_points))
+    return _trace_page(trace_viewer_data(trace, title=title, max_points=max_points))
 
 
 def _trace_page(data: dict[str, Any]) -> str:
