@@ -72,17 +72,17 @@ def _hexagon(out: Path, plots: bool) -> Section:
     _heading("1. Hedgepeth's deployable hexagon (Gan & Pellegrino 2006, Sec. 5, Figs. 12-13)")
     hexagon = lw.load("hedgepeth-rods", n=6)
     inner, outer = deployed_angles(6)
-    path = lw.trace(hexagon, until=("A", inner), steps=200)
-    figs = write_trace_outputs(path, out / "hexagon", plots=plots, html=True, animate=plots)
-    print_trace_summary(path)
-    a = np.degrees(path.angles[-1])
+    traced = lw.trace(hexagon, until=("A", inner), steps=200)
+    figs = write_trace_outputs(traced, out / "hexagon", plots=plots, html=True, animate=plots)
+    print_trace_summary(traced)
+    a = np.degrees(traced.angles[-1])
     return Section(
         "Hedgepeth's hexagon (Sec. 5, Figs. 12-13): from the bundle to the flat hexagon",
         f"The hoop built from its six mitred triangular rods, in 200 equal steps of θA from the folded "
         f"bundle to the flat hexagon; no symmetry imposed, and A = C = E = {a[0]:.4f}°, "
         f"B = D = F = {a[1]:.4f}° at the end (closed form {np.degrees(inner):.4f}° and "
         f"{np.degrees(outer):.4f}°; max |A - C| along the path "
-        f"{np.degrees(np.abs(path.angles[:, 0] - path.angles[:, 2]).max()):.1e}°). Eq. (10)'s 87.0067° "
+        f"{np.degrees(np.abs(traced.angles[:, 0] - traced.angles[:, 2]).max()):.1e}°). Eq. (10)'s 87.0067° "
         "cannot be a flat hexagon: see docs/linkages.md.",
         out / "hexagon",
         [f.name for f in figs],
@@ -95,14 +95,14 @@ def _guest_frame(out: Path, plots: bool) -> Section:
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
 
     _heading("2. Guest's rectangular frame: bifurcations and every branch (Sec. 6, Figs. 15-16)")
-    path = lw.trace(lw.load("guest-frame"), branches=True, max_steps=6000)
-    figs = write_trace_outputs(path, out / "guest-frame", plots=plots, html=True, animate=plots)
-    print_trace_summary(path)
-    lowest = min((b.rank for b in path.bifurcations), default=path.stats["start_rank"])
+    traced = lw.trace(lw.load("guest-frame"), branches=True, max_steps=6000)
+    figs = write_trace_outputs(traced, out / "guest-frame", plots=plots, html=True, animate=plots)
+    print_trace_summary(traced)
+    lowest = min((b.rank for b in traced.bifurcations), default=traced.stats["start_rank"])
     return Section(
         "Guest's frame, every branch",
-        f"{len(path.bifurcations)} bifurcation points (rank {path.stats['start_rank']} → {lowest}) and "
-        f"{len(path.branches)} traced branches.",
+        f"{len(traced.bifurcations)} bifurcation points (rank {traced.stats['start_rank']} → {lowest}) and "
+        f"{len(traced.branches)} traced branches.",
         out / "guest-frame",
         [f.name for f in figs],
     )

@@ -81,8 +81,8 @@ def robustness(
         distribution=distribution,
         spatial=spatial_errors or not mech.planar,
     )
-    path = _nominal_path(mech, until_in_api_units(mech, target), steps, max_steps)
-    setup = prepare(mech, path, model, seed)
+    nominal = _nominal_path(mech, until_in_api_units(mech, target), steps, max_steps)
+    setup = prepare(mech, nominal, model, seed)
     console.print(
         Text(mech.name, style="bold"),
         f"nominal path of {setup.u_path.shape[0]} points; {samples} samples "
@@ -99,7 +99,7 @@ def robustness(
         result, figures = run_and_write_robustness(
             setup,
             samples,
-            nominal_ratio(path),
+            nominal_ratio(nominal),
             out,
             source=spec,
             plots=not no_plots,
@@ -110,7 +110,7 @@ def robustness(
     written = ["robustness.json", "samples.parquet", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
     if target is not None:
-        _check_reached(mech, path, float(setup.drive_values[-1]), target)
+        _check_reached(mech, nominal, float(setup.drive_values[-1]), target)
 
 
 def _check_counts(samples: int, seed: int, workers: int | None) -> None:
@@ -141,10 +141,10 @@ def _nominal_path(
     from linkwork.errors import SpecError
     from linkwork.kinematics.tracer import trace as run_trace
 
-    path = run_trace(mech, until=until, steps=steps, max_steps=max_steps)
-    if path.angles.shape[0] < 2:
+    nominal = run_trace(mech, until=until, steps=steps, max_steps=max_steps)
+    if nominal.angles.shape[0] < 2:
         raise SpecError("the nominal path has a single point; give --until or a longer budget")
-    return path
+    return nominal
 
 
 def _check_reached(mech: Mechanism, trace: Trace, last: float, target: tuple[str, float]) -> None:

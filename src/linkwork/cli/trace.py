@@ -153,19 +153,19 @@ def trace(
             f"start corrected onto the loop: residual {loaded.assembly.residual_before:.2e} -> "
             f"{loaded.assembly.residual_after:.2e}, joints moved by up to {worst:.3g} deg"
         )
-    path = _run_with_progress(
+    traced = _run_with_progress(
         run_trace, mech, total=steps if steps is not None else max_steps, drive=drive, until=until_rad,
         steps=steps, max_step=float(np.radians(max_step)), max_steps=max_steps, branches=branches, limits=limits,
         closure_tol=closure_tol,
     )  # fmt: skip
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
 
-    figures = write_trace_outputs(path, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
-    print_trace_summary(path)
+    figures = write_trace_outputs(traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
+    print_trace_summary(traced)
     written = ["path.csv", "report.json", "points.csv", "mechanism.toml", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
-    if "unmet" in path.stats:
-        raise RequestNotMetError(str(path.stats["unmet"]))
+    if "unmet" in traced.stats:
+        raise RequestNotMetError(str(traced.stats["unmet"]))
 
 
 def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:
