@@ -160,7 +160,9 @@ def trace(
     )  # fmt: skip
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
 
-    figures = write_trace_outputs(traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate)
+    figures = write_trace_outputs(
+        traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate
+    )
     print_trace_summary(traced)
     written = ["path.csv", "report.json", "points.csv", "mechanism.toml", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
