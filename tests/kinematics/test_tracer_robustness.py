@@ -270,3 +270,47 @@ def test_a_branch_that_runs_on_the_sarrus_sheet_ends_once_as_a_component() -> No
     assert steps <= Tolerances().component_points
     assert 1 <= len(marcher.found) <= 2 and not marcher.queue  # no chain of points, no branch switching
     assert all(p.kind == "component" and p.dimension == 2 for p in marcher.found)
+
+
+def _wrapped_distances(x: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Distances (angles compared modulo a full turn) from ``x`` to every row of ``points``."""
+    diff = (x - points + np.pi) % (2.0 * np.pi) - np.pi
+    return np.linalg.norm(diff, axis=1)
+
+
+@pytest.mark.parametrize("name", ["guest-frame", "sarrus", "bricard-threefold"])
+def test_every_arc_of_the_branch_graph_is_traced_once(name: str) -> None:
+    """A branch never runs back along an arc already traced (the other way round): apart from the points it
+    starts and ends at, no point of a branch lies on another branch, and each point where the motion branches is
+    left along every one of its tangents by some traced point next to it."""
+    mech = lw.load(name)
+    tr = trace(mech, branches=True)
+    for br in tr.branches:
+        mine = tr.angles[tr.of_branch(br.id)]
+        others = tr.angles[~tr.of_branch(br.id)]
+        if len(others) == 0:
+            continue
+        near = np.array([_wrapped_distances(x, others).min() for x in mine]) < 1e-2
+        assert near[2:-2].mean() < 0.02, (br.id, near.mean())  # only the ends are shared
+    for bif in tr.bifurcations:
+        if bif.kind != "bifurcation":
+            continue
+        for t in bif.tangents_u:
+            for sign in (1.0, -1.0):  # both ways along each tangent there is a traced point
+                probe = mech.angles_from_q(mech.q_from_u(bif.u + sign * 0.05 * t))
+                away = _wrapped_distances(probe, bif.angles[None, :])[
+                    0
+                ]  # how far the probe is from the point
+                assert _wrapped_distances(probe, tr.angles).min() < 0.5 * away, (bif.id, sign)
+    assert tr.stats["branches_not_retraced"] >= 0
+
+
+def test_the_threefold_bricard_loop_is_one_branch_through_its_point_twice() -> None:
+    """Both motion modes of the threefold Bricard loop cross at all joints = 180 deg, and one closed path runs
+    through that point twice (its joints turn twice round): the branch graph is that one branch."""
+    tr = trace(lw.load("bricard-threefold"), branches=True)
+    assert [b.kind for b in tr.bifurcations] == ["bifurcation"]
+    assert len(tr.branches) == 1 and tr.branches[0].end_reason == "closed path"
+    a = np.degrees(tr.angles[:, 0])
+    assert a.max() - a.min() > 700.0  # joint A turns twice: once along each mode
+    assert tr.stats["branches_not_retraced"] == 2

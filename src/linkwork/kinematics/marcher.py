@@ -131,6 +131,8 @@ class BranchMarcher:
         self.queue: list[QueuedBranch] = []
         self.max_misfit = 0.0
         self.spurious = 0
+        self.arrivals: list[tuple[int, Array]] = []  # (point id, unit direction a traced branch arrived in)
+        self.retraced = 0  # queued branches not traced: an arc already traced, run the other way
 
     # ---- one compiled call
     def march_chunk(
@@ -210,6 +212,8 @@ class BranchMarcher:
                 if known is not None and stop_at_known:
                     self._end_on_known(chunk, known)
                     return n_steps, f"reached bifurcation {known}"
+                if known is not None:  # through a known point and on: the arcs on both sides are traced
+                    self._passed(known, chunk)
             elif chunk.code == CLOSED and self._turns_towards_target(chunk, u_home):
                 # A full turn of the drive: the target is further round.
                 u_home = chunk.u[chunk.count - 1].copy()
@@ -407,6 +411,29 @@ class BranchMarcher:
         rows.sigma[-1][-1] = np.linalg.svd(j_known, compute_uv=False)[: self.cfg.n_sigma]
         rows.res[-1][-1] = r_known
         rows.tau[-1][-1] = 0.0
+        self._arrived(known, diff)
+
+    def _arrived(self, point: int, direction: Array) -> None:
+        """Note that a traced branch came into located point ``point`` moving along ``direction`` (unknowns)."""
+        norm = float(np.linalg.norm(direction))
+        if norm > 0.0:
+            self.arrivals.append((point, direction / norm))
+
+    def _passed(self, point: int, chunk: Chunk) -> None:
+        """Note that the branch of ``chunk`` went through located point ``point`` along its last step."""
+        step = chunk.u[chunk.count - 1] - chunk.u[chunk.count - 2]
+        step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
+        self._arrived(point, step)
+        self._arrived(point, -step)
+
+    def _traced_already(self, job: QueuedBranch) -> bool:
+        """Whether leaving ``job``'s point along its tangent runs back along an arc a traced branch arrived by: the
+        same arc the other way round (a closed mode through the point, or the arc between two located points)."""
+        tangent = job.tangent / np.linalg.norm(job.tangent)
+        return any(
+            point == job.bifurcation and float(direction @ tangent) < -self.cfg.tol.same_branch
+            for point, direction in self.arrivals
+        )
 
     def _basis_before(self, u: Array, t: Array, basis_prev: Array) -> Array:
         """The oriented range basis at point ``u`` (as the march kept it), recomputed for the locator."""
@@ -433,6 +460,9 @@ class BranchMarcher:
         cfg = self.cfg
         while self.queue and self.budget > 0:
             job = self.queue.pop(0)
+            if self._traced_already(job):
+                self.retraced += 1
+                continue
             bid = len(self.branches)
             h = cfg.max_step / 4.0
             u1, _r, ok = correct_on_plane(self.ws, job.u + h * job.tangent, job.tangent, cfg.tol)
@@ -457,4 +487,9 @@ class BranchMarcher:
             for i in range(start_len, len(self.rows.u)):
                 self.rows.s[i] = self.rows.s[i] + s_off
                 self.rows.step[i] = self.rows.step[i] + 1
+            if rb == STOP_REASONS[CLOSED]:  # back round to where it left its point: a closed mode through it
+                block = self.rows.u[-1]
+                step = block[-1] - (block[-2] if len(block) > 1 else self.rows.u[-2][-1])
+                step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
+                self._arrived(job.bifurcation, step)
             self.branches.append(Branch(bid, job.parent, job.bifurcation, job.direction, nb + 1, rb))

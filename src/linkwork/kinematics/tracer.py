@@ -213,6 +213,7 @@ def _assemble(
         "closure_tol": tol.closure,
         "max_misfit": float(max(marcher.max_misfit, float(np.max(np.concatenate(rows.res))))),
         "sign_changes_without_rank_drop": marcher.spurious,
+        "branches_not_retraced": marcher.retraced,
     }
     stats["has_target"] = until is not None
     if until is not None:

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 @trace_keyword
 def branch_degrees(trace: Trace, mask: np.ndarray) -> np.ndarray:
     """Joint values of the points ``mask`` for plotting: revolute joints in degrees wrapped into [-180, 180)
-    (:func:`linkwork.geometry.angles.wrap`), prismatic joints as they are. Guest's 13 branches, which turn
+    (:func:`linkwork.geometry.angles.wrap`), prismatic joints as they are. Guest's 7 branches, which turn
     hinges through whole revolutions, stay in one window."""
     return display_degrees(trace, trace.angles[mask])
 
