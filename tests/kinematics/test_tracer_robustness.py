@@ -314,3 +314,27 @@ def test_the_threefold_bricard_loop_is_one_branch_through_its_point_twice() -> N
     a = np.degrees(tr.angles[:, 0])
     assert a.max() - a.min() > 700.0  # joint A turns twice: once along each mode
     assert tr.stats["branches_not_retraced"] == 2
+
+
+@pytest.mark.parametrize(
+    "links", [(2.0, 1.0, 2.5, 1.5), (2.5, 1.0, 2.0, 1.5)], ids=["crank-shortest", "crank-and-ground-long"]
+)
+def test_a_change_point_four_bar_has_its_bifurcation_where_the_links_are_collinear(links) -> None:
+    """Grashof's change point (s + l = p + q): the two circuits cross where all four pivots lie on one line. The
+    located point must be that configuration (checked on the pivots' positions, not on the tracer's numbers), with
+    two branch tangents; the path crosses it on both circuits, so no other branch is left to trace."""
+    ground, crank, coupler, rocker = links
+    assert min(links) + max(links) == pytest.approx(sum(links) - min(links) - max(links))  # a change point
+    mech = lw.load("four-bar", ground=ground, crank=crank, coupler=coupler, rocker=rocker)
+    tr = trace(mech, branches=True)
+    assert [b.kind for b in tr.bifurcations] == ["bifurcation"]
+    bif = tr.bifurcations[0]
+    assert len(bif.tangents) == 2 and bif.sigma[-1] < 1e-10 * bif.sigma[0]
+    from linkwork.kinematics.positions import joint_positions
+
+    pivots = joint_positions(mech, bif.angles[None, :])[0, :, :2]
+    d = pivots[1:] - pivots[0]
+    cross = d[:, 0] * d[0, 1] - d[:, 1] * d[0, 0]
+    assert np.max(np.abs(cross)) < 1e-9  # every pivot on the line through the first two
+    assert tr.stats["sign_changes_without_rank_drop"] == 0
+    assert len(tr.branches) == 1 and tr.branches[0].end_reason == "closed path"

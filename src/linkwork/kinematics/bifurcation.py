@@ -314,3 +314,52 @@ def locate_minimum(
             x2 = lo + golden * (hi - lo)
             f2, u2 = ratio(x2)
     return (u1, f1) if f1 < f2 else (u2, f2)
+
+
+def refine_singular(
+    ws: Workspace, u: Array, rank: int, tol: Tolerances, *, max_iter: int = 30, fd_step: float = 1e-6
+) -> Array | None:
+    """The singular point of rank ``rank`` next to ``u``, or None when there is none within reach.
+
+    Near a node of the solution set a corrector lands on one of the curves, off the node by about the square root
+    of its residual, so a located sign change can leave a point whose smallest singular value is small but not
+    zero. Here Gauss-Newton solves the extended system of a singular point (Moore & Spence): the closure
+    ``F(u) = 0``, a left null vector ``J(u)^T w = 0`` and ``|w| = 1``, with ``w`` started at the left singular
+    vectors of ``J(u)`` beyond ``rank`` (central differences give the derivative of ``J^T w`` in ``u``). It is
+    consistent at a singular point, where it converges quadratically; the result is accepted when the closure
+    residual is within ``tol.closure`` and singular value ``rank`` is below ``tol.loose`` relative.
+    """
+    _, r, jac = ws.evaluate(u)
+    U, s, _ = np.linalg.svd(jac)
+    if rank >= len(s):
+        return None
+    w = U[:, rank].copy()
+    x = u.copy()
+    m = len(u)
+    for _ in range(max_iter):
+        _, r, jac = ws.evaluate(x)
+        g = np.concatenate([r, jac.T @ w, [w @ w - 1.0]])
+        if np.linalg.norm(g) < tol.closure:
+            break
+        dJw = np.empty((m, m))
+        for k in range(m):
+            e = np.zeros(m)
+            e[k] = fd_step
+            _, _, jp = ws.evaluate(x + e)
+            _, _, jm = ws.evaluate(x - e)
+            dJw[:, k] = (jp - jm).T @ w / (2.0 * fd_step)
+        A = np.zeros((len(g), m + len(w)))
+        A[: len(r), :m] = jac
+        A[len(r) : len(r) + m, :m] = dJw
+        A[len(r) : len(r) + m, m:] = jac.T
+        A[-1, m:] = 2.0 * w
+        delta = np.linalg.lstsq(A, -g, rcond=None)[0]
+        x += delta[:m]
+        w += delta[m:]
+        if not np.all(np.isfinite(x)):
+            return None
+    res, _, jac = ws.evaluate(x)
+    s = np.linalg.svd(jac, compute_uv=False)
+    if res <= tol.closure and s[rank] <= tol.loose * s[0]:
+        return x
+    return None

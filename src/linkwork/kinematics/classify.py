@@ -14,7 +14,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.kinematics.bifurcation import branch_tangents, correct_on_plane, hermite, polish
+from linkwork.kinematics.bifurcation import (
+    branch_tangents,
+    correct_on_plane,
+    hermite,
+    polish,
+    refine_singular,
+)
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank
 from linkwork.kinematics.trace_result import Bifurcation
@@ -29,6 +35,8 @@ Array = NDArray[np.float64]
 COMPONENT_SAMPLES = 12
 #: Distance (in the unknowns) of those samples from the point.
 COMPONENT_RADIUS = 1e-3
+#: How far (in the unknowns) a located point may move onto the singular point next to it.
+NODE_RADIUS = 1e-2
 
 
 def component_dimension(ws: Workspace, u: Array, tol: Tolerances) -> int:
@@ -86,6 +94,8 @@ def classify_point(
         method, rank = "component", numerical_rank(sigma, tol)
     else:
         tangents_u, method, rank, sigma = branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
+        if len(tangents_u) < 2 and sigma[cfg.r_path - 1] < tol.local_min * sigma[0]:
+            u, width, (tangents_u, method, rank, sigma) = _onto_node(mech, ws, u, width, cfg)
         if len(tangents_u) == 2:
             polished, gap = polish(ws, u, tangents_u, tol)
             if np.isfinite(gap) and gap < tol.polish_gap:
@@ -112,6 +122,21 @@ def classify_point(
         kind="component" if dim >= 2 else ("bifurcation" if len(tangents_u) >= 2 else "fold"),
         dimension=dim,
     )
+
+
+def _onto_node(
+    mech: Mechanism, ws: Workspace, u: Array, width: float, cfg: MarchSettings
+) -> tuple[Array, float, tuple[Array, str, int, Array]]:
+    """A located point whose rank has nearly dropped, moved onto the singular point next to it when there is one
+    within the search radius (:func:`linkwork.kinematics.bifurcation.refine_singular`), with its branch tangents
+    there; otherwise the point as it was."""
+    tol = cfg.tol
+    node = refine_singular(ws, u, cfg.r_path - 1, tol)
+    if node is not None and np.linalg.norm(node - u) <= NODE_RADIUS:
+        found = branch_tangents(mech, ws, node, tol, rank_hint=cfg.r_path - 1)
+        if len(found[0]) >= 2:
+            return node, float(np.linalg.norm(node - u)), found
+    return u, width, branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
 
 
 def locate_fold(
