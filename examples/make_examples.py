@@ -138,14 +138,20 @@ def turtle(
 # -------------------------------------------------------------------------------------------- the sets
 
 
-def wing(folder: Path) -> dict[str, float]:
-    """The morphing-wing set: NACA 2412 (chord 1), 4412 (1.18), 6412 (1.36) as Selig files."""
-    sections = [("cruise", "2412", 1.0), ("climb", "4412", 1.18), ("landing", "6412", 1.36)]
+def _naca_sections(folder: Path, sections: list[tuple[str, str, float]]) -> dict[str, float]:
+    """Write each ``(name, NACA code, chord)`` section as ``name.dat`` (Selig) and return their arc lengths."""
     lengths = {}
     for name, code, chord in sections:
         outline = naca4_outline(code, chord)
         write_profile_dat(folder / f"{name}.dat", outline, name=f"NACA {code} chord {chord:g} ({name})")
         lengths[name] = arc_length(outline)
+    return lengths
+
+
+def wing(folder: Path) -> dict[str, float]:
+    """The morphing-wing set: NACA 2412 (chord 1), 4412 (1.18), 6412 (1.36) as Selig files."""
+    sections = [("cruise", "2412", 1.0), ("climb", "4412", 1.18), ("landing", "6412", 1.36)]
+    lengths = _naca_sections(folder, sections)
     _problem(
         folder,
         description="Morphing wing: NACA 2412 -> 4412 -> 6412, chord 1 -> 1.36 (full outline, open profile)",
@@ -164,11 +170,7 @@ def wing(folder: Path) -> dict[str, float]:
 def wing_six(folder: Path) -> dict[str, float]:
     """Six profiles end to end: NACA 1412 -> 6412 with the chord growing 1 -> 1.3 in equal steps (Selig files)."""
     sections = [(f"camber{k}", f"{k}412", 1.0 + 0.06 * (k - 1)) for k in range(1, 7)]
-    lengths = {}
-    for name, code, chord in sections:
-        outline = naca4_outline(code, chord)
-        write_profile_dat(folder / f"{name}.dat", outline, name=f"NACA {code} chord {chord:g} ({name})")
-        lengths[name] = arc_length(outline)
+    lengths = _naca_sections(folder, sections)
     _problem(
         folder,
         description="Six-profile morphing wing: NACA 1412 -> 6412, chord 1 -> 1.3 (full outline, open profile)",
@@ -317,7 +319,9 @@ def _merge_on(merge_below: float) -> str:
     """The seat's threshold is a joint range on the joined chain, not on the targets (the paper's default)."""
     if not merge_below:
         return ""
-    return '\nmerge_on = "chain"   # Eq. 34 ranges on the joined chain (the paper measures them on the targets)'
+    return (
+        '\nmerge_on = "chain"   # Eq. 34 ranges on the joined chain (the paper measures them on the targets)'
+    )
 
 
 def _problem(

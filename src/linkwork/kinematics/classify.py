@@ -95,7 +95,10 @@ def classify_point(
     else:
         tangents_u, method, rank, sigma = branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
         if len(tangents_u) < 2 and sigma[cfg.r_path - 1] < tol.local_min * sigma[0]:
-            u, width, (tangents_u, method, rank, sigma) = _onto_node(mech, ws, u, width, cfg)
+            moved = _onto_node(mech, ws, u, cfg)
+            if moved is not None:
+                width = float(np.linalg.norm(moved[0] - u))
+                u, (tangents_u, method, rank, sigma) = moved
         if len(tangents_u) == 2:
             polished, gap = polish(ws, u, tangents_u, tol)
             if np.isfinite(gap) and gap < tol.polish_gap:
@@ -125,18 +128,17 @@ def classify_point(
 
 
 def _onto_node(
-    mech: Mechanism, ws: Workspace, u: Array, width: float, cfg: MarchSettings
-) -> tuple[Array, float, tuple[Array, str, int, Array]]:
-    """A located point whose rank has nearly dropped, moved onto the singular point next to it when there is one
-    within the search radius (:func:`linkwork.kinematics.bifurcation.refine_singular`), with its branch tangents
-    there; otherwise the point as it was."""
+    mech: Mechanism, ws: Workspace, u: Array, cfg: MarchSettings
+) -> tuple[Array, tuple[Array, str, int, Array]] | None:
+    """The singular point next to a located point whose rank has nearly dropped, with its branch tangents, when
+    there is one within :data:`NODE_RADIUS` with two or more tangents
+    (:func:`linkwork.kinematics.bifurcation.refine_singular`); otherwise None."""
     tol = cfg.tol
     node = refine_singular(ws, u, cfg.r_path - 1, tol)
-    if node is not None and np.linalg.norm(node - u) <= NODE_RADIUS:
-        found = branch_tangents(mech, ws, node, tol, rank_hint=cfg.r_path - 1)
-        if len(found[0]) >= 2:
-            return node, float(np.linalg.norm(node - u)), found
-    return u, width, branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
+    if node is None or np.linalg.norm(node - u) > NODE_RADIUS:
+        return None
+    found = branch_tangents(mech, ws, node, tol, rank_hint=cfg.r_path - 1)
+    return (node, found) if len(found[0]) >= 2 else None
 
 
 def locate_fold(
