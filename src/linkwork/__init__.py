@@ -16,7 +16,9 @@ from typing import TYPE_CHECKING, Any
 from linkwork.errors import AssemblyError, ConvergenceError, LinkworkError, SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances
+from linkwork.kinematics.stops import StopReason
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Trace
+from linkwork.kinematics.trace_stats import TraceStats
 from linkwork.kinematics.tracer import trace
 
 if TYPE_CHECKING:
@@ -33,8 +35,10 @@ __all__ = [
     "LinkworkError",
     "Mechanism",
     "SpecError",
+    "StopReason",
     "Tolerances",
     "Trace",
+    "TraceStats",
     "load",
     "synthesize",
     "trace",

@@ -26,3 +26,9 @@ def trace_keyword(func: F) -> F:
         return func(*args, **kwargs)
 
     return accept  # type: ignore[return-value]
+
+
+def warn(old: str, new: str, stacklevel: int = 3) -> None:
+    """Warn that the spelling ``old`` is deprecated in favour of ``new`` (a :class:`DeprecationWarning` pointing at
+    the caller of the function that calls this)."""
+    warnings.warn(f"{old} is deprecated: use {new}", DeprecationWarning, stacklevel=stacklevel)

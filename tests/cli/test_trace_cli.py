@@ -366,6 +366,9 @@ def test_limit_ends_the_branch_on_the_limit_and_is_reported(tmp_path: Path) -> N
     report = json.loads((out / "report.json").read_text())
     assert report["branches"][0]["end_reason"] == "limit D"
     assert report["branches"][0]["range"]["D"][0] == pytest.approx(-5.0, abs=1e-9)
+    # the same end, structured (degrees in the file)
+    assert (report["branches"][0]["end_kind"], report["branches"][0]["end_joint"]) == ("limit", "D")
+    assert report["branches"][0]["end_value"] == pytest.approx(-5.0, abs=1e-9)
     assert report["target_reached"] is None
 
 

@@ -142,7 +142,7 @@ def test_guest_frame_bifurcation_and_both_branches() -> None:
 
     mech = guest_frame()
     path = trace(mech, branches=True, max_steps=3000)
-    assert path.stats["start_rank"] == 5
+    assert path.stats.start_rank == 5
     first = path.bifurcations[0]
     assert first.rank == 4
     assert first.sigma[4] / first.sigma[0] < 1e-11  # located to round-off

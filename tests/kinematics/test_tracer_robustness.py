@@ -17,6 +17,7 @@ import pytest
 
 import linkwork as lw
 from linkwork.kinematics.rank import Tolerances, numerical_rank
+from linkwork.kinematics.stops import StopReason
 from linkwork.kinematics.tracer import trace
 from linkwork.kinematics.workspace import Workspace
 from linkwork.linkages import REGISTRY
@@ -64,16 +65,14 @@ def test_unreachable_target_ends_when_the_path_closes_with_its_range(four_bar: l
     assert tr.branches[0].end_reason == "closed path"
     # the crank went round once (not 19 times): exactly 360 deg, the last row snapped onto the start
     assert np.ptp(tr.angles[:, four_bar.index("A")]) == pytest.approx(2 * np.pi, abs=1e-9)
-    assert (
-        tr.stats["unmet"] == f"D never reaches -95.00 deg on this path: its range is [{lo:.2f}, {hi:.2f}] deg"
-    )
+    assert tr.stats.unmet == f"D never reaches -95.00 deg on this path: its range is [{lo:.2f}, {hi:.2f}] deg"
 
 
 def test_a_crank_target_beyond_one_turn_is_reached_by_turning_on(four_bar: lw.Mechanism) -> None:
     tr = trace(four_bar, until=("A", 1000 * DEG))
     assert tr.branches[0].end_reason == "reached target"
     assert np.degrees(tr.angles[-1, four_bar.index("A")]) == pytest.approx(1000.0, abs=1e-9)
-    assert "unmet" not in tr.stats
+    assert tr.stats.unmet is None
 
 
 def test_a_limit_ends_the_branch_exactly_on_it(four_bar: lw.Mechanism) -> None:
@@ -108,8 +107,8 @@ def test_play_in_a_hinge_is_traced_within_the_closure_tolerance() -> None:
     tol = 1e-6
     tr = trace(bent, closure_tol=tol)
     assert tr.branches[0].end_reason == "closed path"
-    assert tr.stats["closure_tol"] == tol
-    assert 1e-12 < tr.stats["max_misfit"] <= tol  # a real misfit, within what was allowed
+    assert tr.stats.closure_tol == tol
+    assert 1e-12 < tr.stats.max_misfit <= tol  # a real misfit, within what was allowed
     th = tr.angles
     k = np.sin((a2 + a1) / 2) / np.sin((a2 - a1) / 2)
     rel = np.sin(th[:, 0] / 2) * np.sin(th[:, 1] / 2) - k * np.cos(th[:, 0] / 2) * np.cos(th[:, 1] / 2)
@@ -173,7 +172,7 @@ def test_sarrus_reports_its_two_dimensional_sheet_once_per_meeting_and_no_chain_
         fixed = _newton_onto(moved)
         assert np.linalg.norm(sarrus_closure(fixed)) < 1e-10 and fd_mobility(fixed) == 2
     for b in points:
-        assert len(b.tangents) >= 2 and b.rank < int(tr.stats["start_rank"])
+        assert len(b.tangents) >= 2 and b.rank < int(tr.stats.start_rank)
     for br in tr.branches:
         assert br.mobility == 1 and br.steps > 0
         assert br.end_reason in ("closed path",) or br.end_reason.startswith("reached bifurcation")
@@ -220,7 +219,7 @@ def test_every_builtin_gives_a_clean_branch_graph(name: str) -> None:
     kinds = [b.kind for b in tr.bifurcations]
     assert (kinds.count("bifurcation"), kinds.count("component")) == EXPECTED[name]
     assert len(kinds) == sum(EXPECTED[name])  # and no point labelled a fold
-    assert tr.stats["sign_changes_without_rank_drop"] == 0
+    assert tr.stats.sign_changes_without_rank_drop == 0
     for b in tr.bifurcations:
         if b.kind == "bifurcation":
             assert len(b.tangents) >= 2 and numerical_rank(b.sigma) < mech.n_unknowns - 1
@@ -263,10 +262,11 @@ def test_a_branch_that_runs_on_the_sarrus_sheet_ends_once_as_a_component() -> No
         n_sigma=6, periodic=np.ones(n, dtype=bool), lo=np.full(n, -np.inf), hi=np.full(n, np.inf), tol=Tolerances(),
     )  # fmt: skip
     marcher = BranchMarcher(mech, settings, 5000, switch_branches=True)
-    steps, reason = marcher.run_branch(
+    steps, end = marcher.run_branch(
         0, u0, Vt[-1], np.ascontiguousarray(U[:, :5]), paper=False, h0=0.5 * DEG, stop_at_known=True
     )
-    assert reason.startswith("entered a 2-dimensional component (mobility 2) at point")
+    assert end.text.startswith("entered a 2-dimensional component (mobility 2) at point")
+    assert end.kind == StopReason.COMPONENT and end.text.endswith(f"at point {end.point}")
     assert steps <= Tolerances().component_points
     assert 1 <= len(marcher.found) <= 2 and not marcher.queue  # no chain of points, no branch switching
     assert all(p.kind == "component" and p.dimension == 2 for p in marcher.found)
@@ -302,7 +302,7 @@ def test_every_arc_of_the_branch_graph_is_traced_once(name: str) -> None:
                     0
                 ]  # how far the probe is from the point
                 assert _wrapped_distances(probe, tr.angles).min() < 0.5 * away, (bif.id, sign)
-    assert tr.stats["branches_not_retraced"] >= 0
+    assert tr.stats.branches_not_retraced >= 0
 
 
 def test_the_threefold_bricard_loop_is_one_branch_through_its_point_twice() -> None:
@@ -313,7 +313,7 @@ def test_the_threefold_bricard_loop_is_one_branch_through_its_point_twice() -> N
     assert len(tr.branches) == 1 and tr.branches[0].end_reason == "closed path"
     a = np.degrees(tr.angles[:, 0])
     assert a.max() - a.min() > 700.0  # joint A turns twice: once along each mode
-    assert tr.stats["branches_not_retraced"] == 2
+    assert tr.stats.branches_not_retraced == 2
 
 
 @pytest.mark.parametrize(
@@ -336,5 +336,5 @@ def test_a_change_point_four_bar_has_its_bifurcation_where_the_links_are_colline
     d = pivots[1:] - pivots[0]
     cross = d[:, 0] * d[0, 1] - d[:, 1] * d[0, 0]
     assert np.max(np.abs(cross)) < 1e-9  # every pivot on the line through the first two
-    assert tr.stats["sign_changes_without_rank_drop"] == 0
+    assert tr.stats.sign_changes_without_rank_drop == 0
     assert len(tr.branches) == 1 and tr.branches[0].end_reason == "closed path"

@@ -98,10 +98,10 @@ def _guest_frame(out: Path, plots: bool) -> Section:
     traced = lw.trace(lw.load("guest-frame"), branches=True, max_steps=6000)
     figs = write_trace_outputs(traced, out / "guest-frame", plots=plots, html=True, animate=plots)
     print_trace_summary(traced)
-    lowest = min((b.rank for b in traced.bifurcations), default=traced.stats["start_rank"])
+    lowest = min((b.rank for b in traced.bifurcations), default=traced.stats.start_rank)
     return Section(
         "Guest's frame, every branch",
-        f"{len(traced.bifurcations)} bifurcation points (rank {traced.stats['start_rank']} → {lowest}) and "
+        f"{len(traced.bifurcations)} bifurcation points (rank {traced.stats.start_rank} → {lowest}) and "
         f"{len(traced.branches)} traced branches.",
         out / "guest-frame",
         [f.name for f in figs],

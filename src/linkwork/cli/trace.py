@@ -166,8 +166,8 @@ def trace(
     print_trace_summary(traced)
     written = ["path.csv", "report.json", "points.csv", "mechanism.toml", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
-    if "unmet" in traced.stats:
-        raise RequestNotMetError(str(traced.stats["unmet"]))
+    if traced.stats.unmet is not None:
+        raise RequestNotMetError(traced.stats.unmet)
 
 
 def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:

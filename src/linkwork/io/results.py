@@ -93,7 +93,7 @@ def report_dict(trace: Trace, assembly: Any | None = None) -> dict[str, Any]:
         "joint_types": list(mech.joint_types),
         "units": {"angles": "deg", "s": "deg (arclength in the unknowns)"},
         "drive": trace.drive,
-        "mode": trace.stats.get("mode"),
+        "mode": trace.stats.mode,
         "unknowns": mech.n_unknowns,
         "couplings": [[names[j] for j in group] for group in mech.group_members() if len(group) > 1],
         "fixed": [names[j] for j in np.flatnonzero(mech.groups < 0)],
@@ -101,17 +101,17 @@ def report_dict(trace: Trace, assembly: Any | None = None) -> dict[str, Any]:
         **_rank_entries(trace),
         "points": len(trace.branch),
         "max_residual": float(trace.residual.max()),
-        "closure_tol": float(trace.stats.get("closure_tol", 1e-12)),
-        "max_misfit": float(trace.stats.get("max_misfit", trace.residual.max())),
-        "target_reached": ("unmet" not in trace.stats) if trace.stats.get("has_target") else None,
-        "unmet": trace.stats.get("unmet"),
+        "closure_tol": float(trace.stats.closure_tol),
+        "max_misfit": float(trace.stats.max_misfit),
+        "target_reached": (trace.stats.unmet is None) if trace.stats.has_target else None,
+        "unmet": trace.stats.unmet,
         "max_condition": trace.max_condition,
         "max_condition_raw": trace.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
         "bifurcations": [_bifurcation_entry(trace, b) for b in trace.bifurcations],
         "folds": [_fold_entry(trace, f) for f in trace.folds],
         "branches": [_branch_entry(trace, br) for br in trace.branches],
-        "seconds": trace.stats.get("seconds"),
+        "seconds": trace.stats.seconds,
     }
     if assembly is not None:
         out["assembly"] = _assembly_entry(assembly, names)
@@ -122,7 +122,7 @@ def _rank_entries(trace: Trace) -> dict[str, Any]:
     """``rank`` and ``mobility`` at the start, and their ranges along the path away from the bifurcation points
     (where the rank drops by definition)."""
     mech = trace.mechanism
-    start_rank = int(trace.stats.get("start_rank", trace.rank[0]))
+    start_rank = int(trace.stats.start_rank)
     regular = np.ones(len(trace.rank), dtype=bool)
     for b in trace.bifurcations:
         regular &= np.linalg.norm(trace.angles - b.angles, axis=1) > 1e-6
@@ -182,10 +182,27 @@ def _branch_entry(trace: Trace, br: Branch) -> dict[str, Any]:
         "direction": br.direction,
         "steps": br.steps,
         "end_reason": br.end_reason,
+        **_end_entries(trace, br),
         "mobility": br.mobility,
         "range": branch_range(trace, br.id),
         "start": _named(trace, on_branch[0]),
         "end": _named(trace, on_branch[-1]),
+    }
+
+
+def _end_entries(trace: Trace, br: Branch) -> dict[str, Any]:
+    """The branch's end, structured: ``end_kind`` (the :class:`~linkwork.kinematics.stops.StopReason` name in
+    lower case), ``end_joint`` and ``end_value`` (that joint's value at the end: degrees for a revolute joint),
+    ``end_point`` (the located point it ended on, or ``null``)."""
+    value = br.end_value
+    if value is not None and br.end_joint is not None:
+        if trace.mechanism.joint_types[trace.mechanism.index(br.end_joint)] == "R":
+            value = float(np.degrees(value))
+    return {
+        "end_kind": None if br.end_kind is None else br.end_kind.name.lower(),
+        "end_joint": br.end_joint,
+        "end_value": value,
+        "end_point": br.end_point,
     }
 
 

@@ -7,7 +7,7 @@ its predicted value (the paper's equal steps of the drive). A signed test functi
 Jacobian restricted to its range (basis kept continuous) and bordered by the tangent, is recorded at every
 point: a sign change brackets a bifurcation.
 
-Stop codes returned by :func:`march`: see :data:`STOP_REASONS`.
+Stop codes returned by :func:`march`: the values of :class:`linkwork.kinematics.stops.StopReason`.
 
 References
 ----------
@@ -20,19 +20,19 @@ import numpy as np
 from numba import njit
 
 from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_jacobian, expand
+from linkwork.kinematics.stops import StopReason
 
-BUDGET, TARGET, CLOSED, FAILED, SIGN_CHANGE, LIMIT, TURNING, NO_PROGRESS = 0, 1, 2, 3, 4, 5, 6, 7
+# The stop codes the march returns, as the plain ints numba freezes into the kernels (see StopReason).
+BUDGET = int(StopReason.BUDGET)
+TARGET = int(StopReason.TARGET)
+CLOSED = int(StopReason.CLOSED)
+FAILED = int(StopReason.FAILED)
+SIGN_CHANGE = int(StopReason.SIGN_CHANGE)
+LIMIT = int(StopReason.LIMIT)
+TURNING = int(StopReason.TURNING)
+NO_PROGRESS = int(StopReason.NO_PROGRESS)
+NO_EVENT = -1  # step_event: the step ends nothing
 TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
-STOP_REASONS = {
-    BUDGET: "step budget",
-    TARGET: "reached target",
-    CLOSED: "closed path",
-    FAILED: "corrector failed",
-    SIGN_CHANGE: "bifurcation",
-    LIMIT: "joint limit",
-    TURNING: "drive turning point",
-    NO_PROGRESS: "no progress",
-}
 
 
 @njit(cache=True)
@@ -361,7 +361,7 @@ def march(
         if not paper and count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
             return count, NO_PROGRESS, h
         code = step_event(u, landing, lo, hi, detect, tau_new * out_tau[count - 2])
-        if code >= 0:
+        if code != NO_EVENT:
             return count, code, h
         if check_closed:
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
@@ -399,7 +399,7 @@ def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
 @njit(cache=True, inline="always")
 def step_event(u, landing, lo, hi, detect, tau_product):
     """The stop code an accepted step ends the march with (the target reached, a joint limit passed, a sign change
-    of the test function, ``tau_product`` being the product of its last two values), ``-1`` for none."""
+    of the test function, ``tau_product`` being the product of its last two values), ``NO_EVENT`` for none."""
     if landing:
         return TARGET
     for a in range(u.shape[0]):
@@ -407,7 +407,7 @@ def step_event(u, landing, lo, hi, detect, tau_product):
             return LIMIT
     if detect and tau_product < 0.0:
         return SIGN_CHANGE
-    return -1
+    return NO_EVENT
 
 
 @njit(cache=True, inline="always")

@@ -18,16 +18,9 @@ from numpy.typing import NDArray
 from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
-from linkwork.kinematics.march import (
-    CLOSED,
-    FAILED,
-    LIMIT,
-    NO_PROGRESS,
-    SIGN_CHANGE,
-    STOP_REASONS,
-)
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
+from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold
 from linkwork.kinematics.workspace import Workspace
 from linkwork.progress import Progress
@@ -58,7 +51,8 @@ class MarchSettings:
 
 @dataclass
 class Chunk:
-    """The rows one call of the compiled march wrote (row 0 is its start), its stop code and last step."""
+    """The rows one call of the compiled march wrote (row 0 is its start), its stop code (a
+    :class:`~linkwork.kinematics.stops.StopReason` value) and last step."""
 
     u: Array
     t: Array
@@ -179,20 +173,51 @@ class BranchMarcher:
         stop_at_known: bool,
         step_offset: int = 0,
         check_closed: bool = True,
-    ) -> tuple[int, str]:
-        """March one branch to its end, locating bifurcations and folds on the way; returns (steps, end reason).
+    ) -> tuple[int, End]:
+        """March one branch to its end, locating bifurcations and folds on the way; returns (steps, how it ended).
 
         ``step_offset``: step number of ``u0`` in its branch (1 when the branch opens at a bifurcation point).
         """
+        n_steps, kind, text, about, point = self._march_branch(
+            branch_id, u0, t0, basis, paper=paper, h0=h0, stop_at_known=stop_at_known,
+            step_offset=step_offset, check_closed=check_closed,
+        )  # fmt: skip
+        return n_steps, self.end(kind, text, self.rows.u[-1][-1], about, point)
+
+    def end(
+        self, kind: StopReason, text: str, u: Array, about: int | None = None, point: int | None = None
+    ) -> End:
+        """The :class:`End` of a branch whose last point is ``u``: ``about`` is the unknown the reason is about
+        (``None``: the drive), reported as its first joint and that joint's value at ``u``."""
+        g = self.cfg.drive if about is None else about
+        j = self.mech.group_members()[g][0]
+        value = float(self.mech.angles_from_q(self.mech.q_from_u(u))[j])
+        return End(kind, text, self.mech.joint_names[j], value, point)
+
+    def _march_branch(
+        self,
+        branch_id: int,
+        u0: Array,
+        t0: Array,
+        basis: Array,
+        *,
+        paper: bool,
+        h0: float,
+        stop_at_known: bool,
+        step_offset: int,
+        check_closed: bool,
+    ) -> tuple[int, StopReason, str, int | None, int | None]:
+        """:meth:`run_branch`'s march: returns (steps, kind, text, the unknown the reason is about or ``None``
+        for the drive, the located point it ended on or ``None``)."""
         u, t, u_home = u0.copy(), t0.copy(), u0.copy()
         n_steps, first = 0, True
         while True:
             n = max(min(self.budget, 100 if self.progress else self.budget), 0)
             if n <= 0 and not first:
-                return n_steps, STOP_REASONS[0]
+                return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
-            limit_reason = self._land_on_limit(chunk) if chunk.code == LIMIT else None
+            limit = self._land_on_limit(chunk) if chunk.code == StopReason.LIMIT else None
             component = self._component_entry(chunk)
             if component is not None:
                 chunk.count = component + 1
@@ -206,29 +231,32 @@ class BranchMarcher:
             if self.progress:
                 self.progress(self.max_steps - self.budget, self.max_steps)
             if component is not None:
-                return n_steps, self._enter_component(chunk, branch_id, base + component)
-            if chunk.code == SIGN_CHANGE:
+                point, text = self._enter_component(chunk, branch_id, base + component)
+                return n_steps, StopReason.COMPONENT, text, None, point
+            if chunk.code == StopReason.SIGN_CHANGE:
                 known = self._on_sign_change(chunk, basis_prev, branch_id, n_steps + step_offset)
                 if known is not None and stop_at_known:
                     self._end_on_known(chunk, known)
-                    return n_steps, f"reached bifurcation {known}"
+                    return n_steps, StopReason.KNOWN_POINT, f"reached bifurcation {known}", None, known
                 if known is not None:  # through a known point and on: the arcs on both sides are traced
                     self._passed(known, chunk)
-            elif chunk.code == CLOSED and self._turns_towards_target(chunk, u_home):
+            elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
                 # A full turn of the drive: the target is further round.
                 u_home = chunk.u[chunk.count - 1].copy()
-            elif chunk.code != 0 or self.budget <= 0:
-                return n_steps, limit_reason or self._end_reason(chunk, paper)
+            elif chunk.code != StopReason.BUDGET or self.budget <= 0:
+                if limit is not None:
+                    return n_steps, StopReason.LIMIT, limit[1], limit[0], None
+                return n_steps, StopReason(chunk.code), self._end_reason(chunk, paper), None, None
             if self.budget <= 0:
-                return n_steps, STOP_REASONS[0]
+                return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
             u, t, h0 = chunk.u[chunk.count - 1].copy(), chunk.t[chunk.count - 1].copy(), chunk.h
 
-    def _land_on_limit(self, chunk: Chunk) -> str:
+    def _land_on_limit(self, chunk: Chunk) -> tuple[int, str]:
         """Replace the chunk's last row (past a limit) by the point of the step where the joint is at its limit.
 
         From the row before it, the predictor goes along the tangent to the limit's value and the corrector
         holds that unknown there (as when landing on a target), so a branch ends exactly on the limit. Returns
-        the end reason, ``limit <joint>``.
+        the unknown that passed its limit first and the end reason, ``limit <joint>``.
         """
         cfg, c = self.cfg, chunk.count
         u_a, t_a, u_b = chunk.u[c - 2], chunk.t[c - 2], chunk.u[c - 1]
@@ -237,7 +265,7 @@ class BranchMarcher:
         g = int(over[0])
         bound = cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g]
         if abs(t_a[g]) < 1e-12:
-            return reason
+            return g, reason
         guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
         guess[g] = bound
         tol, ws = cfg.tol, self.ws
@@ -246,13 +274,13 @@ class BranchMarcher:
             ws.q, ws.res, ws.jac,
         )  # fmt: skip
         if not ok:
-            return reason
+            return g, reason
         _, _, jac = ws.evaluate(guess)
         chunk.u[c - 1] = guess
         chunk.sigma[c - 1] = np.linalg.svd(jac, compute_uv=False)[: cfg.n_sigma]
         chunk.res[c - 1] = r
         chunk.s[c - 1] = chunk.s[c - 2] + float(np.linalg.norm(guess - u_a))
-        return reason
+        return g, reason
 
     def _turns_towards_target(self, chunk: Chunk, u_home: Array) -> bool:
         """Whether a closed path turned the (revolute) drive by whole turns towards a target still ahead."""
@@ -265,16 +293,16 @@ class BranchMarcher:
 
     def _end_reason(self, chunk: Chunk, paper: bool) -> str:
         """The end reason a user reads for a chunk's stop code."""
-        if chunk.code == FAILED:
+        if chunk.code == StopReason.FAILED:
             if paper:
                 return "corrector failed at a fixed drive step (the drive cannot take that value here)"
             return f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
-        if chunk.code == NO_PROGRESS:
+        if chunk.code == StopReason.NO_PROGRESS:
             return (
                 f"no progress ({self.cfg.tol.stall_steps} steps advanced less than "
                 f"{self.cfg.tol.stall_length:g} of the largest step)"
             )
-        return STOP_REASONS[chunk.code]
+        return StopReason(chunk.code).text
 
     def _record(self, chunk: Chunk, branch_id: int, first: bool, n_steps: int) -> None:
         """Append a chunk's rows (all of them for the branch's first chunk, else without its start row)."""
@@ -305,8 +333,9 @@ class BranchMarcher:
                 return k + 1 - need
         return None
 
-    def _enter_component(self, chunk: Chunk, branch_id: int, step: int) -> str:
-        """Record where the branch meets a higher-dimensional component (once) and the end reason."""
+    def _enter_component(self, chunk: Chunk, branch_id: int, step: int) -> tuple[int, str]:
+        """Record where the branch meets a higher-dimensional component (once); returns its point and the end
+        reason."""
         u = chunk.u[chunk.count - 1]
         known = self._match(u)
         if known is None:
@@ -318,7 +347,7 @@ class BranchMarcher:
             self.found.append(bif)
             known = bif.id
         dim = self.found[known].dimension
-        return f"entered a {dim}-dimensional component (mobility {dim}) at point {known}"
+        return known, f"entered a {dim}-dimensional component (mobility {dim}) at point {known}"
 
     def _scan_rank_minima(self, chunk: Chunk, branch_id: int, base: int) -> None:
         """Rank drops where the test function keeps its sign: local minima of ``sigma_r / sigma_1``."""
@@ -467,11 +496,8 @@ class BranchMarcher:
             h = cfg.max_step / 4.0
             u1, _r, ok = correct_on_plane(self.ws, job.u + h * job.tangent, job.tangent, cfg.tol)
             if not ok:
-                self.branches.append(
-                    Branch(
-                        bid, job.parent, job.bifurcation, job.direction, 0, "could not leave the bifurcation"
-                    )
-                )
+                end = self.end(StopReason.NOT_LEFT, StopReason.NOT_LEFT.text, job.u, None, job.bifurcation)
+                self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, 0, end))
                 continue
             _, _, jac1 = self.ws.evaluate(u1)
             U1, _, Vt1 = np.linalg.svd(jac1)
@@ -483,13 +509,17 @@ class BranchMarcher:
             s_off = float(np.linalg.norm(u1 - job.u))
             start_len = len(self.rows.u)
             basis = np.ascontiguousarray(U1[:, : cfg.r_path])
-            nb, rb = self.run_branch(bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1)
+            nb, end = self.run_branch(
+                bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1
+            )
             for i in range(start_len, len(self.rows.u)):
                 self.rows.s[i] = self.rows.s[i] + s_off
                 self.rows.step[i] = self.rows.step[i] + 1
-            if rb == STOP_REASONS[CLOSED]:  # back round to where it left its point: a closed mode through it
+            if (
+                end.kind == StopReason.CLOSED
+            ):  # back round to where it left its point: a closed mode through it
                 block = self.rows.u[-1]
                 step = block[-1] - (block[-2] if len(block) > 1 else self.rows.u[-2][-1])
                 step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
                 self._arrived(job.bifurcation, step)
-            self.branches.append(Branch(bid, job.parent, job.bifurcation, job.direction, nb + 1, rb))
+            self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, nb + 1, end))

@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -16,6 +15,8 @@ from numpy.typing import NDArray
 
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.normalization import condition_ratios
+from linkwork.kinematics.stops import End, StopReason
+from linkwork.kinematics.trace_stats import TraceStats
 
 Array = NDArray[np.float64]
 
@@ -67,6 +68,11 @@ class Branch:
     """One traced branch: where it starts (parent branch and bifurcation, or the start), direction, end.
 
     ``mobility`` is the mobility (unknowns minus rank) that holds along the branch away from its ends.
+    ``end_reason`` is the sentence a person reads; the same end, structured: ``end_kind`` (a
+    :class:`~linkwork.kinematics.stops.StopReason`), ``end_joint`` the joint it is about (the limited joint for
+    a limit, otherwise the drive) and ``end_value`` that joint's value at the branch's last point (radians, or
+    length for a prismatic joint), ``end_point`` the located point it ended on (a known point, a component) or
+    could not leave.
     """
 
     id: int
@@ -76,6 +82,27 @@ class Branch:
     steps: int
     end_reason: str
     mobility: int = 1
+    end_kind: StopReason | None = None
+    end_joint: str | None = None
+    end_value: float | None = None
+    end_point: int | None = None
+
+    @classmethod
+    def ended(
+        cls, id: int, parent: int | None, bifurcation: int | None, direction: int, steps: int, end: End
+    ) -> Branch:
+        """A branch that ended as ``end`` says."""
+        return cls(
+            id, parent, bifurcation, direction, steps, end.text,
+            end_kind=end.kind, end_joint=end.joint, end_value=end.value, end_point=end.point,
+        )  # fmt: skip
+
+    @property
+    def end(self) -> End | None:
+        """How the branch ended, structured (``None`` for a branch built without a kind)."""
+        if self.end_kind is None:
+            return None
+        return End(self.end_kind, self.end_reason, self.end_joint, self.end_value, self.end_point)
 
 
 @dataclass(frozen=True)
@@ -112,7 +139,7 @@ class Trace:
     rank: NDArray[np.int64]
     bifurcations: tuple[Bifurcation, ...]
     branches: tuple[Branch, ...]
-    stats: Mapping[str, Any] = field(default_factory=dict)
+    stats: TraceStats = field(default_factory=TraceStats)
     folds: tuple[Fold, ...] = ()
 
     @property

@@ -18,11 +18,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
-from linkwork.kinematics.march import STOP_REASONS
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
+from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_result import Branch, Trace
+from linkwork.kinematics.trace_stats import TraceStats
 from linkwork.kinematics.workspace import Workspace
 from linkwork.progress import Progress
 
@@ -68,10 +69,10 @@ def trace(
         ends with the reason ``limit <name>`` when one is passed.
     closure_tol
         Accept a least-squares closure within this (``Tolerances.with_closure``; default ``tol.closure``); the
-        largest misfit met is ``stats["max_misfit"]``.
+        largest misfit met is ``stats.max_misfit``.
 
     A target that is not reached (the path closes or folds back first, or ends for another reason) does not
-    raise: ``stats["unmet"]`` then says why in one line (the command line exits with code 3 on it).
+    raise: ``stats.unmet`` then says why in one line (the command line exits with code 3 on it).
     """
     m = mech.n_unknowns
     if m == 0:
@@ -103,16 +104,16 @@ def trace(
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
     basis0 = np.ascontiguousarray(U0[:, :r_path])
     # Paper mode keeps the sign: equal drive steps towards a target below the start value are negative.
-    n0, reason0 = marcher.run_branch(
+    n0, end0 = marcher.run_branch(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
     )
-    marcher.branches.append(Branch(0, None, None, 1, n0, reason0))
-    if branches and target is None and reason0 != STOP_REASONS[2]:
+    marcher.branches.append(Branch.ended(0, None, None, 1, n0, end0))
+    if branches and target is None and end0.kind != StopReason.CLOSED:
         # The start is in the middle of its branch: trace the other direction too.
-        n1, reason1 = marcher.run_branch(
+        n1, end1 = marcher.run_branch(
             1, np.zeros(m), -t_start, basis0.copy(), paper=False, h0=max_step / 4.0, stop_at_known=True
         )
-        marcher.branches.append(Branch(1, None, None, -1, n1, reason1))
+        marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
     marcher.follow_queue()
     return _assemble(mech, d_joint, marcher, tol, started, paper, until)
 
@@ -206,23 +207,25 @@ def _assemble(
         replace(br, mobility=_branch_mobility(mech.n_unknowns - ranks[branch == br.id]))
         for br in marcher.branches
     ]
-    stats: dict[str, object] = {
-        "start_rank": marcher.cfg.r_path,
-        "start_mobility": mech.n_unknowns - marcher.cfg.r_path,
-        "mode": "paper" if paper else "adaptive",
-        "closure_tol": tol.closure,
-        "max_misfit": float(max(marcher.max_misfit, float(np.max(np.concatenate(rows.res))))),
-        "sign_changes_without_rank_drop": marcher.spurious,
-        "branches_not_retraced": marcher.retraced,
-    }
-    stats["has_target"] = until is not None
+    unmet = None
     if until is not None:
         on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
-        unmet = target_verdict(mech, until, branch_list[0].end_reason, np.concatenate(on_branch))
-        if unmet:
-            stats["unmet"] = unmet
-    stats["points"] = len(U)
-    stats["seconds"] = time.perf_counter() - started
+        first = branch_list[0]
+        end = End(first.end_kind or StopReason.BUDGET, first.end_reason, first.end_joint, first.end_value)
+        unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
+    stats = TraceStats(
+        start_rank=marcher.cfg.r_path,
+        start_mobility=mech.n_unknowns - marcher.cfg.r_path,
+        mode="paper" if paper else "adaptive",
+        closure_tol=tol.closure,
+        max_misfit=float(max(marcher.max_misfit, float(np.max(np.concatenate(rows.res))))),
+        sign_changes_without_rank_drop=marcher.spurious,
+        branches_not_retraced=marcher.retraced,
+        has_target=until is not None,
+        unmet=unmet,
+        points=len(U),
+        seconds=time.perf_counter() - started,
+    )
     return Trace(
         mechanism=mech,
         drive=mech.joint_names[d_joint],
@@ -248,10 +251,10 @@ def _branch_mobility(mobility: NDArray[np.int64]) -> int:
     return int(values[np.argmax(counts)])
 
 
-def target_verdict(mech: Mechanism, until: tuple[str | int, float], reason: str, angles: Array) -> str | None:
-    """Why the target of ``until`` was not reached on the first branch (``angles``: its points and folds), in
-    one line (``None`` when it was)."""
-    if reason == STOP_REASONS[1]:
+def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, angles: Array) -> str | None:
+    """Why the target of ``until`` was not reached on the first branch (``end``: how it ended; ``angles``: its
+    points and folds), in one line (``None`` when it was)."""
+    if end.kind == StopReason.TARGET:
         return None
     j = mech.index(until[0])
     name = mech.joint_names[j]
@@ -263,7 +266,7 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], reason: str,
 
     lo, hi = float(np.min(angles[:, j])), float(np.max(angles[:, j]))
     span = f"[{np.degrees(lo):.2f}, {np.degrees(hi):.2f}] deg" if revolute else f"[{lo:.6g}, {hi:.6g}]"
-    if reason in (STOP_REASONS[2], STOP_REASONS[6]):
-        why = "" if reason == STOP_REASONS[2] else f" (it turns back near {show(float(angles[-1, j]))})"
+    if end.kind in (StopReason.CLOSED, StopReason.TURNING):
+        why = "" if end.kind == StopReason.CLOSED else f" (it turns back near {show(float(angles[-1, j]))})"
         return f"{name} never reaches {show(until[1])} on this path{why}: its range is {span}"
-    return f"{name} did not reach {show(until[1])}: the path ended with '{reason}' (range so far {span})"
+    return f"{name} did not reach {show(until[1])}: the path ended with '{end.text}' (range so far {span})"

@@ -120,7 +120,7 @@ def singular_values_figure(trace: Trace, branch: int = 0) -> Figure:
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     axes = fig.subplots(1, 2)
     steps = trace.step[mask]
-    rank = int(trace.stats.get("start_rank", s.shape[1]))
+    rank = int(trace.stats.start_rank or s.shape[1])
     # Left: the non-zero singular values on a linear scale against the step (as the paper's Fig. 15);
     # right: all of them on a log scale, the null ones at round-off.
     for i in range(min(rank, s.shape[1])):
