@@ -1,10 +1,11 @@
 """Benchmark of the first run on a fresh install: ``linkwork trace`` with an empty numba cache against a warm run.
 
-What it measures, each command in a fresh process with ``NUMBA_CACHE_DIR`` pointing to a new empty folder:
+What it measures, each command in a fresh process with ``LINKWORK_CACHE_DIR`` pointing to a new empty folder:
 
 1. **cold, default** (``LINKWORK_JIT=auto``): the first run traces with the plain-Python kernels and starts the
    background compile; wall time, the trace time it reports, and its stderr note;
-2. the background compile: wall time until the cache is filled (lock file gone, index written);
+2. the background compile: wall time until the cache is filled (lock file gone, marker ``ready.json`` lists the
+   tracing kernels);
 3. **warm**: the same command again, median of ``--repeats`` runs; the goal is cold <= 2 x warm;
 4. **cold, compile first** (``LINKWORK_JIT=compiled``, a second empty cache): the old behaviour, compile in the
    process, announced and excluded from the reported trace time.
@@ -35,7 +36,7 @@ GOAL = 2.0
 
 def run(cache: Path, out: Path, mode: str, plots: bool) -> dict[str, object]:
     """One ``linkwork trace`` in a fresh process: wall time, reported trace seconds, stderr notes."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), LINKWORK_JIT=mode)
+    env = dict(os.environ, LINKWORK_CACHE_DIR=str(cache), LINKWORK_JIT=mode)
     cmd = [
         sys.executable,
         "-c",
@@ -63,9 +64,9 @@ def wait_for_background(cache: Path, timeout: float = 600.0) -> float:
     """Seconds until the background compile has written the cache and removed its lock file."""
     begin = time.perf_counter()
     while time.perf_counter() - begin < timeout:
-        locked = list(cache.rglob("linkwork-compiling.lock"))
-        indexed = list(cache.rglob("march.march-*.nbi"))
-        if indexed and not locked:
+        locked = list(cache.rglob("compiling.lock"))
+        marked = [m for m in cache.rglob("ready.json") if "tracing" in json.loads(m.read_text())["groups"]]
+        if marked and not locked:
             return time.perf_counter() - begin
         time.sleep(0.25)
     raise RuntimeError(f"the background compile did not finish in {timeout} s")

@@ -20,12 +20,12 @@ from linkwork.kinematics.stops import StopReason
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Trace
 from linkwork.kinematics.trace_stats import TraceStats
 from linkwork.kinematics.tracer import trace
+from linkwork.version import __version__ as __version__
 
 if TYPE_CHECKING:
     from linkwork.synthesis.problem import Problem
     from linkwork.synthesis.result import SynthesisResult
 
-__version__ = "0.1.0"
 
 __all__ = [
     "AssemblyError",

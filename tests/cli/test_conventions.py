@@ -45,7 +45,7 @@ def test_every_out_option_has_the_short_form(command: str) -> None:
         for param in sub.params:
             if "--out" in param.opts:
                 assert "-o" in param.opts, f"{command} --out has no -o"
-        assert command in ("linkages", "show") or any("--out" in p.opts for p in sub.params)
+        assert command in ("linkages", "show", "compile") or any("--out" in p.opts for p in sub.params)
 
 
 def test_short_out_writes_where_asked(tmp_path: Path) -> None:
@@ -82,15 +82,33 @@ def test_exit_codes_are_documented_in_help_and_readme() -> None:
 
 
 def test_a_cold_kernel_cache_is_announced_on_stderr(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from linkwork.kernel_cache import CACHE
     from linkwork.kinematics import jit
 
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
-    monkeypatch.setattr(jit, "kernels_cached", lambda: False)
-    monkeypatch.setitem(jit._state, "ready", False)
-    monkeypatch.setattr(jit, "_warm_up", lambda: None)  # the kernels are compiled in this process already
+    monkeypatch.setattr(CACHE, "ready", lambda group: False)
+    monkeypatch.setattr(CACHE, "mark_ready", lambda groups: None)
+    monkeypatch.setitem(jit._state, "loaded", False)
+    monkeypatch.setattr(jit, "warm_up", lambda: None)  # the kernels are compiled in this process already
     result = runner.invoke(
         app, ["trace", "bennett", "--until", "A=70", "--no-plots", "-o", str(tmp_path / "t")]
     )
     assert result.exit_code == 0, result.stderr
     assert "note: compiling kernels, first run only" in result.stderr
     assert "compiling" not in result.stdout
+
+
+def test_compile_fills_the_cache_and_marks_every_group(monkeypatch: pytest.MonkeyPatch) -> None:
+    from linkwork.cli import kernels
+    from linkwork.kernel_cache import CACHE, GROUPS
+
+    warmed: list[str] = []
+    for group in GROUPS:  # stand-ins: the real warm-ups compile for minutes on a cold cache
+        monkeypatch.setitem(kernels.WARM_UPS, group, lambda group=group: warmed.append(group))
+    marked: list[str] = []
+    monkeypatch.setattr(CACHE, "mark_ready", lambda groups: marked.extend(groups))
+    monkeypatch.setattr(CACHE, "remove_stale", lambda: [])
+    result = runner.invoke(app, ["compile"])
+    assert result.exit_code == 0, result.stderr
+    assert warmed == marked == list(GROUPS)
+    assert f"kernels-{CACHE.key}" in result.stdout and "tracing: ready" in result.stdout

@@ -1,6 +1,6 @@
-"""Compiled and plain-Python tracing kernels (linkwork.kinematics.jit): the same numbers either way, the plain
-ones while numba's cache is cold, a background compile for next time, and compile time kept out of a trace's
-reported seconds.
+"""Compiled and plain-Python tracing kernels (linkwork.kinematics.jit): the same numbers either way, one choice per
+trace, the plain ones while the cache is cold on the command line (a background compile for next time), a
+foreground compile for library calls, and compile time kept out of a trace's reported seconds.
 
 The reference for the plain-Python path is the compiled path (and the other way round): they run the same
 statements, so a trace must agree point for point to 1e-12 rad, with the same branches and bifurcation points.
@@ -9,11 +9,11 @@ statements, so a trace must agree point for point to 1e-12 rad, with the same br
 from __future__ import annotations
 
 import logging
-import os
 import subprocess
 import sys
 import time
 import types
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +21,7 @@ import pytest
 from numba.core.registry import CPUDispatcher
 
 import linkwork as lw
+from linkwork.kernel_cache import CACHE
 from linkwork.kinematics import jit, march
 from linkwork.linkages.hedgepeth_rods import deployed_angles
 
@@ -60,7 +61,7 @@ def test_python_kernels_find_the_same_bifurcations(monkeypatch: pytest.MonkeyPat
 
 
 def test_the_python_twin_calls_no_compiled_code() -> None:
-    twin = jit.python_twin({name: getattr(march, name) for name in jit.ENTRY_POINTS})
+    twin = jit.python_backend()
     seen: set[int] = set()
 
     def walk(fn: types.FunctionType) -> None:
@@ -76,40 +77,96 @@ def test_the_python_twin_calls_no_compiled_code() -> None:
     for name in jit.ENTRY_POINTS:
         walk(getattr(twin, name))
     assert len(seen) >= 8  # march, correct, evaluate, closure_jacobian, exp_unit_twist, log_rigid, ...
+    assert not twin.compiled and jit.compiled_backend().compiled
+    assert jit.compiled_backend().march is march.march
 
 
-def test_a_cold_cache_traces_in_python_and_compiles_in_the_background(
-    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
-) -> None:
-    started: list[tuple[list[str], dict[str, str]]] = []
-    monkeypatch.setenv("LINKWORK_JIT", "auto")
-    monkeypatch.setattr(jit, "kernels_cached", lambda: False)
-    monkeypatch.setitem(jit._state, "ready", False)
-    monkeypatch.setattr(jit, "_compile_under_way", lambda: False)
-    monkeypatch.setattr(jit, "_touch_lock", lambda: None)
+@pytest.fixture
+def cold(monkeypatch: pytest.MonkeyPatch) -> list[list[str]]:
+    """A cold cache (no marker, nothing loaded in this process), with background compiles recorded, not run."""
+    started: list[list[str]] = []
+    monkeypatch.setattr(CACHE, "ready", lambda group: False)
+    monkeypatch.setitem(jit._state, "loaded", False)
     monkeypatch.setitem(jit._state, "spawned", False)
-    monkeypatch.setattr(subprocess, "run", lambda cmd, **kw: started.append((cmd, kw["env"])))
+    monkeypatch.setattr(jit, "compile_under_way", lambda: False)
+    monkeypatch.setattr(jit, "hold_lock", lambda: None)
+    monkeypatch.setattr(
+        subprocess, "run", lambda cmd, **kw: started.append([*cmd, kw["env"]["LINKWORK_JIT"]])
+    )
+    monkeypatch.setattr(jit, "warm_up", lambda: time.sleep(0.3))  # a stand-in compile of a known length
+    monkeypatch.setattr(jit, "_background", [])
+    monkeypatch.setenv("LINKWORK_JIT", "auto")
+    return started
+
+
+def test_a_cold_command_line_run_traces_in_python_and_compiles_in_the_background(
+    cold: list[list[str]], caplog: pytest.LogCaptureFixture
+) -> None:
+    jit.enable_background_compile(["python", "-c", "compile everything"])
     with caplog.at_level(logging.INFO, logger="linkwork.jit"):
-        kernels = jit.march_kernels()
-        jit.march_kernels()  # a second trace in the same process starts no second compile
-    assert isinstance(kernels, jit.SwitchingKernels)
-    assert kernels.march is jit.plain_march_kernels().march
-    assert len(started) == 1
-    cmd, env = started[0]
-    assert cmd == [sys.executable, "-c", jit.LAUNCHER, sys.executable, jit.BACKGROUND_COMMAND]
-    assert env["LINKWORK_JIT"] == "compiled"
+        backend = jit.select_backend()
+        again = jit.select_backend()  # a second trace in the same process starts no second compile
+    assert backend is jit.python_backend() and again is backend
+    assert cold == [[sys.executable, "-c", jit.LAUNCHER, "python", "-c", "compile everything", "compiled"]]
     assert "compiling kernels, first run only" in caplog.text
-    # Once the compile has finished, the next call of an entry point runs compiled code.
-    monkeypatch.setattr(jit, "kernels_cached", lambda: True)
-    monkeypatch.setattr(jit.SwitchingKernels, "CHECK_SECONDS", 0.0)
-    assert kernels.evaluate is march.evaluate
+
+
+def test_a_cold_library_call_compiles_in_the_foreground_and_starts_no_process(
+    cold: list[list[str]], caplog: pytest.LogCaptureFixture
+) -> None:
+    with caplog.at_level(logging.INFO, logger="linkwork.jit"):
+        backend = jit.select_backend()
+    assert backend is jit.compiled_backend()
+    assert cold == []  # a notebook or a Dask worker never starts a detached process
+    assert "compiling kernels, first run only" in caplog.text
+
+
+def test_one_trace_runs_one_backend_chosen_once(
+    cold: list[list[str]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The cache turns warm in the middle of the trace (a background compile finished): the trace keeps its twin.
+    jit.enable_background_compile(["true"])
+    chosen: list[jit.Backend] = []
+    real = jit.select_backend
+
+    def select(mode: str | None = None) -> jit.Backend:
+        chosen.append(real(mode))
+        monkeypatch.setattr(CACHE, "ready", lambda group: True)
+        return chosen[-1]
+
+    from linkwork.kinematics import tracer
+
+    monkeypatch.setattr(tracer, "select_backend", select)
+    calls: list[str] = []
+    twin = jit.python_backend()
+    spy = jit.Backend(False, *(_counting(getattr(twin, name), name, calls) for name in jit.ENTRY_POINTS))
+    monkeypatch.setitem(jit._BACKENDS, False, spy)
+    compiled_calls: list[str] = []
+    real_compiled = jit.compiled_backend()
+    watched = jit.Backend(
+        True, *(_counting(getattr(real_compiled, name), name, compiled_calls) for name in jit.ENTRY_POINTS)
+    )
+    monkeypatch.setitem(jit._BACKENDS, True, watched)
+    tr = lw.trace(lw.load("four-bar"), branches=True, max_steps=300)
+    assert len(chosen) == 1 and chosen[0] is spy
+    assert {"march", "evaluate"} <= set(calls)  # the twin's kernels ran ...
+    assert compiled_calls == []  # ... and the compiled ones never, though the cache turned warm
+    assert tr.branches
+
+
+def _counting(fn: Callable[..., object], name: str, calls: list[str]) -> Callable[..., object]:
+    def call(*args: object, **kwargs: object) -> object:
+        calls.append(name)
+        return fn(*args, **kwargs)
+
+    return call
 
 
 def test_the_launcher_starts_a_detached_process_and_returns_at_once(tmp_path: Path) -> None:
     marker = tmp_path / "ran"
     child = f"import pathlib, time; time.sleep(0.5); pathlib.Path({str(marker)!r}).write_text('yes')"
     begin = time.perf_counter()
-    subprocess.run([sys.executable, "-c", jit.LAUNCHER, sys.executable, child], check=True, timeout=30)
+    subprocess.run([sys.executable, "-c", jit.LAUNCHER, sys.executable, "-c", child], check=True, timeout=30)
     assert not marker.exists()  # the launcher did not wait for its child
     for _ in range(200):  # the detached child finishes on its own (up to 20 s on a loaded machine)
         if marker.exists():
@@ -118,26 +175,13 @@ def test_the_launcher_starts_a_detached_process_and_returns_at_once(tmp_path: Pa
     assert marker.read_text() == "yes", f"launched {time.perf_counter() - begin:.1f} s ago"
 
 
-def test_compile_time_is_not_trace_time(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_compile_time_is_not_trace_time(cold: list[list[str]], monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
-    monkeypatch.setattr(jit, "kernels_cached", lambda: False)
-    monkeypatch.setitem(jit._state, "ready", False)
-    monkeypatch.setattr(jit, "_warm_up", lambda: time.sleep(0.5))  # a stand-in compile of a known length
     begin = time.perf_counter()
     tr = lw.trace(lw.load("bennett"), until=("A", np.radians(70.0)))
     elapsed = time.perf_counter() - begin
-    assert elapsed >= 0.5
-    assert tr.stats.seconds <= elapsed - 0.5 + 1e-3
-
-
-def test_an_empty_cache_reads_as_cold(tmp_path: object) -> None:
-    code = (
-        "from linkwork.kinematics import jit, march; print(jit.kernels_cached(), jit.is_cached(march.march))"
-    )
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert out.stdout.split() == ["False", "False"]
-    assert jit.kernels_cached()  # this process has traced already: warm
+    assert elapsed >= 0.3
+    assert tr.stats.seconds <= elapsed - 0.3 + 1e-3
 
 
 def test_an_unknown_mode_is_reported_and_auto_used(

@@ -13,7 +13,7 @@ from typing import Annotated, Any
 
 import typer
 
-from linkwork.cli import demo, export, help, linkages, mechanize, robustness, sweep, synth, trace
+from linkwork.cli import demo, export, help, kernels, linkages, mechanize, robustness, sweep, synth, trace
 from linkwork.cli.common import fail
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -74,6 +74,7 @@ app.command("mechanize", cls=help.Command)(mechanize.mechanize)
 app.command("demo", cls=help.Command)(demo.demo)
 app.command("robustness", cls=help.Command)(robustness.robustness)
 app.command("sweep", cls=help.Command)(sweep.sweep)
+app.command("compile", cls=help.Command)(kernels.compile_kernels)
 app.add_typer(export.app, name="export")
 
 
@@ -116,5 +117,10 @@ class _StderrNote(logging.Handler):
 
 
 def main() -> None:
-    """Entry point of the ``linkwork`` script."""
+    """Entry point of the ``linkwork`` script: a cold run traces with the plain-Python kernels and compiles every
+    kernel for the next run in a detached process (only the script does this; library calls, and the command
+    group called from Python, compile in the foreground)."""
+    from linkwork.kinematics import jit
+
+    jit.enable_background_compile([sys.executable, "-c", kernels.BACKGROUND_COMMAND])
     app()

@@ -1,20 +1,23 @@
-"""Compiled or plain-Python kernels: which implementation of the tracing hot loop a trace runs, and when to compile.
+"""Compiled kernels or their plain-Python twins: chosen once when a call starts, kept for the whole call.
 
 The tracing kernels (:mod:`linkwork.kinematics.march` and :mod:`linkwork.kinematics.kernels`) are numba functions
-cached on disk. On a fresh install that cache is empty and compiling them takes longer than most traces. So, by
-default (``LINKWORK_JIT=auto``), a process that finds the cache cold traces with the *same* functions run as plain
-Python (numba's ``py_func``, rebound so that they call each other as Python too: identical arithmetic, no
-compile) and starts one background process that compiles the kernels into the cache for the next run; a long trace
-moves to the compiled kernels as soon as they are there (:class:`SwitchingKernels`). When the cache is warm, the
-kernels are loaded before the trace's clock starts, so a trace's reported time is tracing only.
+cached on disk (:mod:`linkwork.kernel_cache`: one directory keyed to the kernels' sources, and a marker that says
+which groups of kernels are compiled into it). :func:`select_backend` is called once at the start of a trace (and
+of a normalised-ratio computation) and returns a :class:`Backend`, which the trace keeps to its end:
 
-The hook: :class:`linkwork.kinematics.workspace.Workspace` holds ``kernels = march_kernels()``; the marcher, the
-bifurcation locator and ``Workspace.evaluate`` call ``ws.kernels.march``, ``.evaluate``, ``.correct`` and
-``.tangent_and_test``.
+* ``LINKWORK_JIT=python``: the plain-Python twins (numba's ``py_func`` of every kernel, rebound so that they call
+  each other as Python too: the same statements, no compile).
+* The marker says the tracing kernels are compiled (the usual case after the first run, after
+  ``linkwork compile``, or in this process after a compile): the compiled kernels, loaded from the cache before
+  the trace's clock starts.
+* The cache is cold and the command line asked for background compiles (:func:`enable_background_compile`; only
+  the ``linkwork`` script does, never a library call from a notebook or a Dask worker): the plain-Python twins,
+  and one detached process compiles every kernel into the cache for the next run.
+* Otherwise (a library call, or ``LINKWORK_JIT=compiled``) the kernels are compiled in this process first,
+  announced on the ``linkwork.jit`` logger and kept out of the trace's reported time.
 
-``LINKWORK_JIT=compiled`` always uses the compiled kernels, compiling them first in this process when the cache is
-cold (announced, and excluded from the trace's reported time); ``LINKWORK_JIT=python`` always uses plain Python.
-Announcements go to the ``linkwork.jit`` logger (the command line prints them on stderr).
+``linkwork compile`` fills the cache ahead of time (CI, container images, Dask workers). Announcements go to the
+``linkwork.jit`` logger (the command line prints them on stderr).
 """
 
 from __future__ import annotations
@@ -25,28 +28,39 @@ import subprocess
 import sys
 import time
 import types
-from collections.abc import Callable
-from pathlib import Path
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from numba.core.registry import CPUDispatcher
 
+from linkwork.kernel_cache import CACHE
+
 log = logging.getLogger("linkwork.jit")
 
 MODES = ("auto", "compiled", "python")
-ENTRY_POINTS = ("march", "evaluate", "correct", "tangent_and_test")
-"""The functions of :mod:`linkwork.kinematics.march` that the tracer, the marcher and the locators call."""
+ENTRY_POINTS = ("march", "evaluate", "correct", "tangent_and_test", "closure_jacobian")
+"""The kernels the tracer, the marcher, the locators and the normalised ratio call."""
 
-LOCK_NAME = "linkwork-compiling.lock"
-BACKGROUND_COMMAND = (
-    "from linkwork.kinematics.jit import compile_in_background; compile_in_background(); "
-    "from linkwork.synthesis.compiled import warm_up; warm_up()"
-)
-"""The background process: the tracing kernels first (holding the lock), then the synthesis search's, so that a
-later ``linkwork synth`` finds them cached too."""
+GROUP = "tracing"
+"""The marker's group of these kernels."""
+
 LOCK_STALE_SECONDS = 600.0
 
-_state: dict[str, Any] = {"compiling": False, "spawned": False, "compile_seconds": 0.0, "ready": False}
+_state: dict[str, Any] = {"loaded": False, "compiling": False, "spawned": False, "compile_seconds": 0.0}
+_background: list[list[str]] = []  # the command a cold CLI run starts (set by enable_background_compile)
+
+
+@dataclass(frozen=True)
+class Backend:
+    """One implementation of the tracing kernels: compiled (``compiled=True``) or their plain-Python twins."""
+
+    compiled: bool
+    march: Callable[..., Any]
+    evaluate: Callable[..., Any]
+    correct: Callable[..., Any]
+    tangent_and_test: Callable[..., Any]
+    closure_jacobian: Callable[..., Any]
 
 
 def mode() -> str:
@@ -82,109 +96,76 @@ def python_twin(functions: dict[str, CPUDispatcher]) -> types.SimpleNamespace:
     return types.SimpleNamespace(**{name: twin(d) for name, d in functions.items()})
 
 
-def is_cached(dispatcher: CPUDispatcher) -> bool:
-    """Whether ``dispatcher`` is compiled in this process or has a compiled version in numba's on-disk cache
-    (an index written by numba for this very source; a stale index reads as empty)."""
-    if dispatcher.signatures:
-        return True
-    try:
-        return bool(dispatcher._cache._cache_file._load_index())  # type: ignore[attr-defined]
-    except Exception:  # numba internals moved: assume warm, i.e. behave as before this module existed
-        return True
+def _dispatchers() -> dict[str, CPUDispatcher]:
+    from linkwork.kinematics import kernels, march
+
+    found = {name: getattr(march, name) for name in ENTRY_POINTS if name != "closure_jacobian"}
+    found["closure_jacobian"] = kernels.closure_jacobian
+    return found
 
 
-def _march_dispatchers() -> dict[str, CPUDispatcher]:
-    from linkwork.kinematics import march
-
-    return {name: getattr(march, name) for name in ENTRY_POINTS}
+_BACKENDS: dict[bool, Backend] = {}
 
 
-def kernels_cached() -> bool:
-    """Whether every tracing kernel is ready without compiling (in this process or in the on-disk cache)."""
-    return all(is_cached(d) for d in _march_dispatchers().values())
+def compiled_backend() -> Backend:
+    """The compiled kernels (compiled on their first call when the cache does not have them)."""
+    if True not in _BACKENDS:
+        _BACKENDS[True] = Backend(True, **_dispatchers())
+    return _BACKENDS[True]
 
 
-_TWIN: dict[str, types.SimpleNamespace] = {}
+def python_backend() -> Backend:
+    """The plain-Python twins of the kernels (built once per process)."""
+    if False not in _BACKENDS:
+        _BACKENDS[False] = Backend(False, **vars(python_twin(_dispatchers())))
+    return _BACKENDS[False]
 
 
-def march_kernels() -> Any:
-    """The implementation of :data:`ENTRY_POINTS` a trace should run now: the compiled module or its
-    plain-Python twin, by :func:`mode` and the state of the cache (see the module's docstring)."""
-    from linkwork.kinematics import march
-
-    chosen = mode()
-    if _state["compiling"]:
-        return march
+def select_backend(chosen: str | None = None) -> Backend:
+    """The kernels a call runs from start to end, chosen now (see the module's docstring): by ``chosen`` (default
+    :func:`mode`), the marker of the cache and whether this process may start a background compile."""
+    chosen = chosen or mode()
     if chosen == "python":
-        return plain_march_kernels()
-    if _state["ready"]:  # loaded in this process: no need to read the cache's index again (0.2 ms a kernel)
-        return march
-    if kernels_cached():
-        if not march.march.signatures:
-            compile_now()  # loads the cached machine code now, so that the trace's clock counts tracing only
-        _state["ready"] = True
-        return march
-    if chosen == "compiled":
-        compile_now(announce=True)
-        return march
-    start_background_compile()
-    return SwitchingKernels()
+        return python_backend()
+    if _state["loaded"] or _state["compiling"]:
+        return compiled_backend()
+    if CACHE.ready(GROUP):
+        compile_now()  # loads the cached machine code now, so that the trace's clock counts tracing only
+        return compiled_backend()
+    if chosen == "auto" and _background:
+        start_background_compile()
+        return python_backend()
+    compile_now(announce=True)
+    return compiled_backend()
 
 
-class SwitchingKernels:
-    """The plain-Python kernels until the background compile has filled the cache, then the compiled ones.
-
-    Looked up at every call of an entry point (``kernels.march(...)``); the cache is checked at most once every
-    :attr:`CHECK_SECONDS`, so that a long first trace moves to compiled code as soon as it exists. Both give the
-    same numbers (see :func:`python_twin`), so a trace may switch halfway.
-    """
-
-    CHECK_SECONDS = 1.0
-
-    def __init__(self) -> None:
-        self._compiled: Any = None
-        self._checked = time.monotonic()
-
-    def __getattr__(self, name: str) -> Any:
-        if name not in ENTRY_POINTS:
-            raise AttributeError(name)
-        if self._compiled is None and time.monotonic() - self._checked > self.CHECK_SECONDS:
-            self._checked = time.monotonic()
-            if background_compile_finished():
-                from linkwork.kinematics import march
-
-                self._compiled = march
-        return getattr(self._compiled or plain_march_kernels(), name)
-
-
-def background_compile_finished() -> bool:
-    """Whether no compile is under way (no fresh lock file) and the kernels are in the cache."""
-    return not _compile_under_way() and kernels_cached()
-
-
-def plain_march_kernels() -> types.SimpleNamespace:
-    """The plain-Python twin of the tracing kernels (built once per process)."""
-    if "march" not in _TWIN:
-        _TWIN["march"] = python_twin(_march_dispatchers())
-    return _TWIN["march"]
+def kernels_ready() -> bool:
+    """Whether the tracing kernels are loaded in this process or the marker says they are in the cache."""
+    return bool(_state["loaded"]) or CACHE.ready(GROUP)
 
 
 def compile_now(announce: bool = False) -> float:
-    """Compile the tracing kernels in this process (into numba's cache), or load them from it when they are
-    there, by tracing a small linkage with them; returns the seconds it took (their sum is
-    ``compile_seconds()``)."""
+    """Compile the tracing kernels in this process (into the cache), or load them from it when they are there,
+    by tracing a small linkage with them; marks the group ready and returns the seconds it took (their sum is
+    :func:`compile_seconds`)."""
     if announce:
-        log.info("compiling kernels, first run only ...")
+        log.info("compiling kernels, first run only (linkwork compile does it ahead of time) ...")
     started = time.perf_counter()
     _state["compiling"] = True
     try:
-        _warm_up()
+        warm_up()
     finally:
         _state["compiling"] = False
+    _state["loaded"] = True
+    if not CACHE.ready(GROUP):
+        try:
+            CACHE.mark_ready([GROUP])
+        except OSError as exc:  # a read-only cache: this process is compiled, the next one compiles again
+            log.warning("could not write the kernel cache's marker %s: %s", CACHE.marker, exc)
     seconds = time.perf_counter() - started
     _state["compile_seconds"] += seconds
     if announce:
-        log.info("compiled kernels in %.1f s (cached for next time)", seconds)
+        log.info("compiled kernels in %.1f s (cached in %s)", seconds, CACHE.directory)
     return seconds
 
 
@@ -193,8 +174,8 @@ def compile_seconds() -> float:
     return float(_state["compile_seconds"])
 
 
-def _warm_up() -> None:
-    """Run every entry point with the argument types a trace uses: adaptive traces of a Bennett linkage with a
+def warm_up() -> None:
+    """Run every tracing kernel with the argument types a trace uses: adaptive traces of a Bennett linkage with a
     target (and its normalised condition ratio), without one and up to a joint limit, and a paper-mode trace."""
     import math
 
@@ -209,52 +190,58 @@ def _warm_up() -> None:
     trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()
 
 
-def _compile_under_way() -> bool:
+# ---- the command line's background compile
+def enable_background_compile(command: Sequence[str]) -> None:
+    """Let a cold ``auto`` run trace with the plain-Python twins and start ``command`` (a detached process that
+    compiles every kernel into the cache and writes the marker). Called by the ``linkwork`` script only."""
+    _background[:] = [list(command)]
+
+
+def disable_background_compile() -> None:
+    """Undo :func:`enable_background_compile` (cold library calls compile in the foreground again)."""
+    _background.clear()
+
+
+def compile_under_way() -> bool:
     """Whether a fresh lock file says that a process is compiling the kernels into the cache."""
-    lock = _lock_path()
     try:
-        return lock is not None and time.time() - lock.stat().st_mtime < LOCK_STALE_SECONDS
+        return time.time() - CACHE.lock.stat().st_mtime < LOCK_STALE_SECONDS
     except OSError:
         return False
 
 
-def _touch_lock() -> None:
-    lock = _lock_path()
-    if lock is not None:
-        try:
-            lock.parent.mkdir(parents=True, exist_ok=True)
-            lock.touch()
-        except OSError:
-            pass
-
-
-def _lock_path() -> Path | None:
+def hold_lock() -> None:
+    """Write the lock file (a background compile is under way)."""
     try:
-        from linkwork.kinematics import march
+        CACHE.lock.parent.mkdir(parents=True, exist_ok=True)
+        CACHE.lock.touch()
+    except OSError:
+        pass
 
-        return Path(march.march._cache._cache_path) / LOCK_NAME  # type: ignore[attr-defined]
-    except Exception:
-        return None
+
+def release_lock() -> None:
+    """Remove the lock file."""
+    CACHE.lock.unlink(missing_ok=True)
 
 
 LAUNCHER = (
     "import subprocess, sys; "
-    "subprocess.Popen([sys.argv[1], '-c', sys.argv[2]], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, "
+    "subprocess.Popen(sys.argv[1:], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, "
     "stderr=subprocess.DEVNULL, start_new_session=True)"
 )
-"""The launcher's source: start ``python -c BACKGROUND_COMMAND`` in a new session, detached, and exit."""
+"""The launcher's source: start its arguments as a command in a new session, detached, and exit."""
 
 
 def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
-    """Start (at most once per process, and not while another process is at it) a detached Python process
-    running :func:`compile_in_background`, which fills the cache; returns whether one was started."""
-    if _state["spawned"]:
+    """Start (at most once per process, and not while another process is at it) the detached background compile
+    of :func:`enable_background_compile`; returns whether one was started."""
+    if _state["spawned"] or not _background:
         return False
     _state["spawned"] = True
-    if _compile_under_way():
+    if compile_under_way():
         log.info("kernels are compiling in another process; tracing with the Python kernels meanwhile")
         return False
-    _touch_lock()  # at once, so that a process started meanwhile does not compile too
+    hold_lock()  # at once, so that a process started meanwhile does not compile too
     log.info(
         "compiling kernels, first run only: in the background for next time; this run uses the Python kernels"
     )
@@ -262,7 +249,7 @@ def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
     # A short-lived launcher starts the detached compile and exits at once, and we wait for the launcher: this
     # process then holds no handle on a still-running child (whose Popen would warn when collected).
     (runner or subprocess.run)(
-        [sys.executable, "-c", LAUNCHER, sys.executable, BACKGROUND_COMMAND],
+        [sys.executable, "-c", LAUNCHER, *_background[0]],
         env=env,
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,
@@ -271,14 +258,3 @@ def start_background_compile(runner: Callable[..., Any] | None = None) -> bool:
         check=False,
     )
     return True
-
-
-def compile_in_background() -> None:
-    """Compile the tracing kernels into the cache holding the lock file (the background process's first job)."""
-    _touch_lock()
-    try:
-        compile_now()
-    finally:
-        lock = _lock_path()
-        if lock is not None:
-            lock.unlink(missing_ok=True)

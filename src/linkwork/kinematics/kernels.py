@@ -14,10 +14,11 @@ W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (21), (23).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from linkwork.kernel_cache import kernel
 
 
-@njit(cache=True)
+@kernel()
 def exp_unit_twist(w: np.ndarray, v: np.ndarray, theta: float, R: np.ndarray, p: np.ndarray) -> None:
     """Write ``exp(xi theta)`` for a unit twist (``|w| = 1`` or ``w = 0``) into ``R (3,3)`` and ``p (3,)``."""
     ww = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
@@ -51,7 +52,7 @@ def exp_unit_twist(w: np.ndarray, v: np.ndarray, theta: float, R: np.ndarray, p:
         p[i] += w[i] * wv * theta
 
 
-@njit(cache=True)
+@kernel()
 def log_rigid(R: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
     """Write the twist ``log([R, p])`` (6,) into ``out``."""
     cos_t = (R[0, 0] + R[1, 1] + R[2, 2] - 1.0) * 0.5
@@ -108,7 +109,7 @@ def log_rigid(R: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
     out[5] = p[2] - 0.5 * kz + D * k2z
 
 
-@njit(cache=True)
+@kernel()
 def closure_jacobian(
     twists: np.ndarray,
     q: np.ndarray,
@@ -131,7 +132,7 @@ def closure_jacobian(
     )
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def closure_pass(
     twists: np.ndarray,
     q: np.ndarray,
@@ -188,7 +189,7 @@ def closure_pass(
             residual[k * nrows + r] = lg[rows[r]] if weight is None else weighted_entry(weight, rows[r], lg)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def work_arrays() -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, ...]]:
     """The work arrays of :func:`closure_pass`: ``(Rg, Re, Rn)`` and ``(pg, pe, w, v, column, log)``."""
     matrices = (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)))
@@ -196,7 +197,7 @@ def work_arrays() -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.n
     return matrices, vectors
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def adjoint_column(Rg: np.ndarray, pg: np.ndarray, w: np.ndarray, v: np.ndarray, col: np.ndarray) -> None:
     """``col = Ad(g) xi = (Rg w, Rg v + pg x (Rg w))``: the twist ``xi = (w, v)`` carried to the base frame."""
     for i in range(3):
@@ -207,7 +208,7 @@ def adjoint_column(Rg: np.ndarray, pg: np.ndarray, w: np.ndarray, v: np.ndarray,
     col[5] += pg[0] * col[1] - pg[1] * col[0]
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def compose(Rg: np.ndarray, pg: np.ndarray, Re: np.ndarray, pe: np.ndarray, Rn: np.ndarray) -> None:
     """``g <- g e`` in place for rigid motions ``g = [Rg, pg]`` and ``e = [Re, pe]`` (``Rn`` is work space)."""
     for i in range(3):
@@ -220,7 +221,7 @@ def compose(Rg: np.ndarray, pg: np.ndarray, Re: np.ndarray, pe: np.ndarray, Rn: 
             Rg[i, c] = Rn[i, c]
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def weighted_entry(weight: np.ndarray, row: int, vector: np.ndarray) -> float:
     """``(W vector)[row]`` for a 6-vector."""
     acc = 0.0
@@ -229,7 +230,7 @@ def weighted_entry(weight: np.ndarray, row: int, vector: np.ndarray) -> float:
     return acc
 
 
-@njit(cache=True)
+@kernel()
 def expand(u: np.ndarray, groups: np.ndarray, q: np.ndarray) -> None:
     """Joint displacements ``q (n,)`` from unknowns ``u (m,)``; fixed joints (group -1) stay at 0."""
     for j in range(groups.shape[0]):
@@ -237,7 +238,7 @@ def expand(u: np.ndarray, groups: np.ndarray, q: np.ndarray) -> None:
         q[j] = u[g] if g >= 0 else 0.0
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def cholesky_in_place(A: np.ndarray, floor: float, fallback: float) -> bool:
     """Cholesky factor ``A = L L^T`` of a symmetric positive (semi)definite ``A``, written into its lower triangle
     (the lower triangle of ``A`` is all that is read).
@@ -261,7 +262,7 @@ def cholesky_in_place(A: np.ndarray, floor: float, fallback: float) -> bool:
     return True
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def cholesky_solve(L: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
     """``x`` solving ``L L^T x = b`` by two triangular solves, ``L`` the lower triangle of a Cholesky factor."""
     n = b.shape[0]

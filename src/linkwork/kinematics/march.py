@@ -17,8 +17,8 @@ W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (28).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_jacobian, expand
 from linkwork.kinematics.stops import StopReason
 
@@ -35,7 +35,7 @@ NO_EVENT = -1  # step_event: the step ends nothing
 TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
 
 
-@njit(cache=True)
+@kernel()
 def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac):
     """Residual and reduced Jacobian at unknowns ``u`` (``q``, ``res``, ``jac`` are work arrays)."""
     expand(u, groups, q)
@@ -43,7 +43,7 @@ def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, j
     return np.sqrt(np.sum(res * res))
 
 
-@njit(cache=True)
+@kernel()
 def correct(
     twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, exact, roundoff, truncate, max_iter, q,
     res, jac,
@@ -92,7 +92,7 @@ def correct(
     return False, max_iter, prev
 
 
-@njit(cache=True)
+@kernel()
 def least_squares_step(jac, res, held, u):
     """``u -= argmin |J du + r|`` over the unknowns other than ``held``, by Cholesky of ``J^T J``.
 
@@ -131,7 +131,7 @@ def least_squares_step(jac, res, held, u):
     return True
 
 
-@njit(cache=True)
+@kernel()
 def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
     """Oriented null vector, singular values and the signed test function at the current Jacobian.
 
@@ -168,7 +168,7 @@ def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
     return np.linalg.det(A)
 
 
-@njit(cache=True)
+@kernel()
 def wrapped_distance(a, b, periodic):
     """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to [-pi, pi)."""
     d = 0.0
@@ -180,7 +180,7 @@ def wrapped_distance(a, b, periodic):
     return np.sqrt(d)
 
 
-@njit(cache=True)
+@kernel()
 def step_geometry(u, t, u_try, t_new):
     """``(turn, dist, ahead)`` of a corrected step: the cosine between the tangents, the step's length and how far
     it went along the old tangent."""
@@ -195,7 +195,7 @@ def step_geometry(u, t, u_try, t_new):
     return turn, np.sqrt(dist), ahead
 
 
-@njit(cache=True)
+@kernel()
 def snap_home(u, u_home, periodic, out):
     """``out``: the start ``u_home`` written in the continuous angles of ``u`` (revolute unknowns differ from it
     by whole turns), the last row of a closed path."""
@@ -206,7 +206,7 @@ def snap_home(u, u_home, periodic, out):
         out[a] = u[a] + diff
 
 
-@njit(cache=True)
+@kernel()
 def predict(u, t, h, paper, drive, target, has_target, first, u_try):
     """The predictor (Sec. 4.1): ``u_try = u + step t``; returns ``(step, landing, held)``.
 
@@ -247,7 +247,7 @@ def predict(u, t, h, paper, drive, target, has_target, first, u_try):
     return step, landing, held
 
 
-@njit(cache=True)
+@kernel()
 def march(
     twists,
     loop_joint,
@@ -375,7 +375,7 @@ def march(
     return count, BUDGET, h
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, row, u, t, sig, r, tau, s):
     """Row ``row`` of the march's outputs: the point, its tangent, singular values, residual, test value and
     arclength."""
@@ -387,7 +387,7 @@ def write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, row, u, t, sig, 
     out_s[row] = s
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
     """Whether an adaptive step is kept: the tangent turned by less than ``acos(cos_turn)``, the corrector neither
     jumped (more than twice the step away) nor pulled the point back (less than ``advance`` of the step ahead)."""
@@ -396,7 +396,7 @@ def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
     return not (turn < cos_turn or jumped or pulled_back)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def step_event(u, landing, lo, hi, detect, tau_product):
     """The stop code an accepted step ends the march with (the target reached, a joint limit passed, a sign change
     of the test function, ``tau_product`` being the product of its last two values), ``NO_EVENT`` for none."""
@@ -410,7 +410,7 @@ def step_event(u, landing, lo, hi, detect, tau_product):
     return NO_EVENT
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def close_path(u, u_home, periodic, row, out_u, out_sigma, out_res, out_tau):
     """Make row ``row`` the start again (in ``u``'s continuous angles, see :func:`snap_home`): the path closed."""
     snap_home(u, u_home, periodic, out_u[row])

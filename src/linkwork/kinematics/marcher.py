@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
+from linkwork.kinematics.jit import Backend
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
@@ -110,9 +111,10 @@ class BranchMarcher:
         *,
         switch_branches: bool,
         progress: Progress | None = None,
+        kernels: Backend | None = None,
     ) -> None:
         self.mech = mech
-        self.ws = Workspace.of(mech)
+        self.ws = Workspace.of(mech, kernels)  # the kernels the whole trace runs (chosen by its caller)
         self.cfg = settings
         self.max_steps = max_steps
         self.budget = max_steps

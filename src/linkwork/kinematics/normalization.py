@@ -27,15 +27,13 @@ values are unchanged. Scaling every length by ``s`` scales ``v_c`` and ``L`` ali
 
 from __future__ import annotations
 
-import functools
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from linkwork.kinematics.kernels import closure_jacobian
+from linkwork.kinematics.jit import select_backend
 from linkwork.kinematics.mechanism import Array, Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank
 
@@ -73,28 +71,6 @@ def hinge_centre(axes: ArrayLike, joint_types: Sequence[str]) -> tuple[Array, fl
     return c[0], float(L[0])
 
 
-@functools.cache
-def _plain_closure_jacobian() -> Callable[..., None]:
-    """The closure-Jacobian kernel run as plain Python (the same statements; see :mod:`linkwork.kinematics.jit`)."""
-    from linkwork.kinematics import jit
-
-    compiled: Any = closure_jacobian
-    twin: Callable[..., None] = jit.python_twin({"closure_jacobian": compiled}).closure_jacobian
-    return twin
-
-
-def _jacobian_kernel() -> Callable[..., None]:
-    """The compiled kernel when it is ready (or compiling is asked for); its plain-Python twin while numba's cache is
-    cold, so that a first run does not compile it in the foreground (the background compile fills the cache)."""
-    from linkwork.kinematics import jit
-
-    chosen = jit.mode()
-    compiled: Any = closure_jacobian
-    if chosen == "python" or (chosen != "compiled" and not jit.is_cached(compiled)):
-        return _plain_closure_jacobian()
-    return closure_jacobian
-
-
 def _full_jacobians(mech: Mechanism, q: Array) -> Array:
     """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)``."""
     joints, signs, ptr = mech.loop_arrays()
@@ -105,7 +81,7 @@ def _full_jacobians(mech: Mechanism, q: Array) -> Array:
     rows = np.arange(6, dtype=np.int64)
     groups = np.arange(n, dtype=np.int64)
     twists = np.ascontiguousarray(mech.twists)
-    kernel = _jacobian_kernel()
+    kernel = select_backend().closure_jacobian  # compiled, or its plain-Python twin while the cache is cold
     for k, qk in enumerate(q):
         kernel(twists, np.ascontiguousarray(qk), joints, signs, ptr, rows, groups, n, residual, out[k])
     return out

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.kinematics.jit import select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
@@ -79,8 +80,9 @@ def trace(
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
     d_joint, d_unknown, target = _drive_and_target(mech, drive, until, steps)
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
-    # Workspace.of picks compiled or plain-Python kernels (and compiles or loads them) before the clock starts.
-    ws = Workspace.of(mech)
+    # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
+    backend = select_backend()
+    ws = Workspace.of(mech, backend)
     started = time.perf_counter()
     r0, _, jac0 = ws.evaluate(np.zeros(m))
     if r0 > tol.start_slack * tol.closure:
@@ -99,7 +101,9 @@ def trace(
         drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=float(np.cos(max_turn)),
         r_path=r_path, n_sigma=min(jac0.shape), periodic=periodic, lo=lo, hi=hi, tol=tol,
     )  # fmt: skip
-    marcher = BranchMarcher(mech, settings, max_steps, switch_branches=branches, progress=progress)
+    marcher = BranchMarcher(
+        mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend
+    )
     paper = steps is not None
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
     basis0 = np.ascontiguousarray(U0[:, :r_path])

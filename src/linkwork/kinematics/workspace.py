@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.kinematics.jit import march_kernels
+from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.mechanism import Mechanism
 
 Array = NDArray[np.float64]
@@ -22,7 +21,7 @@ class Workspace:
     :meth:`Mechanism.loop_arrays` and friends, in the layout :func:`linkwork.kinematics.march.march` takes;
     ``q``, ``res`` and ``jac`` are overwritten by every :meth:`evaluate`. ``kernels`` is the implementation of
     the :mod:`~linkwork.kinematics.march` kernels to call (compiled, or the same functions as plain Python while
-    numba's cache is cold; chosen by :func:`linkwork.kinematics.jit.march_kernels`).
+    the cache is cold), chosen once per trace by :func:`linkwork.kinematics.jit.select_backend`.
     """
 
     twists: Array
@@ -34,11 +33,12 @@ class Workspace:
     q: Array
     res: Array
     jac: Array
-    kernels: Any
+    kernels: Backend
 
     @classmethod
-    def of(cls, mech: Mechanism) -> Workspace:
-        """Scratch space for ``mech``."""
+    def of(cls, mech: Mechanism, kernels: Backend | None = None) -> Workspace:
+        """Scratch space for ``mech``, calling ``kernels`` (default: chosen now by
+        :func:`~linkwork.kinematics.jit.select_backend`)."""
         lj, ls, lp = mech.loop_arrays()
         return cls(
             twists=mech.twists,
@@ -50,7 +50,7 @@ class Workspace:
             q=np.empty(mech.n_joints),
             res=np.empty(mech.n_equations),
             jac=np.empty((mech.n_equations, mech.n_unknowns)),
-            kernels=march_kernels(),
+            kernels=kernels if kernels is not None else select_backend(),
         )
 
     def kernel_arrays(

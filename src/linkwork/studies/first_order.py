@@ -20,10 +20,10 @@ W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (21).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from linkwork.geometry import adjoint, exp_se3
+from linkwork.kernel_cache import kernel
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.studies.imperfections import HingeLines
@@ -83,7 +83,7 @@ def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array
     return G, normal
 
 
-@njit(cache=True, fastmath=True)
+@kernel(fastmath=True)
 def _first_order_kernel(G: np.ndarray, rows: np.ndarray, delta: np.ndarray) -> np.ndarray:
     # fastmath lets the compiler vectorise the dot products; each sample still runs the same instructions
     # whatever its chunk, so its numbers do not depend on the chunking.

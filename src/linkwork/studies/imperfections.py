@@ -23,10 +23,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
+from linkwork.kernel_cache import kernel
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.studies.scale import line_points
 
@@ -102,7 +102,7 @@ def sample_seeds(seed: int, start: int, stop: int) -> NDArray[np.uint64]:
     return _sample_seeds(key, start, stop)
 
 
-@njit(cache=True)
+@kernel()
 def _sample_seeds(key: np.ndarray, start: int, stop: int) -> np.ndarray:
     out = np.empty(stop - start, dtype=np.uint64)
     for i in range(start, stop):
@@ -110,7 +110,7 @@ def _sample_seeds(key: np.ndarray, start: int, stop: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@kernel()
 def _splitmix64(state: np.uint64) -> np.uint64:
     z = state + np.uint64(0x9E3779B97F4A7C15)
     z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
@@ -118,14 +118,14 @@ def _splitmix64(state: np.uint64) -> np.uint64:
     return z ^ (z >> np.uint64(31))
 
 
-@njit(cache=True)
+@kernel()
 def _uniform(seed: np.uint64, counter: int) -> float:
     """A uniform number in (0, 1) from the ``counter``-th splitmix64 output of ``seed``."""
     x = _splitmix64(seed + np.uint64(counter) * np.uint64(0x9E3779B97F4A7C15))
     return (float(x >> np.uint64(11)) + 0.5) * (1.0 / 9007199254740992.0)
 
 
-@njit(cache=True)
+@kernel()
 def unit_noise(seeds: np.ndarray, n_joints: int, uniform: bool) -> np.ndarray:
     """``(S, n, 4)`` noise of unit size per sample seed: ``(t1, t2, s1, s2)`` per joint, standard normal
     components, or two points uniform in the unit disc."""

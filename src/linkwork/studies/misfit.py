@@ -17,12 +17,12 @@ W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eqs. (21), (23).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand, work_arrays
 
 
-@njit(cache=True)
+@kernel()
 def weighted_closure(
     twists: np.ndarray,
     q: np.ndarray,
@@ -43,7 +43,7 @@ def weighted_closure(
     )
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _solve_normal(Jy: np.ndarray, r: np.ndarray, dy: np.ndarray, A: np.ndarray, b: np.ndarray) -> None:
     """Gauss-Newton step ``dy``: ``(A + mu I) dy = -Jy^T r`` with ``A = Jy^T Jy`` by Cholesky (``A``, ``b`` are
     work arrays); ``mu`` a tiny regularisation that keeps singular points finite."""
@@ -69,7 +69,7 @@ def _solve_normal(Jy: np.ndarray, r: np.ndarray, dy: np.ndarray, A: np.ndarray, 
     cholesky_solve(A, b, dy)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _on_plane(u_path: np.ndarray, normal: np.ndarray, k: int, y: np.ndarray, u: np.ndarray) -> None:
     """``u = u_k + Q_k y``: the unknowns at offset ``y`` in the plane normal to the nominal path at point ``k``."""
     for a in range(u.shape[0]):
@@ -79,7 +79,7 @@ def _on_plane(u_path: np.ndarray, normal: np.ndarray, k: int, y: np.ndarray, u: 
         u[a] = acc
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _warm_start(u_path: np.ndarray, normal: np.ndarray, k: int, u: np.ndarray, y: np.ndarray) -> None:
     """``y = Q_k^T (u - u_{k-1})``: the previous point's offset from the path, carried into point ``k``'s plane."""
     for c in range(y.shape[0]):
@@ -89,7 +89,7 @@ def _warm_start(u_path: np.ndarray, normal: np.ndarray, k: int, u: np.ndarray, y
         y[c] = acc
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _in_plane(J: np.ndarray, normal: np.ndarray, k: int, Jy: np.ndarray) -> None:
     """``Jy = J Q_k``: the Jacobian in the plane's coordinates."""
     for e in range(J.shape[0]):
@@ -100,7 +100,7 @@ def _in_plane(J: np.ndarray, normal: np.ndarray, k: int, Jy: np.ndarray) -> None
             Jy[e, c] = acc
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _predicted_gain(Jy: np.ndarray, dy: np.ndarray) -> float:
     """``|Jy dy|^2``: how much the step lowers ``|r|^2``, to first order."""
     gain = 0.0
@@ -112,7 +112,7 @@ def _predicted_gain(Jy: np.ndarray, dy: np.ndarray) -> float:
     return gain
 
 
-@njit(cache=True)
+@kernel()
 def misfit_along_path(
     twists: np.ndarray,
     u_path: np.ndarray,
@@ -185,7 +185,7 @@ def misfit_along_path(
         out[k] = best
 
 
-@njit(cache=True)
+@kernel()
 def misfit_batch(
     twists: np.ndarray,
     u_path: np.ndarray,

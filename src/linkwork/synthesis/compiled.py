@@ -14,14 +14,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
+
+from linkwork.kernel_cache import kernel
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _centroid(points: Array) -> tuple[float, float]:  # pragma: no cover - compiled
     """Mean of ``points (n, 2)``, summed in order."""
     n = points.shape[0]
@@ -32,7 +33,7 @@ def _centroid(points: Array) -> tuple[float, float]:  # pragma: no cover - compi
     return mx / n, my / n
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _best_turn(
     src: Array, tgt: Array, ms: tuple[float, float], mt: tuple[float, float]
 ) -> tuple[float, float]:  # pragma: no cover - compiled
@@ -51,7 +52,7 @@ def _best_turn(
     return (dot / h, cross / h) if h > 0.0 else (1.0, 0.0)
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _aligned_distance(src: Array, tgt: Array, rms: bool) -> float:  # pragma: no cover - compiled
     """Largest (or with ``rms`` the root mean square) distance after the best rigid registration of
     ``src (n, 2)`` onto ``tgt (n, 2)``: the one kernel behind both the error (Eq. 21) and :func:`fit_bound`.
@@ -74,7 +75,7 @@ def _aligned_distance(src: Array, tgt: Array, rms: bool) -> float:  # pragma: no
     return math.sqrt(acc / src.shape[0]) if rms else math.sqrt(acc)
 
 
-@njit(cache=True)
+@kernel()
 def fit_bound(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
     """A lower bound on the largest distance of ANY rigid placement of ``src (n, 2)`` against ``tgt (n, 2)``.
 
@@ -100,13 +101,13 @@ def fit_bound(src: Array, tgt: Array) -> float:  # pragma: no cover - compiled
     return best
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _fit(src: Array, tgt: Array, bound: bool) -> float:  # pragma: no cover - compiled
     """The error of ``src`` registered onto ``tgt`` (Eq. 21), or with ``bound`` its :func:`fit_bound`."""
     return fit_bound(src, tgt) if bound else _aligned_distance(src, tgt, False)
 
 
-@njit(cache=True)
+@kernel()
 def _mean_shape(points: Array, offsets: IntArray, starts: IntArray, pieces: int) -> tuple[Array, Array]:
     """``(z, mean)``: the pieces ``(p, n, 2)`` and their mean shape in profile 1's frame (Eqs. 12-14)."""
     p = starts.shape[0]
@@ -126,7 +127,7 @@ def _mean_shape(points: Array, offsets: IntArray, starts: IntArray, pieces: int)
     return z, mean
 
 
-@njit(cache=True)
+@kernel()
 def mean_fits(
     points: Array, offsets: IntArray, starts: IntArray, pieces: int, bound: bool
 ) -> Array:  # pragma: no cover - compiled
@@ -139,7 +140,7 @@ def mean_fits(
     return out
 
 
-@njit(cache=True)
+@kernel()
 def _arc(pieces: IntArray, curvature: float, piece_length: float) -> Array:  # pragma: no cover - compiled
     """The arc of the longest instance: equal chords ``piece_length``, each turning by the same angle."""
     longest = 0
@@ -154,7 +155,7 @@ def _arc(pieces: IntArray, curvature: float, piece_length: float) -> Array:  # p
     return arc
 
 
-@njit(cache=True)
+@kernel()
 def arc_fits(
     points: Array,
     offsets: IntArray,

@@ -17,9 +17,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from linkwork.kernel_cache import kernel
 from linkwork.synthesis.compiled import arc_fits, mean_fits
 from linkwork.synthesis.error_kernels import ProfileTables
 from linkwork.synthesis.segment_matrix import MAX_ITERATIONS, PATIENCE, SearchOutcome
@@ -31,7 +31,7 @@ IntArray = NDArray[np.int64]
 MAX_ENTRIES = 128
 
 
-@njit(cache=True)
+@kernel()
 def _pairwise_sum(a: Array, lo: int, n: int) -> float:  # pragma: no cover - compiled
     """numpy's pairwise summation of ``a[lo : lo + n]``, ``n <= 128`` (the order ``ndarray.mean`` uses).
 
@@ -60,7 +60,7 @@ def _pairwise_sum(a: Array, lo: int, n: int) -> float:  # pragma: no cover - com
     return np.nan
 
 
-@njit(cache=True)
+@kernel()
 def _arc_parameters(
     offsets: IntArray, chord_sum: Array, curvature_sum: Array, first: IntArray, pieces: IntArray
 ) -> tuple[float, float]:  # pragma: no cover - compiled
@@ -82,7 +82,7 @@ def _arc_parameters(
     return kappa, s_bar
 
 
-@njit(cache=True)
+@kernel()
 def _segment_matrix_table(
     sm: IntArray,
     is_m: NDArray[np.bool_],
@@ -110,7 +110,7 @@ def _segment_matrix_table(
     return em
 
 
-@njit(cache=True)
+@kernel()
 def _adjust(sm: IntArray, em: Array, is_m: NDArray[np.bool_], absorber: int, alpha: int) -> IntArray:
     """The adjustment rules of Sec. 4, decision for decision as ``segment_matrix.adjust``."""  # pragma: no cover
     q, p = sm.shape
@@ -170,7 +170,7 @@ def _adjust(sm: IntArray, em: Array, is_m: NDArray[np.bool_], absorber: int, alp
     return out
 
 
-@njit(cache=True)
+@kernel()
 def _search(
     starts: IntArray,
     is_m: NDArray[np.bool_],

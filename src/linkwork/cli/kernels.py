@@ -1,0 +1,96 @@
+"""``linkwork compile``: compile every kernel into the cache ahead of time, and the background compile of a cold run.
+
+A fresh install traces with the plain-Python twins of the kernels until the cache is filled (see
+:mod:`linkwork.kinematics.jit`). ``linkwork compile`` fills it now: in CI, in a container image, on every Dask
+worker's image, so that no run meets a cold cache. The first ``linkwork`` command of a cold install starts the same
+compile in a detached background process (:func:`compile_in_background`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from linkwork.cli.common import friendly_errors
+from linkwork.outputs.staging import console
+
+BACKGROUND_COMMAND = "from linkwork.cli.kernels import compile_in_background; compile_in_background()"
+"""What the detached background process runs (``python -c``)."""
+
+
+def warm_tracing() -> None:
+    """The tracing kernels, and the normalised ratio's (in this process: loaded or compiled)."""
+    from linkwork.kinematics import jit
+
+    jit.compile_now()
+
+
+def warm_synthesis() -> None:
+    """The segment-matrix search's kernels."""
+    from linkwork.synthesis.compiled import warm_up
+
+    warm_up()
+
+
+def warm_studies() -> None:
+    """The imperfection study's kernels (seeds, noise, misfit by Gauss-Newton, first-order prediction), on a short
+    nominal path of a Bennett linkage."""
+    import numpy as np
+
+    from linkwork.io.spec import resolve_spec
+    from linkwork.kinematics.tracer import trace
+    from linkwork.studies.imperfections import ImperfectionModel
+    from linkwork.studies.robustness import prepare, run_chunk
+
+    mech = resolve_spec("bennett", {}).mechanism
+    nominal = trace(mech, until=(mech.joint_names[0], float(mech.offsets[0]) + 0.2))
+    for distribution in ("normal", "uniform"):
+        model = ImperfectionModel(1e-3, float(np.radians(0.05)), distribution=distribution)
+        run_chunk(prepare(mech, nominal, model, seed=1), 0, 2)
+
+
+WARM_UPS: dict[str, Callable[[], None]] = {
+    "tracing": warm_tracing,
+    "synthesis": warm_synthesis,
+    "studies": warm_studies,
+}
+"""Each group of the marker and what compiles it."""
+
+
+def compile_all(report: Callable[[str, float], None] | None = None) -> float:
+    """Compile (or load) every group of kernels and mark each ready in the cache; returns the seconds taken."""
+    from linkwork.kernel_cache import CACHE
+
+    begin = time.perf_counter()
+    for group, warm in WARM_UPS.items():
+        started = time.perf_counter()
+        warm()
+        CACHE.mark_ready([group])
+        if report is not None:
+            report(group, time.perf_counter() - started)
+    CACHE.remove_stale()
+    return time.perf_counter() - begin
+
+
+def compile_in_background() -> None:
+    """The detached background process: every kernel into the cache, holding the lock file meanwhile."""
+    from linkwork.kinematics import jit
+
+    jit.hold_lock()
+    try:
+        compile_all()
+    finally:
+        jit.release_lock()
+
+
+@friendly_errors
+def compile_kernels() -> None:
+    """Compile every kernel into linkwork's cache now (for CI, container images and Dask workers), so that no
+    later run traces with the slower plain-Python kernels or compiles on its first call."""
+    from linkwork.kernel_cache import CACHE
+
+    def report(group: str, seconds: float) -> None:
+        console.print(f"{group}: ready ({seconds:.1f} s)")
+
+    seconds = compile_all(report)
+    console.print(f"kernels compiled in {seconds:.1f} s into {CACHE.directory}", soft_wrap=True)
