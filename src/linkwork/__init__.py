@@ -77,10 +77,10 @@ def _file_units(spec: str | pathlib.Path, params: dict[str, Any]) -> dict[str, A
         return params
     import math
 
-    from linkwork.io.spec import _import_builtins
+    from linkwork.io.spec import import_builtins
     from linkwork.linkages.registry import REGISTRY, get
 
-    _import_builtins()
+    import_builtins()
     if str(spec).replace("_", "-").lower() not in REGISTRY:
         return params  # a file name without .toml, or an unknown name: resolve_spec says which
     entry = get(str(spec))

@@ -83,13 +83,13 @@ def test_exit_codes_are_documented_in_help_and_readme() -> None:
 
 def test_a_cold_kernel_cache_is_announced_on_stderr(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from linkwork.kernel_cache import CACHE
-    from linkwork.kinematics import jit
+    from linkwork.kinematics import jit, tracer
 
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
     monkeypatch.setattr(CACHE, "ready", lambda group: False)
     monkeypatch.setattr(CACHE, "mark_ready", lambda groups: None)
     monkeypatch.setitem(jit._state, "loaded", False)
-    monkeypatch.setattr(jit, "warm_up", lambda: None)  # the kernels are compiled in this process already
+    monkeypatch.setattr(tracer, "warm_up", lambda: None)  # the kernels are compiled in this process already
     result = runner.invoke(
         app, ["trace", "bennett", "--until", "A=70", "--no-plots", "-o", str(tmp_path / "t")]
     )

@@ -11,10 +11,10 @@ from fuzzkit import EXAMPLES, FUZZ, HOSTILE_TEXT, run_cli
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from linkwork.io.spec import _import_builtins
+from linkwork.io.spec import import_builtins
 from linkwork.linkages.registry import REGISTRY
 
-_import_builtins()
+import_builtins()
 #: Built-ins quick to build (the Bricard linkages search for their start assembly, seconds each).
 QUICK = sorted(name for name in REGISTRY if not name.startswith("bricard"))
 

@@ -232,10 +232,10 @@ def assert_same_mechanism(got: Mechanism, want: Mechanism) -> None:
 
 
 def builtin_cases() -> list[tuple[str, dict[str, float]]]:
-    from linkwork.io.spec import _import_builtins
+    from linkwork.io.spec import import_builtins
     from linkwork.linkages.registry import REGISTRY
 
-    _import_builtins()
+    import_builtins()
     cases: list[tuple[str, dict[str, float]]] = [(name, {}) for name in sorted(REGISTRY)]
     if "hedgepeth" in REGISTRY:
         cases += [("hedgepeth", {"n": 4}), ("hedgepeth", {"n": 10})]  # n = 10 carries couplings

@@ -263,10 +263,8 @@ def kernel(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     joint, sign, ptr = mech.loop_arrays()
     residual = np.empty(mech.n_equations)
     jac = np.empty((mech.n_equations, mech.n_unknowns))
-    kernels.closure_jacobian(
-        mech.twists, np.ascontiguousarray(q, dtype=float), joint, sign, ptr,
-        np.array(mech.rows, dtype=np.int64), mech.groups, mech.n_unknowns, residual, jac,
-    )  # fmt: skip
+    arrays = (mech.twists, joint, sign, ptr, np.array(mech.rows, dtype=np.int64), mech.groups)
+    kernels.closure_jacobian(arrays, np.ascontiguousarray(q, dtype=float), mech.n_unknowns, residual, jac)
     return residual, jac
 
 

@@ -22,7 +22,7 @@ from numba.core.registry import CPUDispatcher
 
 import linkwork as lw
 from linkwork.kernel_cache import CACHE
-from linkwork.kinematics import jit, march
+from linkwork.kinematics import jit, march, tracer
 from linkwork.linkages.hedgepeth_rods import deployed_angles
 
 
@@ -93,7 +93,7 @@ def cold(monkeypatch: pytest.MonkeyPatch) -> list[list[str]]:
     monkeypatch.setattr(
         subprocess, "run", lambda cmd, **kw: started.append([*cmd, kw["env"]["LINKWORK_JIT"]])
     )
-    monkeypatch.setattr(jit, "warm_up", lambda: time.sleep(0.3))  # a stand-in compile of a known length
+    monkeypatch.setattr(tracer, "warm_up", lambda: time.sleep(0.3))  # a stand-in compile of a known length
     monkeypatch.setattr(jit, "_background", [])
     monkeypatch.setenv("LINKWORK_JIT", "auto")
     return started
@@ -104,8 +104,8 @@ def test_a_cold_command_line_run_traces_in_python_and_compiles_in_the_background
 ) -> None:
     jit.enable_background_compile(["python", "-c", "compile everything"])
     with caplog.at_level(logging.INFO, logger="linkwork.jit"):
-        backend = jit.select_backend()
-        again = jit.select_backend()  # a second trace in the same process starts no second compile
+        backend = jit.select_backend(warm_up=tracer.warm_up)
+        again = jit.select_backend(warm_up=tracer.warm_up)  # a second trace starts no second compile
     assert backend is jit.python_backend() and again is backend
     assert cold == [[sys.executable, "-c", jit.LAUNCHER, "python", "-c", "compile everything", "compiled"]]
     assert "compiling kernels, first run only" in caplog.text
@@ -115,7 +115,7 @@ def test_a_cold_library_call_compiles_in_the_foreground_and_starts_no_process(
     cold: list[list[str]], caplog: pytest.LogCaptureFixture
 ) -> None:
     with caplog.at_level(logging.INFO, logger="linkwork.jit"):
-        backend = jit.select_backend()
+        backend = jit.select_backend(warm_up=tracer.warm_up)
     assert backend is jit.compiled_backend()
     assert cold == []  # a notebook or a Dask worker never starts a detached process
     assert "compiling kernels, first run only" in caplog.text
@@ -129,12 +129,10 @@ def test_one_trace_runs_one_backend_chosen_once(
     chosen: list[jit.Backend] = []
     real = jit.select_backend
 
-    def select(mode: str | None = None) -> jit.Backend:
-        chosen.append(real(mode))
+    def select(mode: str | None = None, warm_up: Callable[[], None] | None = None) -> jit.Backend:
+        chosen.append(real(mode, warm_up))
         monkeypatch.setattr(CACHE, "ready", lambda group: True)
         return chosen[-1]
-
-    from linkwork.kinematics import tracer
 
     monkeypatch.setattr(tracer, "select_backend", select)
     calls: list[str] = []
@@ -202,3 +200,13 @@ def test_the_normalised_ratio_is_the_same_with_the_python_jacobian(monkeypatch: 
     monkeypatch.setenv("LINKWORK_JIT", "python")
     plain = normalization.condition_ratios(tr.mechanism, tr.angles, tr.rank)
     np.testing.assert_allclose(plain, compiled, rtol=1e-12, atol=0.0)
+
+
+def test_the_warm_up_traces_the_built_in_bennett_linkage() -> None:
+    from linkwork.kinematics.chains import from_dh
+
+    params = [{"theta": t, "d": 0.0, "a": np.sin(al), "alpha": al} for t, al in tracer.WARM_UP_DH]
+    mech, _ = from_dh("Bennett linkage", params, joint_names=("A", "B", "C", "D"))
+    builtin = lw.load("bennett")
+    np.testing.assert_allclose(mech.offsets, builtin.offsets, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(mech.twists, builtin.twists, rtol=0, atol=1e-15)

@@ -103,6 +103,6 @@ def test_weighted_closure_matches_the_numpy_reference(bennett):
     rows = np.array(mech.rows, dtype=np.int64)
     r = np.empty(mech.n_equations)
     J = np.empty((mech.n_equations, mech.n_unknowns))
-    weighted_closure(mech.twists, q, joint, sign, ptr, rows, mech.groups, T, r, J)
+    weighted_closure((mech.twists, joint, sign, ptr, rows, mech.groups), q, T, r, J)
     np.testing.assert_allclose(r, T @ closure_residual(mech, q), atol=1e-13)
     np.testing.assert_allclose(J, T @ jacobian(mech, q) @ mech.coupling_matrix(), atol=1e-13)

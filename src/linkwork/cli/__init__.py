@@ -80,7 +80,7 @@ app.add_typer(export.app, name="export")
 
 def _print_version(value: bool) -> None:
     if value:
-        from linkwork import __version__
+        from linkwork.version import __version__
 
         typer.echo(f"linkwork {__version__}")
         raise typer.Exit()

@@ -20,16 +20,28 @@ BACKGROUND_COMMAND = "from linkwork.cli.kernels import compile_in_background; co
 
 def warm_tracing() -> None:
     """The tracing kernels, and the normalised ratio's (in this process: loaded or compiled)."""
-    from linkwork.kinematics import jit
+    from linkwork.kinematics import jit, tracer
 
-    jit.compile_now()
+    jit.compile_now(tracer.warm_up)
 
 
 def warm_synthesis() -> None:
-    """The segment-matrix search's kernels."""
-    from linkwork.synthesis.compiled import warm_up
+    """The segment-matrix search's kernels (:mod:`linkwork.synthesis.compiled`,
+    :mod:`linkwork.synthesis.compiled_search`), with the argument types the search uses."""
+    import numpy as np
 
-    warm_up()
+    from linkwork.synthesis.compiled_search import CompiledTables, compiled_rms_bound, compiled_search
+    from linkwork.synthesis.error_kernels import ProfileTables
+
+    t = np.linspace(0.0, 1.0, 9)
+    curve = np.column_stack([t, 0.1 * np.sin(3.0 * t)])
+    tables = ProfileTables([curve, 1.1 * curve], compiled=True)
+    tables.mean_errors([0, 1], 4)
+    tables.arc_errors([0, 1], [4, 5])
+    compiled = CompiledTables.from_tables(tables)  # the segment-matrix search: 8 pieces on both profiles
+    start = np.array([[4, 4], [4, 4]], dtype=np.int64)
+    compiled_search("MC", [start], 2, compiled)
+    compiled_rms_bound("MC", start, compiled)
 
 
 def warm_studies() -> None:

@@ -43,7 +43,7 @@ _MAX_DEPTH = 24  # recursion limit of the adaptive flattening: 2**24 pieces per 
 # ---------------------------------------------------------------------------------------------------- checks
 
 
-def _size(points: Points) -> float:
+def bounding_size(points: Points) -> float:
     """The diagonal of the bounding box of ``points`` (1 for a degenerate box: tolerances stay positive)."""
     if len(points) == 0:
         return 1.0
@@ -66,7 +66,7 @@ def is_closed(points: ArrayLike) -> bool:
     pts = np.asarray(points, dtype=float)
     if len(pts) < 3:
         return False
-    return bool(np.hypot(*(pts[-1] - pts[0])) <= COINCIDENT * _size(pts))
+    return bool(np.hypot(*(pts[-1] - pts[0])) <= COINCIDENT * bounding_size(pts))
 
 
 def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
@@ -91,7 +91,7 @@ def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
     if n_pieces < 2:
         return None
     closed = is_closed(pts)
-    length_tol = COINCIDENT * _size(pts)
+    length_tol = COINCIDENT * bounding_size(pts)
     a, b = pts[:-1], pts[1:]
     direction = b - a
     piece_length = np.hypot(direction[:, 0], direction[:, 1])
@@ -205,7 +205,7 @@ def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points
             source=where,
         )
     step = np.hypot(*np.diff(pts, axis=0).T)
-    repeated = np.flatnonzero(step <= COINCIDENT * _size(pts))
+    repeated = np.flatnonzero(step <= COINCIDENT * bounding_size(pts))
     if len(repeated):
         i = int(repeated[0])
         raise SpecError(
@@ -226,7 +226,7 @@ def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points
 # ------------------------------------------------------------------------------------------- flattening
 
 
-def _flatten(
+def flatten_curve(
     curve: Callable[[float], tuple[float, float]],
     tolerance: float,
     depth: int = 0,
@@ -260,7 +260,7 @@ def _flatten(
         return [p1]
     tm = 0.5 * (t0 + t1)
     pm = curve(tm)
-    return _flatten(curve, tolerance, depth + 1, t0, tm, p0, pm) + _flatten(
+    return flatten_curve(curve, tolerance, depth + 1, t0, tm, p0, pm) + flatten_curve(
         curve, tolerance, depth + 1, tm, t1, pm, p1
     )
 
@@ -286,7 +286,7 @@ def _arc_points(
     return [(center[0] + radius * math.cos(a), center[1] + radius * math.sin(a)) for a in angles]
 
 
-def _spline_points(entity: Any, tolerance: float, path: Path) -> Points:
+def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
     """A DXF SPLINE flattened by ezdxf to ``tolerance`` times the size of its control points."""
     count = len(entity.control_points)
     order = int(entity.dxf.get("degree", 3)) + 1
@@ -302,7 +302,7 @@ def _spline_points(entity: Any, tolerance: float, path: Path) -> Points:
             f"the SPLINE has a control point that is not finite or beyond +-{MAX_COORDINATE:g}",
             source=str(path),
         )
-    absolute = tolerance * _size(control)
+    absolute = tolerance * bounding_size(control)
     points = []
     for v in spline.flattening(absolute, segments=8):
         points.append((v.x, v.y))
@@ -313,13 +313,13 @@ def _spline_points(entity: Any, tolerance: float, path: Path) -> Points:
     return np.array(points, dtype=float)
 
 
-def _bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, tolerance: float) -> Points:
+def bulge_polyline(vertices: list[tuple[float, float, float]], closed: bool, tolerance: float) -> Points:
     """Flatten polyline vertices ``(x, y, bulge)`` whose bulge turns the piece after a vertex into an arc."""
     from ezdxf.math import bulge_to_arc
 
     if not vertices:
         return np.empty((0, 2))
-    absolute = tolerance * _size(np.array([v[:2] for v in vertices], dtype=float))
+    absolute = tolerance * bounding_size(np.array([v[:2] for v in vertices], dtype=float))
     chain = [*vertices, vertices[0]] if closed else vertices
     points = [chain[0][:2]]
     for number, ((x0, y0, bulge), (x1, y1, _)) in enumerate(itertools.pairwise(chain), start=1):

@@ -13,20 +13,10 @@ from typing import Any
 
 import numpy as np
 
-from linkwork.io.curves import Points, _size
+from linkwork.io.curves import Points, bounding_size
+from linkwork.units import LENGTH_UNITS
 
 __all__ = ["LENGTH_UNITS", "new_dxf", "svg_d", "svg_document", "svg_path", "xml_escape"]
-
-#: Length units a problem file may name (``units = "mm"``): DXF ``$INSUNITS`` code, and the SVG unit and factor
-#: that express one such length (SVG has no metre, foot or micrometre).
-LENGTH_UNITS: dict[str, tuple[int, str, float]] = {
-    "mm": (4, "mm", 1.0),
-    "cm": (5, "cm", 1.0),
-    "m": (6, "mm", 1000.0),
-    "um": (13, "mm", 0.001),
-    "in": (1, "in", 1.0),
-    "ft": (2, "in", 12.0),
-}
 
 
 def svg_path(d: str, colour: str, *, dashed: bool = False, label: str | None = None) -> str:
@@ -50,7 +40,7 @@ def svg_document(
     ``pixels`` across."""
     everything = np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents])
     lo, hi = everything.min(axis=0), everything.max(axis=0)
-    margin = 0.05 * _size(everything)
+    margin = 0.05 * bounding_size(everything)
     x0, y0 = lo[0] - margin, -hi[1] - margin
     width, height = hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin
     if units is None:

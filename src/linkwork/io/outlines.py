@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from linkwork.io.curves import _size
+from linkwork.io.curves import bounding_size
 from linkwork.io.drawing import new_dxf, svg_d, svg_document, svg_path, xml_escape
 
 if TYPE_CHECKING:
@@ -39,7 +39,7 @@ def write_outline_svg(path: str | Path, result: SynthesisResult) -> None:
     chains = final_chain(result)
     joints = _live_joints(result)
     extents = [t.points for t in result.targets] + [c.points for c in chains]
-    radius = 0.006 * _size(np.vstack(extents))
+    radius = 0.006 * bounding_size(np.vstack(extents))
     body = []
     for j, (target, chain) in enumerate(zip(result.targets, chains, strict=True)):
         name = target.name or f"profile {j + 1}"
@@ -67,7 +67,7 @@ def write_outline_dxf(path: str | Path, result: SynthesisResult) -> None:
     """
     chains = final_chain(result)
     joints = _live_joints(result)
-    radius = 0.006 * _size(np.vstack([t.points for t in result.targets]))
+    radius = 0.006 * bounding_size(np.vstack([t.points for t in result.targets]))
     document = new_dxf(result.problem.units)
     space = document.modelspace()
     layers = _dxf_layer_names([t.name or f"profile {j + 1}" for j, t in enumerate(result.targets)])

@@ -33,13 +33,13 @@ from linkwork.io.curves import (
     MAX_COORDINATE,
     MAX_FLATTENED_POINTS,
     Points,
-    _bulge_polyline,
-    _flatten,
-    _size,
-    _spline_points,
+    bounding_size,
+    bulge_polyline,
     check_profile,
     find_self_crossing,
+    flatten_curve,
     is_closed,
+    spline_points,
 )
 from linkwork.io.drawing import LENGTH_UNITS, new_dxf, svg_d, svg_document, svg_path
 from linkwork.io.outlines import final_chain, write_outline_dxf, write_outline_svg
@@ -209,7 +209,7 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
         if isinstance(segment, svg_lib.Arc):
             box = segment.bbox()
             defining += [(box[0], box[1]), (box[2], box[3])]
-    absolute = tolerance * _size(np.array(defining, dtype=float))
+    absolute = tolerance * bounding_size(np.array(defining, dtype=float))
     first = segments[0].start
     points: list[tuple[float, float]] = [(float(first.x), float(first.y))]
     for segment in segments:
@@ -223,7 +223,7 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
                 point = segment.point(t)
                 return (float(point.x), float(point.y))
 
-            points += _flatten(curve, absolute)
+            points += flatten_curve(curve, absolute)
     pts = np.array(points, dtype=float)
     return np.column_stack([pts[:, 0], -pts[:, 1]]) + 0.0  # + 0.0 turns -0.0 into 0.0
 
@@ -263,7 +263,7 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     entity = entities[0]
     kind = entity.dxftype()
     if kind == "SPLINE":
-        return _spline_points(entity, tolerance, path)
+        return spline_points(entity, tolerance, path)
     if kind == "LWPOLYLINE":
         vertices = [(float(x), float(y), float(bulge)) for x, y, bulge in entity.get_points("xyb")]
         closed = bool(entity.closed)
@@ -277,7 +277,7 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
             for v in entity.vertices
         ]
         closed = bool(entity.is_closed)
-    return _bulge_polyline(vertices, closed, tolerance)
+    return bulge_polyline(vertices, closed, tolerance)
 
 
 def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:

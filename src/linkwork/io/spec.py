@@ -49,10 +49,10 @@ from linkwork.io.spec_reader import (
     ANGLE_UNITS,
     CONVENTIONS,
     TOP_KEYS,
-    _read_loop,
-    _read_mechanism,
-    _read_points,
-    _Reader,
+    SpecReader,
+    read_loop_table,
+    read_mechanism_table,
+    read_points_table,
 )
 
 # The reader's key tables and limits and the writer keep their old import path, ``linkwork.io.spec``.
@@ -135,7 +135,7 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     path = Path(path)
     source = str(path)
     table = _read_toml(path)
-    reader = _Reader(source)
+    reader = SpecReader(source)
     reader.check_keys(table, "", TOP_KEYS)
     name = reader.string(table, "name", "", default=path.stem, limit=MAX_NAME_CHARS)
     if re.search(r"[\x00-\x08\x0a-\x1f\x7f\u2028\u2029]", name):  # a tab is fine (and valid XML)
@@ -157,9 +157,9 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     meta = {"source": source}
     try:
         if has_loop:
-            mech, assembly, couplings = _read_loop(reader, table["loop"], name, meta, closure_tol)
+            mech, assembly, couplings = read_loop_table(reader, table["loop"], name, meta, closure_tol)
         else:
-            mech, couplings = _read_mechanism(reader, table["mechanism"], name, meta)
+            mech, couplings = read_mechanism_table(reader, table["mechanism"], name, meta)
             assembly = None
     except AssemblyError as exc:
         raise AssemblyError(f"{source}: {exc}", residual=exc.residual) from None
@@ -169,7 +169,7 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     if assembly is None:
         _check_not_near_mobile(mech, source, closure_tol)
     if "points" in table:
-        mech = replace(mech, meta={**mech.meta, "points": _read_points(reader, table["points"], mech)})
+        mech = replace(mech, meta={**mech.meta, "points": read_points_table(reader, table["points"], mech)})
     return LoadedSpec(mechanism=mech, assembly=assembly, source=path)
 
 
@@ -227,11 +227,11 @@ def resolve_spec(
         return load_spec(path, closure_tol=closure_tol)
     from linkwork.linkages.registry import get
 
-    _import_builtins()
+    import_builtins()
     return LoadedSpec(mechanism=get(str(spec)).make(**params), assembly=None, source=None)
 
 
-def _import_builtins() -> None:
+def import_builtins() -> None:
     """Import every module of :mod:`linkwork.linkages` so that each registers its built-ins."""
     import linkwork.linkages as package
 

@@ -73,7 +73,7 @@ _closest = closest
 _key = key_path
 
 
-class _Reader(TomlReader):
+class SpecReader(TomlReader):
     """The spec file's reader: :class:`TomlReader` plus joints, joint names and couplings."""
 
     def __init__(self, source: str) -> None:
@@ -158,8 +158,8 @@ class _Reader(TomlReader):
 Couplings = tuple[list[list[str]], list[str]]
 
 
-def _read_loop(
-    reader: _Reader, value: Any, name: str, meta: Mapping[str, Any], closure_tol: float = 1e-12
+def read_loop_table(
+    reader: SpecReader, value: Any, name: str, meta: Mapping[str, Any], closure_tol: float = 1e-12
 ) -> tuple[Mechanism, Assembly | None, Couplings]:
     """The ``[loop]`` table: one closed loop of revolute joints in one of :data:`CONVENTIONS`."""
     section = reader.table(value, "loop", LOOP_KEYS)
@@ -221,8 +221,8 @@ def _read_loop(
     return mech, assembly, couplings
 
 
-def _read_mechanism(
-    reader: _Reader, value: Any, name: str, meta: Mapping[str, Any]
+def read_mechanism_table(
+    reader: SpecReader, value: Any, name: str, meta: Mapping[str, Any]
 ) -> tuple[Mechanism, Couplings]:
     """The ``[mechanism]`` table: revolute and prismatic joints between named bodies."""
     section = reader.table(value, "mechanism", MECHANISM_KEYS)
@@ -282,7 +282,7 @@ def _read_mechanism(
     return mech, couplings
 
 
-def _read_points(reader: _Reader, value: Any, mech: Mechanism) -> list[dict[str, Any]]:
+def read_points_table(reader: SpecReader, value: Any, mech: Mechanism) -> list[dict[str, Any]]:
     """The optional ``[[points]]`` tables: named points (``name``, ``body``, ``position`` in the start
     configuration) whose world coordinates ``points.csv`` follows along the path."""
     if not isinstance(value, list):
@@ -308,7 +308,7 @@ def _read_points(reader: _Reader, value: Any, mech: Mechanism) -> list[dict[str,
 
 
 def _joint_line(
-    reader: _Reader, joint: Mapping[str, Any], here: str, kind: str, planar: bool
+    reader: SpecReader, joint: Mapping[str, Any], here: str, kind: str, planar: bool
 ) -> tuple[Array, Array]:
     """Point and direction of a ``[[mechanism.joints]]`` entry as 3-vectors.
 
@@ -340,7 +340,7 @@ def _joint_line(
     return point, direction
 
 
-def _check_connected(reader: _Reader, pairs: Sequence[tuple[str, str]], path: str) -> None:
+def _check_connected(reader: SpecReader, pairs: Sequence[tuple[str, str]], path: str) -> None:
     """Every body must be reached from the ground (or the first body) through joints."""
     bodies = list(dict.fromkeys(b for pair in pairs for b in pair))
     root = "ground" if "ground" in bodies else bodies[0]

@@ -22,6 +22,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
+from linkwork.messages import escape_line, show
+from linkwork.names import MAX_NAME_CHARS
 
 __all__ = [
     "MAX_FILE_BYTES",
@@ -39,40 +41,6 @@ MAX_FILE_BYTES = 16 * 1024 * 1024
 
 MAX_MAGNITUDE = 1e12
 """The largest absolute value of a number in a file (a length, a coordinate, an angle)."""
-
-MAX_NAME_CHARS = 100
-"""The longest name (of a joint, profile or linkage) accepted, in characters."""
-
-_SHOW_CHARS = 40
-
-
-def show(value: Any) -> str:
-    """A short, one-line, TOML-like rendering of a value for an error message.
-
-    Strings are quoted with newlines and other control characters escaped (``"a\\nb"``) and cut after 40
-    characters, so that a hostile value can never break the one line an error is.
-    """
-    if isinstance(value, str):
-        shown = value if len(value) <= _SHOW_CHARS else value[: _SHOW_CHARS - 3] + "..."
-        return '"' + escape_line(shown).replace('"', '\\"') + '"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        text = "[" + ", ".join(show(item) for item in value[:8]) + "]"
-        return text if len(text) <= 60 and len(value) <= 8 else f"a list of {len(value)}"
-    if isinstance(value, int) and abs(value) >= 10**30:
-        return f"an integer of {len(str(abs(value)))} digits"
-    return escape_line(str(value))
-
-
-_CONTROL = re.compile(r"[\x00-\x1f\x7f\u0085\u2028\u2029]")
-
-
-def escape_line(text: str) -> str:
-    """``text`` with line breaks and other control characters written as escapes (``\\n``, ``\\x1b``)."""
-    return _CONTROL.sub(lambda m: repr(m.group(0))[1:-1], text)
 
 
 def closest(word: str, choices: Sequence[str], cutoff: float = 0.6) -> str | None:

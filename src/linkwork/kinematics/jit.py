@@ -121,21 +121,27 @@ def python_backend() -> Backend:
     return _BACKENDS[False]
 
 
-def select_backend(chosen: str | None = None) -> Backend:
+def select_backend(chosen: str | None = None, warm_up: Callable[[], None] | None = None) -> Backend:
     """The kernels a call runs from start to end, chosen now (see the module's docstring): by ``chosen`` (default
-    :func:`mode`), the marker of the cache and whether this process may start a background compile."""
+    :func:`mode`), the marker of the cache and whether this process may start a background compile.
+
+    ``warm_up`` runs every kernel once with a trace's argument types (the tracer passes
+    :func:`linkwork.kinematics.tracer.warm_up`): it loads or compiles them before the caller's clock starts.
+    Without it the compiled kernels load or compile on their first call."""
     chosen = chosen or mode()
     if chosen == "python":
         return python_backend()
-    if _state["loaded"] or _state["compiling"]:
+    if _state["loaded"] or _state["compiling"] or warm_up is None:
         return compiled_backend()
     if CACHE.ready(GROUP):
-        compile_now()  # loads the cached machine code now, so that the trace's clock counts tracing only
+        compile_now(
+            warm_up
+        )  # loads the cached machine code now, so that the trace's clock counts tracing only
         return compiled_backend()
     if chosen == "auto" and _background:
         start_background_compile()
         return python_backend()
-    compile_now(announce=True)
+    compile_now(warm_up, announce=True)
     return compiled_backend()
 
 
@@ -144,10 +150,10 @@ def kernels_ready() -> bool:
     return bool(_state["loaded"]) or CACHE.ready(GROUP)
 
 
-def compile_now(announce: bool = False) -> float:
+def compile_now(warm_up: Callable[[], None], announce: bool = False) -> float:
     """Compile the tracing kernels in this process (into the cache), or load them from it when they are there,
-    by tracing a small linkage with them; marks the group ready and returns the seconds it took (their sum is
-    :func:`compile_seconds`)."""
+    by running ``warm_up`` (tracing a small linkage with them); marks the group ready and returns the seconds it
+    took (their sum is :func:`compile_seconds`)."""
     if announce:
         log.info("compiling kernels, first run only (linkwork compile does it ahead of time) ...")
     started = time.perf_counter()
@@ -172,22 +178,6 @@ def compile_now(announce: bool = False) -> float:
 def compile_seconds() -> float:
     """Seconds this process has spent compiling kernels, or loading them from the cache, before tracing."""
     return float(_state["compile_seconds"])
-
-
-def warm_up() -> None:
-    """Run every tracing kernel with the argument types a trace uses: adaptive traces of a Bennett linkage with a
-    target (and its normalised condition ratio), without one and up to a joint limit, and a paper-mode trace."""
-    import math
-
-    from linkwork.io.spec import resolve_spec
-    from linkwork.kinematics.tracer import trace
-
-    mech = resolve_spec("bennett", {}).mechanism
-    a, start = mech.joint_names[0], float(mech.offsets[0])
-    trace(mech, until=(a, start + 0.3)).condition()  # the normalised ratio's Jacobian kernel too
-    trace(mech, until=(a, start + 0.3), steps=4)
-    trace(mech, max_steps=8, max_step=math.radians(5.0))
-    trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()
 
 
 # ---- the command line's background compile

@@ -2,9 +2,10 @@
 Cholesky solve of the correctors' normal equations.
 
 The closure kernels do, one joint at a time and without temporaries, what :mod:`linkwork.kinematics.closure`
-does with numpy; tests check that both agree. Arrays are laid out as in :class:`linkwork.kinematics.mechanism.Mechanism`:
-``twists (n, 6)`` as ``(omega, v)``; loops flattened into ``loop_joint``, ``loop_sign`` and ``loop_ptr``;
-``groups (n,)`` maps each joint to its unknown (``-1`` = fixed); ``rows`` are the twist rows kept per loop.
+does with numpy; tests check that both agree. A mechanism is passed as one tuple ``mech = (twists, loop_joint,
+loop_sign, loop_ptr, rows, groups)`` laid out as in :class:`linkwork.kinematics.mechanism.Mechanism`: ``twists
+(n, 6)`` as ``(omega, v)``; loops flattened into ``loop_joint``, ``loop_sign`` and ``loop_ptr``; ``rows`` are the
+twist rows kept per loop; ``groups (n,)`` maps each joint to its unknown (``-1`` = fixed).
 
 References
 ----------
@@ -111,36 +112,20 @@ def log_rigid(R: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
 
 @kernel()
 def closure_jacobian(
-    twists: np.ndarray,
-    q: np.ndarray,
-    loop_joint: np.ndarray,
-    loop_sign: np.ndarray,
-    loop_ptr: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
-    m: int,
-    residual: np.ndarray,
-    jac: np.ndarray,
+    mech: tuple[np.ndarray, ...], q: np.ndarray, m: int, residual: np.ndarray, jac: np.ndarray
 ) -> None:
     """Closure residual ``(E,)`` and reduced Jacobian ``(E, m)`` at displacements ``q``, written in place.
 
     :func:`closure_pass` without a weight, with work arrays of its own (the hot loop of tracing).
     """
     matrices, vectors = work_arrays()
-    closure_pass(
-        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, None, residual, jac, matrices, vectors
-    )
+    closure_pass(mech, q, None, residual, jac, matrices, vectors)
 
 
 @kernel(inline="always")
 def closure_pass(
-    twists: np.ndarray,
+    mech: tuple[np.ndarray, ...],
     q: np.ndarray,
-    loop_joint: np.ndarray,
-    loop_sign: np.ndarray,
-    loop_ptr: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
     weight: np.ndarray | None,
     residual: np.ndarray,
     jac: np.ndarray,
@@ -158,6 +143,7 @@ def closure_pass(
     Inlined into its callers (numba passes every array as a dozen scalars: a call per evaluation would cost a
     quarter of it).
     """
+    twists, loop_joint, loop_sign, loop_ptr, rows, groups = mech
     nrows = rows.shape[0]
     jac[:, :] = 0.0
     Rg, Re, Rn = matrices

@@ -34,33 +34,50 @@ NO_PROGRESS = int(StopReason.NO_PROGRESS)
 NO_EVENT = -1  # step_event: the step ends nothing
 TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
 
+MECHANISM = ("twists", "loop_joint", "loop_sign", "loop_ptr", "rows", "groups")
+"""The members of the mechanism tuple every kernel takes (see :mod:`linkwork.kinematics.kernels`)."""
+CORRECTOR = ("tol", "exact", "roundoff", "truncate", "max_iter")
+"""The members of :func:`correct`'s settings tuple."""
+MARCH_ARGUMENTS = {
+    "mech": MECHANISM,
+    "start": ("u0", "t0", "u_home", "basis"),
+    "steps": (
+        "paper", "drive", "h0", "hmin", "hmax", "cos_turn", "target", "has_target", "advance", "stall_steps",
+        "stall_length", "max_steps", "r_path", "detect", "check_closed",
+    ),
+    "corrector": CORRECTOR,
+    "bounds": ("periodic", "lo", "hi"),
+    "out": ("out_u", "out_t", "out_sigma", "out_res", "out_tau", "out_s"),
+}  # fmt: skip
+"""The tuples :func:`march` takes, in order, and their members."""
+
 
 @kernel()
-def evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac):
-    """Residual and reduced Jacobian at unknowns ``u`` (``q``, ``res``, ``jac`` are work arrays)."""
-    expand(u, groups, q)
-    closure_jacobian(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, u.shape[0], res, jac)
+def evaluate(mech, u, q, res, jac):
+    """Residual and reduced Jacobian at unknowns ``u`` of ``mech`` (the tuple of
+    :mod:`~linkwork.kinematics.kernels`; ``q``, ``res``, ``jac`` are work arrays)."""
+    expand(u, mech[5], q)
+    closure_jacobian(mech, q, u.shape[0], res, jac)
     return np.sqrt(np.sum(res * res))
 
 
 @kernel()
-def correct(
-    twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, held, tol, exact, roundoff, truncate, max_iter, q,
-    res, jac,
-):  # fmt: skip
+def correct(mech, u, held, corrector, q, res, jac):
     """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
 
+    ``corrector`` is ``(tol, exact, roundoff, truncate, max_iter)`` (:data:`CORRECTOR`).
     ``held`` is the unknown kept fixed (-1: none, minimum-norm correction over all unknowns). Returns
     ``(converged, iterations, residual)``. Converged: a residual below ``exact``, or one that stalls (falls by
     less than half in an iteration) below ``max(tol, roundoff * exact)``: the least-squares closure of a loop
     whose parameters are off by up to ``tol`` (``Tolerances.closure``), or the round-off floor of a very long
     loop.
     """
+    tol, exact, roundoff, truncate, max_iter = corrector
     m = u.shape[0]
     prev = np.inf
     accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
-        r = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
+        r = evaluate(mech, u, q, res, jac)
         if not np.isfinite(r):
             return False, it, r
         if r < exact:
@@ -248,48 +265,15 @@ def predict(u, t, h, paper, drive, target, has_target, first, u_try):
 
 
 @kernel()
-def march(
-    twists,
-    loop_joint,
-    loop_sign,
-    loop_ptr,
-    rows,
-    groups,
-    u0,
-    t0,
-    u_home,
-    basis,
-    paper,
-    drive,
-    h0,
-    hmin,
-    hmax,
-    cos_turn,
-    target,
-    has_target,
-    tol,
-    exact,
-    roundoff,
-    truncate,
-    max_iter,
-    advance,
-    stall_steps,
-    stall_length,
-    max_steps,
-    r_path,
-    periodic,
-    lo,
-    hi,
-    detect,
-    check_closed,
-    out_u,
-    out_t,
-    out_sigma,
-    out_res,
-    out_tau,
-    out_s,
-):
+def march(mech, start, steps, corrector, bounds, out):
     """March from ``(u0, t0)`` for at most ``max_steps`` steps; row 0 of the outputs is the start.
+
+    The arguments are tuples (:data:`MARCH_ARGUMENTS` names their members): ``mech`` the mechanism's arrays (see
+    :mod:`~linkwork.kinematics.kernels`); ``start = (u0, t0, u_home, basis)``; ``steps = (paper, drive, h0,
+    hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length, max_steps, r_path, detect,
+    check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi)``;
+    ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s)``, the rows written. numba unpacks each tuple once
+    per call; the inner kernels get the tuples they need.
 
     ``u_home`` is where the path began (for closed-path detection across several calls).
 
@@ -303,6 +287,14 @@ def march(
     otherwise adaptive arclength steps in ``[hmin, hmax]`` with the minimum-norm corrector. Returns
     ``(count, code, h)``: rows written, the stop code and the last step length.
     """
+    u0, t0, u_home, basis = start
+    (
+        paper, drive, h0, hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length,
+        max_steps, r_path, detect, check_closed,
+    ) = steps  # fmt: skip
+    periodic, lo, hi = bounds
+    out_u, out_sigma, out_res, out_tau = out[0], out[2], out[3], out[4]
+    loop_ptr, rows, groups = mech[3], mech[4], mech[5]
     m = u0.shape[0]
     E = (loop_ptr.shape[0] - 1) * rows.shape[0]
     q = np.empty(groups.shape[0])
@@ -315,10 +307,10 @@ def march(
     u_try = np.empty(m)
     h = h0
     # ---- the start: row 0, its tangent oriented along t0
-    r0 = evaluate(twists, loop_joint, loop_sign, loop_ptr, rows, groups, u, q, res, jac)
+    r0 = evaluate(mech, u, q, res, jac)
     tau = tangent_and_test(jac, t, basis, r_path, t_new, sig)
     t[:] = t_new
-    write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, 0, u, t, sig, r0, tau, 0.0)
+    write_row(out, 0, u, t, sig, r0, tau, 0.0)
     s_total = 0.0
     basis_try = basis.copy()
     far = wrapped_distance(u0, u_home, periodic)
@@ -330,10 +322,7 @@ def march(
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
-        ok, iters, r = correct(
-            twists, loop_joint, loop_sign, loop_ptr, rows, groups, u_try, held, tol, exact, roundoff, truncate,
-            max_iter, q, res, jac,
-        )  # fmt: skip
+        ok, iters, r = correct(mech, u_try, held, corrector, q, res, jac)
         turn, dist, tau_new = 1.0, 0.0, 0.0
         if ok:
             basis_try[:, :] = basis
@@ -354,7 +343,7 @@ def march(
             u[a] = u_try[a]
             t[a] = t_new[a]
         basis[:, :] = basis_try
-        write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, count, u, t, sig, r, tau_new, s_total)
+        write_row(out, count, u, t, sig, r, tau_new, s_total)
         recent[count % recent.shape[0]] = dist
         count += 1
         # ---- events that end the march
@@ -376,9 +365,10 @@ def march(
 
 
 @kernel(inline="always")
-def write_row(out_u, out_t, out_sigma, out_res, out_tau, out_s, row, u, t, sig, r, tau, s):
-    """Row ``row`` of the march's outputs: the point, its tangent, singular values, residual, test value and
-    arclength."""
+def write_row(out, row, u, t, sig, r, tau, s):
+    """Row ``row`` of the march's outputs ``out``: the point, its tangent, singular values, residual, test value
+    and arclength."""
+    out_u, out_t, out_sigma, out_res, out_tau, out_s = out
     out_u[row, :] = u
     out_t[row, :] = t
     out_sigma[row, :] = sig

@@ -149,16 +149,26 @@ class BranchMarcher:
             res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty(n + 1), count=0, code=0, h=h0,
         )  # fmt: skip
         ws = self.ws
+        steps = (
+            paper,
+            cfg.drive,
+            h0,
+            cfg.min_step,
+            cfg.max_step,
+            cfg.cos_turn,
+            0.0 if cfg.target is None else cfg.target,
+            cfg.target is not None,
+            tol.advance,
+            tol.stall_steps,
+            tol.stall_length,
+            n,
+            cfg.r_path,
+            True,
+            check_closed,
+        )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
-            twists=ws.twists, loop_joint=ws.loop_joint, loop_sign=ws.loop_sign, loop_ptr=ws.loop_ptr,
-            rows=ws.rows, groups=ws.groups, u0=u, t0=t, u_home=u_home, basis=basis, paper=paper,
-            drive=cfg.drive, h0=h0, hmin=cfg.min_step, hmax=cfg.max_step, cos_turn=cfg.cos_turn,
-            target=0.0 if cfg.target is None else cfg.target, has_target=cfg.target is not None,
-            tol=tol.closure, exact=tol.exact, roundoff=tol.roundoff, truncate=tol.truncate,
-            max_iter=tol.max_iter, advance=tol.advance, stall_steps=tol.stall_steps,
-            stall_length=tol.stall_length, max_steps=n, r_path=cfg.r_path, periodic=cfg.periodic,
-            lo=cfg.lo, hi=cfg.hi, detect=True, check_closed=check_closed,
-            out_u=out.u, out_t=out.t, out_sigma=out.sigma, out_res=out.res, out_tau=out.tau, out_s=out.s,
+            ws.kernel_arrays(), (u, t, u_home, basis), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi),
+            (out.u, out.t, out.sigma, out.res, out.tau, out.s),
         )  # fmt: skip
         return out
 
@@ -271,10 +281,7 @@ class BranchMarcher:
         guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
         guess[g] = bound
         tol, ws = cfg.tol, self.ws
-        ok, _, r = ws.kernels.correct(
-            *ws.kernel_arrays(), guess, g, tol.closure, tol.exact, tol.roundoff, tol.truncate, tol.max_iter,
-            ws.q, ws.res, ws.jac,
-        )  # fmt: skip
+        ok, _, r = ws.kernels.correct(ws.kernel_arrays(), guess, g, ws.corrector(tol), ws.q, ws.res, ws.jac)
         if not ok:
             return g, reason
         _, _, jac = ws.evaluate(guess)

@@ -83,7 +83,7 @@ def _full_jacobians(mech: Mechanism, q: Array) -> Array:
     twists = np.ascontiguousarray(mech.twists)
     kernel = select_backend().closure_jacobian  # compiled, or its plain-Python twin while the cache is cold
     for k, qk in enumerate(q):
-        kernel(twists, np.ascontiguousarray(qk), joints, signs, ptr, rows, groups, n, residual, out[k])
+        kernel((twists, joints, signs, ptr, rows, groups), np.ascontiguousarray(qk), n, residual, out[k])
     return out
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
-from linkwork import deprecation
+from linkwork.deprecation import warn
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,7 @@ class TraceStats:
         return key in names and not (key == "unmet" and self.unmet is None)
 
     def _warn(self, how: str) -> None:
-        deprecation.warn(f"Trace.stats {how}", "the attribute of the TraceStats record (stats.unmet, ...)", 4)
+        warn(f"Trace.stats {how}", "the attribute of the TraceStats record (stats.unmet, ...)", 4)
 
     def __getitem__(self, key: str) -> Any:
         self._warn("stats[key]")

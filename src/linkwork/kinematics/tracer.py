@@ -81,7 +81,7 @@ def trace(
     d_joint, d_unknown, target = _drive_and_target(mech, drive, until, steps)
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
-    backend = select_backend()
+    backend = select_backend(warm_up=warm_up)
     ws = Workspace.of(mech, backend)
     started = time.perf_counter()
     r0, _, jac0 = ws.evaluate(np.zeros(m))
@@ -274,3 +274,29 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, an
         why = "" if end.kind == StopReason.CLOSED else f" (it turns back near {show(float(angles[-1, j]))})"
         return f"{name} never reaches {show(until[1])} on this path{why}: its range is {span}"
     return f"{name} did not reach {show(until[1])}: the path ended with '{end.text}' (range so far {span})"
+
+
+WARM_UP_DH = (  # Bennett's linkage (twists 45 and 75 deg, a / sin(alpha) = 1) at theta_A = 60 deg
+    (1.0471975511965974, 0.7853981633974483),
+    (2.799865397326153, 1.3089969389957472),
+    (-1.0471975511965974, 0.7853981633974483),
+    (-2.799865397326153, 1.3089969389957472),
+)
+"""``(theta, alpha)`` of the warm-up's loop: the start angles of Bennett's closed form (as ``lw.load("bennett")``
+builds it), link lengths ``sin(alpha)``."""
+
+
+def warm_up() -> None:
+    """Run every tracing kernel with the argument types a trace uses: adaptive traces of a Bennett linkage with a
+    target (and its normalised condition ratio), without one and up to a joint limit, and a paper-mode trace."""
+    import math
+
+    from linkwork.kinematics.chains import from_dh
+
+    params = [{"theta": t, "d": 0.0, "a": math.sin(al), "alpha": al} for t, al in WARM_UP_DH]
+    mech, _ = from_dh("Bennett linkage", params, joint_names=("A", "B", "C", "D"))
+    a, start = mech.joint_names[0], float(mech.offsets[0])
+    trace(mech, until=(a, start + 0.3)).condition()  # the normalised ratio's Jacobian kernel too
+    trace(mech, until=(a, start + 0.3), steps=4)
+    trace(mech, max_steps=8, max_step=math.radians(5.0))
+    trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()

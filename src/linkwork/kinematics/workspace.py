@@ -9,6 +9,7 @@ from numpy.typing import NDArray
 
 from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.rank import Tolerances
 
 Array = NDArray[np.float64]
 
@@ -58,12 +59,17 @@ class Workspace:
     ) -> tuple[
         Array, NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]
     ]:
-        """The mechanism arrays in the order the compiled kernels take them (``twists`` ... ``groups``)."""
+        """The mechanism tuple every kernel takes (``twists`` ... ``groups``, :data:`~linkwork.kinematics.march.MECHANISM`)."""
         return self.twists, self.loop_joint, self.loop_sign, self.loop_ptr, self.rows, self.groups
+
+    @staticmethod
+    def corrector(tol: Tolerances) -> tuple[float, float, float, float, int]:
+        """The corrector's settings tuple (:data:`~linkwork.kinematics.march.CORRECTOR`) of ``tol``."""
+        return tol.closure, tol.exact, tol.roundoff, tol.truncate, tol.max_iter
 
     def evaluate(self, u: Array) -> tuple[float, Array, Array]:
         """Residual norm, residual and reduced Jacobian (copies) at ``u``."""
         r = self.kernels.evaluate(
-            *self.kernel_arrays(), np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac
+            self.kernel_arrays(), np.ascontiguousarray(u, dtype=float), self.q, self.res, self.jac
         )
         return float(r), self.res.copy(), self.jac.copy()

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import SpecError
-from linkwork.io.toml_reader import show
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.messages import show
 
 MAX_RODS = 100
 """The largest ``n`` of a built-in hoop (Hedgepeth's n rods)."""

@@ -24,23 +24,12 @@ from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closu
 
 @kernel()
 def weighted_closure(
-    twists: np.ndarray,
-    q: np.ndarray,
-    loop_joint: np.ndarray,
-    loop_sign: np.ndarray,
-    loop_ptr: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
-    T: np.ndarray,
-    residual: np.ndarray,
-    jac: np.ndarray,
+    mech: tuple[np.ndarray, ...], q: np.ndarray, T: np.ndarray, residual: np.ndarray, jac: np.ndarray
 ) -> None:
     """Weighted closure residual ``T log(P)`` (kept rows, per loop) and its Jacobian in the unknowns, in place:
     :func:`linkwork.kinematics.kernels.closure_pass` (columns ``s Ad(g) xi``, Eq. (21)) with the weight ``T``."""
     matrices, vectors = work_arrays()
-    closure_pass(
-        twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, residual, jac, matrices, vectors
-    )
+    closure_pass(mech, q, T, residual, jac, matrices, vectors)
 
 
 @kernel(inline="always")
@@ -114,24 +103,22 @@ def _predicted_gain(Jy: np.ndarray, dy: np.ndarray) -> float:
 
 @kernel()
 def misfit_along_path(
-    twists: np.ndarray,
-    u_path: np.ndarray,
-    normal: np.ndarray,
-    loop_joint: np.ndarray,
-    loop_sign: np.ndarray,
-    loop_ptr: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
+    mech: tuple[np.ndarray, ...],
+    path: tuple[np.ndarray, np.ndarray],
     T: np.ndarray,
     max_iter: int,
     out: np.ndarray,
 ) -> None:
-    """Misfit ``out (K,)`` of one imperfect mechanism at every nominal path point ``u_path (K, m)``.
+    """Misfit ``out (K,)`` of one imperfect mechanism ``mech`` (the mechanism tuple of
+    :mod:`~linkwork.kinematics.kernels`, with its perturbed twists) at every nominal path point of ``path =
+    (u_path (K, m), normal)``.
 
     At point ``k`` the unknowns move in the plane normal to the nominal path, ``u = u_k + Q_k y`` with
     ``normal[k] = Q_k (m, m - 1)`` orthonormal: the drive held wherever it parameterises the path, and still a
     well-posed problem at a fold of the drive.
     """
+    u_path, normal = path
+    loop_ptr, rows, groups = mech[3], mech[4], mech[5]
     K, m = u_path.shape
     p = normal.shape[2]
     E = (loop_ptr.shape[0] - 1) * rows.shape[0]
@@ -154,7 +141,7 @@ def misfit_along_path(
         for _ in range(max_iter):
             _on_plane(u_path, normal, k, y, u)
             expand(u, groups, q)
-            closure_pass(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, matrices, vectors)
+            closure_pass(mech, q, T, r, J, matrices, vectors)
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
@@ -188,21 +175,19 @@ def misfit_along_path(
 @kernel()
 def misfit_batch(
     twists: np.ndarray,
-    u_path: np.ndarray,
-    normal: np.ndarray,
-    loop_joint: np.ndarray,
-    loop_sign: np.ndarray,
-    loop_ptr: np.ndarray,
-    rows: np.ndarray,
-    groups: np.ndarray,
+    path: tuple[np.ndarray, np.ndarray],
+    loops: tuple[np.ndarray, ...],
     T: np.ndarray,
     max_iter: int,
 ) -> np.ndarray:
-    """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path."""
+    """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path ``path =
+    (u_path, normal)``; ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
+    its twists)."""
     S = twists.shape[0]
-    out = np.empty((S, u_path.shape[0]))
+    out = np.empty((S, path[0].shape[0]))
+    loop_joint, loop_sign, loop_ptr, rows, groups = loops
     for s in range(S):
         misfit_along_path(
-            twists[s], u_path, normal, loop_joint, loop_sign, loop_ptr, rows, groups, T, max_iter, out[s]
+            (twists[s], loop_joint, loop_sign, loop_ptr, rows, groups), path, T, max_iter, out[s]
         )
     return out

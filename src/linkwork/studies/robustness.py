@@ -62,10 +62,10 @@ class RobustnessSetup:
     keep_tol: float
 
     def kernel_args(self) -> tuple[Any, ...]:
-        """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists."""
+        """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists: ``(path, loops, weight)``."""
         joint, sign, ptr = self.mech.loop_arrays()
         rows = np.array(self.mech.rows, dtype=np.int64)
-        return (self.u_path, self.normal, joint, sign, ptr, rows, self.mech.groups, self.scale.weight)
+        return (self.u_path, self.normal), (joint, sign, ptr, rows, self.mech.groups), self.scale.weight
 
 
 @dataclass
@@ -127,8 +127,7 @@ def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
     seeds = sample_seeds(setup.seed, start, stop)
     errors = hinge_errors(seeds, setup.mech, setup.model, setup.lines)
     twists = perturbed_twists(errors, setup.lines)
-    u_path, normal, joint, sign, ptr, rows, groups, weight = setup.kernel_args()
-    misfit = misfit_batch(twists, u_path, normal, joint, sign, ptr, rows, groups, weight, MAX_ITER)
+    misfit = misfit_batch(twists, *setup.kernel_args(), MAX_ITER)
     predicted = first_order_misfit(setup.G, errors)
     at = np.argmax(misfit, axis=1)
     worst = misfit[np.arange(len(seeds)), at]

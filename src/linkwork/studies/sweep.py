@@ -144,10 +144,10 @@ def prepare_study(study: Study) -> Study:
     from linkwork.io.spec import resolve_spec
 
     if study.grid:  # a built-in: its name and parameter names must be right (values are checked per point)
-        from linkwork.io.spec import _import_builtins
+        from linkwork.io.spec import import_builtins
         from linkwork.linkages.registry import get
 
-        _import_builtins()
+        import_builtins()
         entry = get(study.target)
         unknown = [k for k in study.grid if k not in entry.params]
         if unknown:

@@ -173,20 +173,3 @@ def arc_fits(
         lo = offsets[j] + starts[j]
         out[j] = _fit(arc[: pieces[j] + 1], points[lo : lo + pieces[j] + 1], bound)
     return out
-
-
-def warm_up() -> None:
-    """Compile these kernels into numba's cache (run by the background compile of a first run, see
-    :mod:`linkwork.kinematics.jit`), with the argument types the search uses."""
-    from linkwork.synthesis.compiled_search import CompiledTables, compiled_rms_bound, compiled_search
-    from linkwork.synthesis.error_kernels import ProfileTables
-
-    t = np.linspace(0.0, 1.0, 9)
-    curve = np.column_stack([t, 0.1 * np.sin(3.0 * t)])
-    tables = ProfileTables([curve, 1.1 * curve], compiled=True)
-    tables.mean_errors([0, 1], 4)
-    tables.arc_errors([0, 1], [4, 5])
-    compiled = CompiledTables.from_tables(tables)  # the segment-matrix search: 8 pieces on both profiles
-    start = np.array([[4, 4], [4, 4]], dtype=np.int64)
-    compiled_search("MC", [start], 2, compiled)
-    compiled_rms_bound("MC", start, compiled)

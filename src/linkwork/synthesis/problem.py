@@ -12,7 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
-from linkwork.io.toml_reader import MAX_NAME_CHARS, show
+from linkwork.messages import show
+from linkwork.names import MAX_NAME_CHARS
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
 RankBy = Literal["error", "joints"]
@@ -188,7 +189,7 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
 
 def _ranking_rules(p: Problem) -> list[tuple[str, str]]:
     """``merge_on``, ``rank_by`` with its ``e_max_tolerance``, and an initial segment matrix's design."""
-    from linkwork.io.profiles import LENGTH_UNITS
+    from linkwork.units import LENGTH_UNITS
 
     if p.units is not None and (not isinstance(p.units, str) or p.units not in LENGTH_UNITS):
         return [("units", f"expected one of {', '.join(LENGTH_UNITS)}, got {show(p.units)}")]

@@ -72,7 +72,7 @@ def mechanism_viewer_data(found: Mechanization, *, title: str | None = None) -> 
 
 def write_mechanism_viewer(found: Mechanization, file: str | Path, *, title: str | None = None) -> Path:
     """Write ``mechanism.html``: the offline viewer of the mechanism moving through the target profiles."""
-    from linkwork.viz.viewer import _trace_page
-    from linkwork.viz.viewer_page import _write
+    from linkwork.viz.viewer import trace_page
+    from linkwork.viz.viewer_page import write_page
 
-    return _write(file, _trace_page(mechanism_viewer_data(found, title=title)))
+    return write_page(file, trace_page(mechanism_viewer_data(found, title=title)))

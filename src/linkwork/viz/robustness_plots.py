@@ -4,11 +4,12 @@ singular-value ratio, and the histogram of every sample's largest misfit. matplo
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from linkwork.studies.robustness import RobustnessResult
+if TYPE_CHECKING:  # a type only: viz sits below studies
+    from linkwork.studies.robustness import RobustnessResult
 
 
 def _positive(values: list[float | None]) -> np.ndarray:

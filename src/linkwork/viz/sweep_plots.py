@@ -4,11 +4,12 @@ when the grid has exactly two parameters. matplotlib is imported inside the func
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from linkwork.studies.study_file import Study
+if TYPE_CHECKING:  # a type only: viz sits below studies
+    from linkwork.studies.study_file import Study
 
 #: Results plotted, when present, with their axis labels.
 METRICS = {

@@ -15,14 +15,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.viz.palette import TAB10
-from linkwork.viz.viewer_page import _page, _Viewer, _write
+from linkwork.viz.viewer_page import ViewerAssets, page_html, write_page
 
 if TYPE_CHECKING:
     from linkwork.synthesis.result import SynthesisResult
 
 __all__ = ["joint_turns", "synthesis_viewer_data", "synthesis_viewer_page", "write_synthesis_viewer"]
 
-_SYNTHESIS = _Viewer("synthesis.html", ("common.js", "synthesis.js"), "target profile")
+_SYNTHESIS = ViewerAssets("synthesis.html", ("common.js", "synthesis.js"), "target profile")
 
 
 def joint_turns(points: NDArray[np.float64], joints: list[int]) -> NDArray[np.float64]:
@@ -112,9 +112,9 @@ def write_synthesis_viewer(result: SynthesisResult, file: str | Path, *, title: 
     -------
     The path of the file written.
     """
-    return _write(file, synthesis_viewer_page(result, title=title))
+    return write_page(file, synthesis_viewer_page(result, title=title))
 
 
 def synthesis_viewer_page(result: SynthesisResult, *, title: str | None = None) -> str:
     """The HTML text of :func:`write_synthesis_viewer`'s page (for an inline view in a notebook)."""
-    return _page(_SYNTHESIS, synthesis_viewer_data(result, title=title))
+    return page_html(_SYNTHESIS, synthesis_viewer_data(result, title=title))

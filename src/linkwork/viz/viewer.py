@@ -31,7 +31,15 @@ from linkwork.viz.synthesis_viewer import (
     synthesis_viewer_page,
     write_synthesis_viewer,
 )
-from linkwork.viz.viewer_page import DATA_ID, _packed, _page, _Viewer, _write, script_json, unpack
+from linkwork.viz.viewer_page import (
+    DATA_ID,
+    ViewerAssets,
+    packed_array,
+    page_html,
+    script_json,
+    unpack,
+    write_page,
+)
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
@@ -66,7 +74,7 @@ __all__ = [
     "write_trace_viewer",
 ]
 
-_TRACE = _Viewer("trace.html", ("common.js", "scene.js", "trace.js"), "position along the branch")
+_TRACE = ViewerAssets("trace.html", ("common.js", "scene.js", "trace.js"), "position along the branch")
 
 
 @dataclass(frozen=True)
@@ -294,17 +302,17 @@ def trace_viewer_data(
             "centred": _bounds(parts, _compose(steady, poses), np.zeros_like(centres)),
         },
         "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
-        "centres": _packed(centres, "f4"),
-        "steady": _packed(steady, "f4"),
+        "centres": packed_array(centres, "f4"),
+        "steady": packed_array(steady, "f4"),
         "points": len(keep),
         "points_traced": len(trace.branch),
-        "poses": _packed(poses, "f4"),
-        "angles": _packed(file_units(mech, trace.angles[keep]), "f4"),
-        "sigma": _packed(trace.sigma[keep], "f8"),
-        "rank": _packed(trace.rank[keep], "i4"),
-        "step": _packed(trace.step[keep], "i4"),
-        "arclength": _packed(np.degrees(trace.arclength[keep]), "f4"),
-        "residual": _packed(trace.residual[keep], "f4"),
+        "poses": packed_array(poses, "f4"),
+        "angles": packed_array(file_units(mech, trace.angles[keep]), "f4"),
+        "sigma": packed_array(trace.sigma[keep], "f8"),
+        "rank": packed_array(trace.rank[keep], "i4"),
+        "step": packed_array(trace.step[keep], "i4"),
+        "arclength": packed_array(np.degrees(trace.arclength[keep]), "f4"),
+        "residual": packed_array(trace.residual[keep], "f4"),
         "unknowns": mech.n_unknowns,
         "branches": _branch_entries(trace, per_branch),
         "bifurcations": _bifurcation_entries(trace, visits_all, per_branch),
@@ -332,8 +340,8 @@ def _part_entry(part: Part) -> dict[str, Any]:
         "body": part.body,
         "name": part.name,
         "color": part.color,
-        "vertices": _packed(part.vertices, "f4"),
-        "faces": _packed(part.faces, "u2" if len(part.vertices) < 65536 else "u4"),
+        "vertices": packed_array(part.vertices, "f4"),
+        "faces": packed_array(part.faces, "u2" if len(part.vertices) < 65536 else "u4"),
     }
 
 
@@ -402,15 +410,15 @@ def write_trace_viewer(
     -------
     The path of the file written.
     """
-    return _write(file, trace_viewer_page(trace, title=title, max_points=max_points))
+    return write_page(file, trace_viewer_page(trace, title=title, max_points=max_points))
 
 
 @trace_keyword
 def trace_viewer_page(trace: Trace, *, title: str | None = None, max_points: int = MAX_POINTS) -> str:
     """The HTML text of :func:`write_trace_viewer`'s page (for an inline view in a notebook)."""
-    return _trace_page(trace_viewer_data(trace, title=title, max_points=max_points))
+    return trace_page(trace_viewer_data(trace, title=title, max_points=max_points))
 
 
-def _trace_page(data: dict[str, Any]) -> str:
+def trace_page(data: dict[str, Any]) -> str:
     """The trace viewer's page around ``data`` (:func:`trace_viewer_data`, or the mechanism viewer's)."""
-    return _page(_TRACE, data)
+    return page_html(_TRACE, data)

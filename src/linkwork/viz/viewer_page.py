@@ -26,7 +26,7 @@ DATA_ID = "linkwork-data"
 """The ``id`` of the ``<script type="application/json">`` element holding a viewer's data."""
 
 
-def _packed(values: Any, dtype: str) -> dict[str, Any]:
+def packed_array(values: Any, dtype: str) -> dict[str, Any]:
     """A numpy array as ``{"dtype", "shape", "b64"}``, little-endian, for ``decode`` in the page's script."""
     arr = np.ascontiguousarray(np.asarray(values), dtype=np.dtype(dtype).newbyteorder("<"))
     return {"dtype": dtype, "shape": list(arr.shape), "b64": base64.b64encode(arr.tobytes()).decode("ascii")}
@@ -43,7 +43,7 @@ def _asset(name: str) -> str:
 
 
 @dataclass(frozen=True)
-class _Viewer:
+class ViewerAssets:
     """One viewer's assets: its ``body`` (panel, controls and plots inside the shared ``page.html``), its scripts
     in load order, and the accessible name of its slider (inside the shared ``player.html``)."""
 
@@ -52,11 +52,11 @@ class _Viewer:
     slider: str
 
 
-def _page(viewer: _Viewer, data: dict[str, Any]) -> str:
+def page_html(viewer: ViewerAssets, data: dict[str, Any]) -> str:
     """A self-contained page: the shared shell ``page.html`` (head, title, footer, data, script) around the
     viewer's body, its play button and slider from ``player.html``; then ``{{TITLE}}`` (``data["title"]``),
     ``{{CSS}}``, ``{{DATA}}``, ``{{JS}}`` and the rest filled in one pass."""
-    from linkwork import __version__
+    from linkwork.version import __version__
 
     values = {
         "TITLE": html.escape(data["title"]),
@@ -84,7 +84,7 @@ def script_json(data: Any) -> str:
     return re.sub("[<>&\u2028\u2029]", lambda m: _SCRIPT_UNSAFE[m.group(0)], payload)
 
 
-def _write(file: str | Path, text: str) -> Path:
+def write_page(file: str | Path, text: str) -> Path:
     file = Path(file)
     file.parent.mkdir(parents=True, exist_ok=True)
     file.write_text(text, encoding="utf-8")

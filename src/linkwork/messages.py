@@ -1,0 +1,44 @@
+"""Message formatting every layer uses: a value quoted on one line for an error message, and one-line escaping.
+
+On the ground floor (it imports nothing of linkwork): the file readers, the problem's own rules, the registry of
+built-ins, the writers and the command line all quote values the same way.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+__all__ = ["SHOW_CHARS", "escape_line", "show"]
+
+SHOW_CHARS = 40
+"""The longest string :func:`show` quotes whole; a longer one is cut, ending in ``...``."""
+
+
+def show(value: Any) -> str:
+    """A short, one-line, TOML-like rendering of a value for an error message.
+
+    Strings are quoted with newlines and other control characters escaped (``"a\\nb"``) and cut after 40
+    characters, so that a hostile value can never break the one line an error is.
+    """
+    if isinstance(value, str):
+        shown = value if len(value) <= SHOW_CHARS else value[: SHOW_CHARS - 3] + "..."
+        return '"' + escape_line(shown).replace('"', '\\"') + '"'
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        text = "[" + ", ".join(show(item) for item in value[:8]) + "]"
+        return text if len(text) <= 60 and len(value) <= 8 else f"a list of {len(value)}"
+    if isinstance(value, int) and abs(value) >= 10**30:
+        return f"an integer of {len(str(abs(value)))} digits"
+    return escape_line(str(value))
+
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f\u0085\u2028\u2029]")
+
+
+def escape_line(text: str) -> str:
+    """``text`` with line breaks and other control characters written as escapes (``\\n``, ``\\x1b``)."""
+    return _CONTROL.sub(lambda m: repr(m.group(0))[1:-1], text)
