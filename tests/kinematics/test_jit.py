@@ -210,3 +210,14 @@ def test_the_warm_up_traces_the_built_in_bennett_linkage() -> None:
     builtin = lw.load("bennett")
     np.testing.assert_allclose(mech.offsets, builtin.offsets, rtol=0, atol=1e-15)
     np.testing.assert_allclose(mech.twists, builtin.twists, rtol=0, atol=1e-15)
+
+
+def test_a_cold_command_line_run_computes_the_normalised_ratio_in_python_too(cold: list[list[str]]) -> None:
+    # The ratio (report.json's max_condition) is a call of its own: on a cold command-line run it must not
+    # compile its kernel in the foreground either.
+    jit.enable_background_compile(["true"])
+    assert jit.select_backend() is jit.python_backend()
+    jit.disable_background_compile()
+    assert (
+        jit.select_backend() is jit.compiled_backend()
+    )  # a library call: compiled (numba compiles on first call)

@@ -131,17 +131,17 @@ def select_backend(chosen: str | None = None, warm_up: Callable[[], None] | None
     chosen = chosen or mode()
     if chosen == "python":
         return python_backend()
-    if _state["loaded"] or _state["compiling"] or warm_up is None:
+    if _state["loaded"] or _state["compiling"]:
         return compiled_backend()
     if CACHE.ready(GROUP):
-        compile_now(
-            warm_up
-        )  # loads the cached machine code now, so that the trace's clock counts tracing only
+        if warm_up is not None:
+            compile_now(warm_up)  # loads the cached machine code now: the trace's clock counts tracing only
         return compiled_backend()
     if chosen == "auto" and _background:
         start_background_compile()
         return python_backend()
-    compile_now(warm_up, announce=True)
+    if warm_up is not None:
+        compile_now(warm_up, announce=True)
     return compiled_backend()
 
 
