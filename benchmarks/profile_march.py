@@ -1,0 +1,147 @@
+"""What one step of the compiled march costs on the hexagon (``hedgepeth-rods``, n = 6, paper mode, 200 steps).
+
+Prints the best time per trace and per step, then the kernels a step is made of, each timed alone in a compiled
+loop (best of ``--repeats``): a closure evaluation (residual and Jacobian, G&P Eqs. (21), (23)), the corrector
+from a predicted point (Eq. (28); Gauss-Newton with the drive held, Cholesky on the normal equations), the tangent
+and test function (one SVD of the Jacobian, its range basis kept continuous, two small determinants) and, inside
+it, numba's ``np.linalg.svd`` of the 6x6 Jacobian (LAPACK ``gesdd``). It also counts, with the plain-Python
+twins, how many of each a trace calls. The share of the SVD in a step is what limits the march.
+
+Run: ``python benchmarks/profile_march.py [--repeats 5]`` (single-threaded, on a quiet machine).
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import os
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+import linkwork as lw
+from linkwork.kinematics import jit
+from linkwork.kinematics import march as kernels
+from linkwork.kinematics.rank import Tolerances
+from linkwork.kinematics.workspace import Workspace
+from linkwork.linkages.hedgepeth_rods import deployed_angles
+
+STEPS = 200
+LOOPS = 20000
+
+
+@njit
+def _evaluations(mech: Any, u: Any, q: Any, res: Any, jac: Any, n: int) -> float:
+    acc = 0.0
+    for _ in range(n):
+        acc += kernels.evaluate(mech, u, q, res, jac)
+    return acc
+
+
+@njit
+def _corrections(mech: Any, u0: Any, t: Any, corrector: Any, q: Any, res: Any, jac: Any, n: int) -> float:
+    acc = 0.0
+    for _ in range(n):
+        u = u0 + 0.01 * t  # a predicted point one step along the tangent
+        _, iterations, _ = kernels.correct(mech, u, 0, corrector, q, res, jac)
+        acc += iterations
+    return acc
+
+
+@njit
+def _tangents(jac: Any, t: Any, basis: Any, r_path: int, t_out: Any, sigma: Any, n: int) -> float:
+    acc = 0.0
+    for _ in range(n):
+        acc += kernels.tangent_and_test(jac, t, basis.copy(), r_path, t_out, sigma)
+    return acc
+
+
+@njit
+def _svds(jac: Any, n: int) -> float:
+    acc = 0.0
+    for _ in range(n):
+        _, s, _ = np.linalg.svd(jac)
+        acc += s[0]
+    return acc
+
+
+def best_of(call: Callable[[], object], repeats: int, per: int = 1) -> float:
+    """Best seconds per unit of ``call`` (``per`` units a call) over ``repeats`` calls."""
+    best = np.inf
+    for _ in range(repeats):
+        begin = time.perf_counter()
+        call()
+        best = min(best, time.perf_counter() - begin)
+    return best / per
+
+
+def counts(hexagon: lw.Mechanism, until: tuple[str, float]) -> dict[str, int]:
+    """Calls of each kernel in one trace, counted on the plain-Python twins (the same statements)."""
+    twin = jit.python_backend()
+    found: collections.Counter[str] = collections.Counter()
+    scopes = {"march": twin.march.__globals__, "correct": twin.correct.__globals__}
+    patched = []
+    for scope, name in (("march", "correct"), ("march", "tangent_and_test"), ("correct", "evaluate")):
+        original = scopes[scope][name]
+
+        def counted(*args: Any, _fn: Any = original, _name: str = name) -> Any:
+            found[_name] += 1
+            return _fn(*args)
+
+        scopes[scope][name] = counted
+        patched.append((scope, name, original))
+    previous = os.environ.get("LINKWORK_JIT")
+    os.environ["LINKWORK_JIT"] = "python"
+    try:
+        lw.trace(hexagon, until=until, steps=STEPS)
+    finally:
+        for scope, name, original in patched:
+            scopes[scope][name] = original
+        if previous is None:
+            os.environ.pop("LINKWORK_JIT")
+        else:
+            os.environ["LINKWORK_JIT"] = previous
+    return dict(found)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5)
+    args = parser.parse_args()
+    hexagon = lw.load("hedgepeth-rods", n=6)
+    until = ("A", float(deployed_angles(6)[0]))
+    lw.trace(hexagon, until=until, steps=STEPS)  # compiled (or loaded) before timing
+    trace_s = best_of(lambda: lw.trace(hexagon, until=until, steps=STEPS), 20 * args.repeats)
+    ws = Workspace.of(hexagon, jit.compiled_backend())
+    mech = ws.kernel_arrays()
+    u = np.zeros(hexagon.n_unknowns)
+    q, res, jac = np.empty(hexagon.n_joints), np.empty(hexagon.n_equations), ws.jac
+    kernels.evaluate(mech, u, q, res, jac)
+    U, _, Vt = np.linalg.svd(jac)
+    r_path = hexagon.n_unknowns - 1
+    basis, t = np.ascontiguousarray(U[:, :r_path]), Vt[-1].copy()
+    t_out, sigma = np.empty_like(t), np.empty(min(jac.shape))
+    corrector = Workspace.corrector(Tolerances())
+    parts = {
+        "closure evaluation": lambda: _evaluations(mech, u, q, res, jac.copy(), LOOPS),
+        "corrector from a predicted point": lambda: _corrections(
+            mech, u, t, corrector, q, res, jac.copy(), LOOPS
+        ),
+        "tangent and test function": lambda: _tangents(jac, t, basis, r_path, t_out, sigma, LOOPS),
+        "  of which np.linalg.svd (6x6)": lambda: _svds(jac, LOOPS),
+    }
+    for call in parts.values():
+        call()  # compile the timing loops
+    print(
+        f"hexagon, paper mode, {STEPS} steps: {trace_s * 1e3:.3f} ms a trace, {trace_s / STEPS * 1e6:.2f} us a step"
+    )
+    for name, call in parts.items():
+        print(f"  {name:36s} {best_of(call, args.repeats, LOOPS) * 1e6:7.2f} us")
+    print("  calls in one trace:", counts(hexagon, until))
+
+
+if __name__ == "__main__":
+    main()
