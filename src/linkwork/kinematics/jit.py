@@ -14,10 +14,11 @@ of a normalised-ratio computation) and returns a :class:`Backend`, which the tra
   the ``linkwork`` script does, never a library call from a notebook or a Dask worker): the plain-Python twins,
   and one detached process compiles every kernel into the cache for the next run.
 * Otherwise (a library call, or ``LINKWORK_JIT=compiled``) the kernels are compiled in this process first,
-  announced on the ``linkwork.jit`` logger and kept out of the trace's reported time.
+  announced (a warning of the ``linkwork.jit`` logger) and kept out of the trace's reported time.
 
 ``linkwork compile`` fills the cache ahead of time (CI, container images, Dask workers). Announcements go to the
-``linkwork.jit`` logger (the command line prints them on stderr).
+``linkwork.jit`` logger (the command line prints them on stderr); a foreground compile is announced as a warning,
+which Python prints on stderr even where logging is not set up (a script, a notebook).
 """
 
 from __future__ import annotations
@@ -154,8 +155,8 @@ def compile_now(warm_up: Callable[[], None], announce: bool = False) -> float:
     """Compile the tracing kernels in this process (into the cache), or load them from it when they are there,
     by running ``warm_up`` (tracing a small linkage with them); marks the group ready and returns the seconds it
     took (their sum is :func:`compile_seconds`)."""
-    if announce:
-        log.info("compiling kernels, first run only (linkwork compile does it ahead of time) ...")
+    if announce:  # a warning, so that a script or a notebook without logging set up sees why it waits
+        log.warning("compiling kernels, first run only (linkwork compile does it ahead of time) ...")
     started = time.perf_counter()
     _state["compiling"] = True
     try:
