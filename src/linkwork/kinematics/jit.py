@@ -146,11 +146,6 @@ def select_backend(chosen: str | None = None, warm_up: Callable[[], None] | None
     return compiled_backend()
 
 
-def kernels_ready() -> bool:
-    """Whether the tracing kernels are loaded in this process or the marker says they are in the cache."""
-    return bool(_state["loaded"]) or CACHE.ready(GROUP)
-
-
 def compile_now(warm_up: Callable[[], None], announce: bool = False) -> float:
     """Compile the tracing kernels in this process (into the cache), or load them from it when they are there,
     by running ``warm_up`` (tracing a small linkage with them); marks the group ready and returns the seconds it
