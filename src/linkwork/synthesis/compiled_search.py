@@ -62,11 +62,12 @@ def _pairwise_sum(a: Array, lo: int, n: int) -> float:  # pragma: no cover - com
 
 @kernel()
 def _arc_parameters(
-    offsets: IntArray, chord_sum: Array, curvature_sum: Array, first: IntArray, pieces: IntArray
+    tables: tuple[Array, IntArray, Array, Array], first: IntArray, pieces: IntArray
 ) -> tuple[float, float]:  # pragma: no cover - compiled
     """``(curvature, piece_length)`` of a C-segment of ``pieces[j]`` pieces from ``first[j]`` on profile ``j``:
     the mean interior curvature (Eq. 18, averaging ``1/r``) and mean chord (Eq. 20 with its ``1/p``), from the
-    prefix sums as ``ProfileTables.arc_errors`` takes them."""
+    prefix sums of ``tables`` (:attr:`CompiledTables.arrays`) as ``ProfileTables.arc_errors`` takes them."""
+    _, offsets, chord_sum, curvature_sum = tables
     p = pieces.shape[0]
     kappa_total = 0.0
     interior = 0
@@ -84,18 +85,14 @@ def _arc_parameters(
 
 @kernel()
 def _segment_matrix_table(
-    sm: IntArray,
-    is_m: NDArray[np.bool_],
-    points: Array,
-    offsets: IntArray,
-    chord_sum: Array,
-    curvature_sum: Array,
-    rms: bool,
+    sm: IntArray, is_m: NDArray[np.bool_], tables: tuple[Array, IntArray, Array, Array], rms: bool
 ) -> Array:  # pragma: no cover - compiled
     """``(q, p)`` errors (Eq. 21) of a segment matrix, or with ``rms`` the lower bounds of ``compiled.fit_bound``.
 
-    The arithmetic of ``ProfileTables.mean_errors/arc_errors`` (curvature and chord from prefix sums).
+    The arithmetic of ``ProfileTables.mean_errors/arc_errors`` (curvature and chord from prefix sums);
+    ``tables`` is :attr:`CompiledTables.arrays`.
     """
+    points, offsets = tables[0], tables[1]
     q, p = sm.shape
     em = np.empty((q, p))
     first = np.zeros(p, dtype=np.int64)
@@ -103,7 +100,7 @@ def _segment_matrix_table(
         if is_m[e]:
             em[e] = mean_fits(points, offsets, first, sm[e, 0], rms)
         else:
-            kappa, s_bar = _arc_parameters(offsets, chord_sum, curvature_sum, first, sm[e])
+            kappa, s_bar = _arc_parameters(tables, first, sm[e])
             em[e] = arc_fits(points, offsets, first, sm[e].copy(), kappa, s_bar, rms)
         for j in range(p):
             first[j] += sm[e, j]
@@ -176,10 +173,7 @@ def _search(
     is_m: NDArray[np.bool_],
     absorber: int,
     alpha: int,
-    points: Array,
-    offsets: IntArray,
-    chord_sum: Array,
-    curvature_sum: Array,
+    tables: tuple[Array, IntArray, Array, Array],
     patience: int,
     max_iterations: int,
 ) -> tuple[IntArray, Array, Array, IntArray]:  # pragma: no cover - compiled
@@ -193,7 +187,7 @@ def _search(
     for k in range(n_starts):
         sm = starts[k].copy()
         for it in range(max_iterations):
-            em = _segment_matrix_table(sm, is_m, points, offsets, chord_sum, curvature_sum, False)
+            em = _segment_matrix_table(sm, is_m, tables, False)
             e_max = em.max()  # Eq. (22)
             e_mean = _pairwise_sum(em.ravel(), 0, q * p) / (q * p)
             if e_max < best_max or (e_max == best_max and e_mean < best_mean):
@@ -220,6 +214,11 @@ class CompiledTables:
     chord_sum: Array
     curvature_sum: Array
 
+    @property
+    def arrays(self) -> tuple[Array, IntArray, Array, Array]:
+        """The tuple the compiled kernels take: ``(points, offsets, chord_sum, curvature_sum)``."""
+        return self.points, self.offsets, self.chord_sum, self.curvature_sum
+
     @classmethod
     def from_tables(cls, tables: ProfileTables) -> CompiledTables:
         """Stack the prefix sums of :class:`ProfileTables` (each as long as its profile's points)."""
@@ -243,10 +242,7 @@ def compiled_search(
         is_m,
         absorber,
         int(min_pieces),
-        tables.points,
-        tables.offsets,
-        tables.chord_sum,
-        tables.curvature_sum,
+        tables.arrays,
         PATIENCE,
         MAX_ITERATIONS,
     )
@@ -260,7 +256,5 @@ def compiled_rms_bound(design: str, segment_matrix: IntArray, tables: CompiledTa
     rigidly; see :func:`linkwork.synthesis.search.joined_error_bound`)."""
     is_m = np.array([k == "M" for k in design])
     sm = np.ascontiguousarray(np.asarray(segment_matrix, dtype=np.int64))
-    table = _segment_matrix_table(
-        sm, is_m, tables.points, tables.offsets, tables.chord_sum, tables.curvature_sum, True
-    )
+    table = _segment_matrix_table(sm, is_m, tables.arrays, True)
     return float(table.max())
