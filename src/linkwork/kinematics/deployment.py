@@ -6,8 +6,9 @@ amount", and they want structures that fold "into a tight bundle" and deploy "in
 :func:`deployment` puts numbers on those words for any :class:`~linkwork.kinematics.trace_result.Trace`; the
 formulas are in ``docs/deployment.md``.
 
-The deployment path is branch 0 from its start to the deployed configuration (its last point, or where a chosen
-joint reaches a chosen value). The attachment points are the named points of the spec (``[[points]]``) when it
+The deployment path is branch 0 of the trace; the deployed configuration is its last point, or where a chosen
+joint first reaches a chosen value on it (a structure traced from its flat, deployed start, such as a
+``rect-frame``: ``deployed_at = ("A", 0.0)``). The attachment points are the named points of the spec (``[[points]]``) when it
 declares any, else every joint's point, as written to ``points.csv``.
 """
 
@@ -46,7 +47,7 @@ class Deployment:
     attachment
         Names of the attachment points (named points, else joints).
     path
-        ``(K,)`` rows of the trace on the deployment path: branch 0 from its start to the deployed configuration.
+        ``(K,)`` rows of the trace on the deployment path: branch 0.
     deployed_at
         ``(joint, value)`` when the deployed configuration was chosen by a joint value, else ``None`` (the last
         point of branch 0).
@@ -160,7 +161,7 @@ def deployment(
     deployed_at
         ``(joint, value)`` (radians, or a length for a prismatic joint): the deployed configuration is where that
         joint first reaches ``value`` on branch 0 (between two traced points it is solved onto the loop with the
-        joint held there). Default: the last point of branch 0.
+        joint held there, and counts as a point of the path). Default: the last point of branch 0.
 
     Raises
     ------
@@ -175,7 +176,7 @@ def deployment(
     if deployed_at is None:
         deployed = trace.angles[rows[-1]]
     else:
-        rows, deployed, extra_end = _cut_at(trace, rows, deployed_at)
+        deployed, extra_end = _deployed_at(trace, rows, deployed_at)
     angles = trace.angles[rows] if extra_end is None else np.vstack([trace.angles[rows], extra_end])
     pts = attachment_positions(mech, angles)
     dep_pts = attachment_positions(mech, deployed[None, :])[0]
@@ -212,11 +213,11 @@ def deployment(
     )
 
 
-def _cut_at(
+def _deployed_at(
     trace: Trace, rows: NDArray[np.int64], deployed_at: tuple[str, float]
-) -> tuple[NDArray[np.int64], Array, Array | None]:
-    """The path up to where joint ``deployed_at[0]`` first reaches ``deployed_at[1]`` on branch 0: the rows
-    before it, the configuration there, and that configuration again when it falls between two rows."""
+) -> tuple[Array, Array | None]:
+    """The configuration where joint ``deployed_at[0]`` first reaches ``deployed_at[1]`` on branch 0 (``rows``),
+    and the same again when it falls between two traced points (an extra point of the path)."""
     mech = trace.mechanism
     name, value = deployed_at
     j = mech.index(name)
@@ -232,14 +233,13 @@ def _cut_at(
             f"from {values.min() * scale:.6g} to {values.max() * scale:.6g}{unit}"
         )
     if float(first).is_integer():
-        k = int(first)
-        return rows[: k + 1], trace.angles[rows[k]], None
+        return trace.angles[rows[int(first)]], None
     k = int(first - 0.5)
     a, b = trace.angles[rows[k]], trace.angles[rows[k + 1]]
     t = (value - a[j]) / (b[j] - a[j])
     guess = a + t * (b - a)
     solved = _close_with_joint(mech, guess, j, value)
-    return rows[: k + 1], solved, solved
+    return solved, solved
 
 
 def _close_with_joint(mech: Mechanism, angles: Array, j: int, value: float) -> Array:
