@@ -34,6 +34,10 @@ OUTPUT_NAMES = (
 
 RECORD_FORMAT = "linkwork-search-records/1"
 
+VIEWER_POINTS = 150
+"""Points per branch in a gallery candidate's viewer page (thinned evenly, ends and bifurcations kept): pages stay
+small and quick to write; ``linkwork trace --html`` of the candidate gives every point."""
+
 
 class SearchRecords:
     """The resumable record of a search in ``out``: :attr:`rows` already finished (by grid index), and
@@ -165,7 +169,7 @@ def _write_gallery(search: SearchStudy, rows: list[dict[str, Any]], stage: Path,
             svg = deployment_svg(again.trace, again.deployment)
             name = f"candidate-{row['index']:05d}.html"
             title = f"{search.study.name}: candidate {row['index']}"
-            write_trace_viewer(again.trace, stage / "viewers" / name, title=title)
+            write_trace_viewer(again.trace, stage / "viewers" / name, title=title, max_points=VIEWER_POINTS)
             link = f"viewers/{name}"
         cards.append(({**again.row, "index": row["index"], "rank": row.get("rank")}, svg, link))
     what = "the closest candidates (none passes)" if none_pass else f"the best {len(rows)} passing candidates"

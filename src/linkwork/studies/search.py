@@ -30,7 +30,14 @@ if TYPE_CHECKING:
 
 Row = dict[str, Any]
 
-CRITERIA = ("mobility", "max_bifurcations", "max_membrane_stretch", "max_flatness", "max_bundle_ratio")
+CRITERIA = (
+    "mobility",
+    "max_bifurcations",
+    "min_bifurcations",
+    "max_membrane_stretch",
+    "max_flatness",
+    "max_bundle_ratio",
+)
 """The criteria, in the order they are checked (a candidate's ``reason`` is the first it fails)."""
 
 MEASURES = ("membrane_stretch", "bundle_ratio", "flatness", "bifurcations")
@@ -65,14 +72,17 @@ MAX_BATCH = 25
 class Criteria:
     """What a candidate must meet (``None``: not asked), where it is deployed, and how passing ones are ranked.
 
-    ``mobility``: the mobility at the start and everywhere along the path, its located singular points included;
-    ``max_*``: upper limits of :class:`~linkwork.kinematics.deployment.Deployment`'s measures (``max_bifurcations``
-    counts the bifurcation points on the path). ``deployed_at``: ``(joint, value in degrees)`` or ``None`` (the
+    ``mobility``: the mobility at the start and everywhere along the path, its located singular points included
+    (a path the tracer cannot follow from the start fails it too); ``max_*``: upper limits of
+    :class:`~linkwork.kinematics.deployment.Deployment`'s measures (``max_bifurcations`` counts the bifurcation
+    points on the path); ``min_bifurcations``: at least that many (to find the structures that can deploy into
+    the wrong shape, as the paper's search did). ``deployed_at``: ``(joint, value in degrees)`` or ``None`` (the
     last point of branch 0).
     """
 
     mobility: int | None = None
     max_bifurcations: int | None = None
+    min_bifurcations: int | None = None
     max_membrane_stretch: float | None = None
     max_flatness: float | None = None
     max_bundle_ratio: float | None = None
@@ -117,6 +127,7 @@ def parse_criteria(table: Any, source: str) -> Criteria:
     table = reader.table(table, "criteria", CRITERIA_KEYS)
     mobility = reader.integer(table, "mobility", "criteria", default=None, minimum=0, maximum=1000)
     max_bif = reader.integer(table, "max_bifurcations", "criteria", default=None, minimum=0)
+    min_bif = reader.integer(table, "min_bifurcations", "criteria", default=None, minimum=0)
     limits: dict[str, float | None] = {}
     for key in ("max_membrane_stretch", "max_flatness", "max_bundle_ratio"):
         value = reader.number(table, key, "criteria", default=math.nan)
@@ -147,6 +158,7 @@ def parse_criteria(table: Any, source: str) -> Criteria:
     return Criteria(
         mobility=mobility,
         max_bifurcations=max_bif,
+        min_bifurcations=min_bif,
         max_membrane_stretch=limits["max_membrane_stretch"],
         max_flatness=limits["max_flatness"],
         max_bundle_ratio=limits["max_bundle_ratio"],
@@ -263,6 +275,9 @@ def judge(criteria: Criteria, row: Row, error: str = "") -> tuple[bool, str, flo
     if criteria.max_bifurcations is not None and row["bifurcations_on_path"] > criteria.max_bifurcations:
         excess = float(row["bifurcations_on_path"] - criteria.max_bifurcations)
         failed.append((f"bifurcations: {row['bifurcations_on_path']} > {criteria.max_bifurcations}", excess))
+    if criteria.min_bifurcations is not None and row["bifurcations_on_path"] < criteria.min_bifurcations:
+        lack = float(criteria.min_bifurcations - row["bifurcations_on_path"])
+        failed.append((f"bifurcations: {row['bifurcations_on_path']} < {criteria.min_bifurcations}", lack))
     for key in ("membrane_stretch", "flatness", "bundle_ratio"):
         limit = getattr(criteria, f"max_{key}")
         value = row[key]
@@ -309,7 +324,10 @@ def run_search(
     """Yield the rows of every candidate not in ``skip``, batch by batch in grid order (the Dask engine,
     :func:`~linkwork.studies.engine.map_chunks`)."""
     todo = [i for i in range(search.total) if i not in (skip or set())]
-    chunks = [(batch,) for batch in batches(todo, workers if workers else default_workers())]
+    in_process = workers == 0 and client is None and scheduler is None
+    # In this process a batch of one costs nothing and records every candidate as soon as it is done.
+    sizes = [(i,) for i in todo] if in_process else batches(todo, workers or default_workers())
+    chunks = [(batch,) for batch in sizes]
     already = search.total - len(todo)
     size = len(chunks[0][0]) if chunks else 1
 
