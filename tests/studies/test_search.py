@@ -200,3 +200,35 @@ def test_a_search_over_hundreds_of_members_completes_with_table_and_gallery(tmp_
     assert len(read_csv(out / "candidates.csv")) == 256
     ranked = read_csv(out / "ranked.csv")
     assert ranked and len(list((out / "viewers").iterdir())) == min(12, len(ranked))
+
+
+def test_stalled_members_are_mobile_to_first_order_only() -> None:
+    """The members the search fails with "the path stops" are rigid to second order: with t the Jacobian's null
+    vector at the flat start and w its left null vector, w . H(t, t) != 0 (H the closure Hessian), so no curve
+    leaves the start; the members it traces have w . H(t, t) = 0. Over the 36 mobile face choices of Guest's cuts."""
+    import itertools
+
+    from linkwork.kinematics.closure import hessian
+    from linkwork.studies.search import Criteria, SearchStudy, evaluate
+    from linkwork.studies.study_file import Study
+
+    search_study = SearchStudy(
+        Study(kind="linkage", name="t", target="rect-frame", grid={}, max_steps=300), Criteria(mobility=1)
+    )
+    stalled = moving = 0
+    for faces in ("".join(f) for f in itertools.product("io", repeat=6)):
+        mech = lw.load("rect-frame", faces=faces)
+        u, s, vt = np.linalg.svd(jacobian(mech, np.zeros(6)))
+        if s[4] < 1e-9 * s[0]:
+            continue  # mobility two: no single tangent
+        if s[5] > 1e-9 * s[0]:
+            continue  # rigid
+        second = abs(u[:, -1] @ np.einsum("eij,i,j->e", hessian(mech, np.zeros(6)), vt[-1], vt[-1]))
+        row = evaluate(search_study, {"faces": faces}).row
+        if row["reason"].startswith("mobility: the path stops"):
+            stalled += 1
+            assert second > 1e-3, faces
+        else:
+            moving += 1
+            assert second < 1e-12, faces
+    assert stalled > 0 and moving > 0 and stalled + moving == 36
