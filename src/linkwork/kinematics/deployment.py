@@ -34,8 +34,9 @@ COINCIDENT = 1e-9
 """Pairs of attachment points closer than this fraction of the deployed size in the deployed configuration are
 left out of the stretch (their ratio has no meaning)."""
 
-PAIR_BLOCK = 1 << 22
-"""The most pair distances held in memory at once (points x pairs), so memory stays bounded for many points."""
+PAIR_BLOCK = 1 << 20
+"""The most pair distances computed at once (points x pairs): about 50 MB of temporaries, whatever the number of
+points."""
 
 
 @dataclass(frozen=True)
@@ -127,14 +128,20 @@ def pair_extremes(points: Array, deployed: Array) -> tuple[Array, NDArray[np.int
     if len(i) == 0:
         return stretch, where, size, ref
     keep = ref > COINCIDENT * max(float(ref.max()), np.finfo(float).tiny)
+    inverse = np.where(keep, 1.0 / np.where(keep, ref, 1.0), 0.0)
+    coords = np.ascontiguousarray(np.moveaxis(points, 2, 0))  # (3, N, m): one coordinate at a time
     block = max(1, PAIR_BLOCK // len(i))
     for start in range(0, n, block):
-        part = points[start : start + block]
-        dist = np.linalg.norm(part[:, i] - part[:, j], axis=-1)  # (b, P)
-        size[start : start + block] = dist.max(axis=1)
-        ratio = np.where(keep, dist / np.where(keep, ref, 1.0) - 1.0, -np.inf)
-        where[start : start + block] = np.argmax(ratio, axis=1)
-        stretch[start : start + block] = ratio[np.arange(len(part)), where[start : start + block]]
+        stop = min(n, start + block)
+        squared = np.zeros((stop - start, len(i)))
+        for c in coords:
+            diff = c[start:stop, i] - c[start:stop, j]
+            squared += diff * diff
+        dist = np.sqrt(squared)  # (b, P)
+        size[start:stop] = dist.max(axis=1)
+        ratio = np.where(keep, dist * inverse - 1.0, -np.inf)
+        where[start:stop] = np.argmax(ratio, axis=1)
+        stretch[start:stop] = ratio[np.arange(stop - start), where[start:stop]]
     if not np.any(keep):
         stretch[:] = 0.0
     return stretch, where, size, ref
