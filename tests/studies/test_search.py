@@ -146,6 +146,7 @@ def test_bad_criteria_are_refused_in_one_line(tmp_path: Path) -> None:
         ("max_membrane_stretch = -1", "expected a number >= 0"),
         ('rank_by = ["speed"]', "criteria.rank_by[0]: expected one of"),
         ('deployed_at = "A"', "criteria.deployed_at"),
+        ('deployed_at = "Q=0"', "no joint 'Q'; joints are A, B, C, D, E, F"),
         ("mobility = 1.5", "criteria.mobility"),
     ]:
         code, output = search([str(study(tmp_path, criteria)), "-o", str(out)])

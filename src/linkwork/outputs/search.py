@@ -9,7 +9,9 @@ same ``OUT`` reads them and traces only the rest; a changed study starts afresh.
 from __future__ import annotations
 
 import json
+import math
 import os
+from dataclasses import asdict
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -125,7 +127,7 @@ def write_search_outputs(
         "candidates": len(rows),
         "passing": len(best),
         "failed_to_trace": sum(1 for r in rows if r["error"]),
-        "criteria": {k: v for k, v in vars(search.criteria).items()},
+        "criteria": asdict(search.criteria),
         "best": {k: best[0].get(k) for k in ["index", *search.study.grid, "membrane_stretch"]}
         if best
         else None,
@@ -137,11 +139,22 @@ def write_search_outputs(
         write_table(rows, cols, stage / "candidates.parquet", stage / "candidates.csv")
         _write_ranked(best, ["rank", *cols], stage / "ranked.csv")
         (stage / "search.json").write_text(
-            json.dumps(summary, indent=2, default=str) + "\n", encoding="utf-8"
+            json.dumps(_finite(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
         drawn = best[:gallery] if best else sorted(rows, key=lambda r: (r["shortfall"], r["index"]))[:gallery]
         _write_gallery(search, drawn, stage, none_pass=not best)
     return summary
+
+
+def _finite(value: Any) -> Any:
+    """``value`` for strict JSON: infinite and NaN numbers become ``null``, tuples lists."""
+    if isinstance(value, dict):
+        return {str(k): _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 def _write_ranked(rows: list[dict[str, Any]], cols: list[str], file: Path) -> None:

@@ -184,7 +184,21 @@ def load_search(path: Any) -> SearchStudy:
             "missing; expected a [criteria] table (e.g. mobility = 1)", source=source, key="criteria"
         )
     criteria = parse_criteria(study.extra["criteria"], source)
-    return SearchStudy(prepare_study(replace(study, extra={})), criteria)
+    search = SearchStudy(prepare_study(replace(study, extra={})), criteria)
+    if criteria.deployed_at is not None:  # its joint must exist (checked on the first candidate)
+        from linkwork.io.spec import resolve_spec
+
+        try:
+            first = resolve_spec(search.study.target, search.study.points()[0]).mechanism
+        except LinkworkError:
+            return search  # that candidate's own row will say why it cannot be built
+        if criteria.deployed_at[0] not in first.joint_names:
+            raise SpecError(
+                f"no joint {criteria.deployed_at[0]!r}; joints are {', '.join(first.joint_names)}",
+                source=source,
+                key="criteria.deployed_at",
+            )
+    return search
 
 
 # ------------------------------------------------------------------------------------------------ one candidate
@@ -236,6 +250,8 @@ def evaluate(search: SearchStudy, params: dict[str, Any]) -> Candidate:
         )
     except LinkworkError as exc:
         error = str(exc)
+    except (np.linalg.LinAlgError, FloatingPointError) as exc:  # a numerical failure ends this candidate only
+        error = f"{type(exc).__name__}: {exc}"
     passes, reason, shortfall = judge(search.criteria, row, error)
     row.update(passes=passes, reason=reason, shortfall=shortfall, error=error)
     return Candidate(row, traced, dep)
