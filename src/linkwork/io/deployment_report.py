@@ -50,12 +50,17 @@ def deployment_entry(trace: Trace, deployment: Deployment | None = None) -> dict
         "path_points": len(deployment.path),
         "deployed": {"at": at, "size": deployment.deployed_size, "angles": named(deployment.deployed_angles)},
         "membrane_stretch": {
-            "value": deployment.membrane_stretch,
+            "value": _number(deployment.membrane_stretch),
             "pair": list(deployment.stretch_pair),
             **where(deployment.stretch_row),
         },
-        "bundle_ratio": {"value": deployment.bundle_ratio, **where(deployment.bundle_row)},
-        "flatness": deployment.flatness,
+        "bundle_ratio": {"value": _number(deployment.bundle_ratio), **where(deployment.bundle_row)},
+        "flatness": _number(deployment.flatness),
         "bifurcations_on_path": deployment.bifurcations_on_path,
         "mobility_on_path": deployment.mobility_on_path,
     }
+
+
+def _number(value: float) -> float | None:
+    """A finite number as it is, anything else (a bundle ratio with a deployed size of 0) as ``null``."""
+    return float(value) if np.isfinite(value) else None
