@@ -41,7 +41,7 @@ def stretch_figure(trace: Trace, deployment: Deployment | None = None) -> Figure
     axes[1].plot(steps, size, lw=1.3)
     b = int(np.flatnonzero(dep.path == dep.bundle_row)[0])
     axes[1].plot([steps[b]], [size[b]], "o", label=f"bundle ratio {dep.bundle_ratio:.3g}")
-    axes[1].set_ylabel("size / deployed size")
+    axes[1].set_ylabel("size / deployed size (ratio)")
     for ax in axes:
         ax.set_xlabel("step along branch 0")
         ax.grid(alpha=0.3)
