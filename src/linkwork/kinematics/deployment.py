@@ -34,6 +34,9 @@ COINCIDENT = 1e-9
 """Pairs of attachment points closer than this fraction of the deployed size in the deployed configuration are
 left out of the stretch (their ratio has no meaning)."""
 
+TIE = 1e-12
+"""Relative difference below which two values of a measure along the path count as equal (round-off)."""
+
 PAIR_BLOCK = 1 << 20
 """The most pair distances computed at once (points x pairs): about 50 MB of temporaries, whatever the number of
 points."""
@@ -190,9 +193,10 @@ def deployment(
     stretch, where, size, ref = pair_extremes(pts, dep_pts)
     names = attachment_names(mech)
     pi, pj = np.triu_indices(len(names), 1)
-    k = int(np.argmax(stretch))
+    # The first point within round-off of the extreme: a plateau (the bundle before it opens) reports its start.
+    k = int(np.flatnonzero(stretch >= stretch.max() - TIE * max(1.0, abs(float(stretch.max()))))[0])
     deployed_size = float(ref.max()) if len(ref) else 0.0
-    bundle = int(np.argmin(size))
+    bundle = int(np.flatnonzero(size <= size.min() * (1.0 + TIE))[0])
     last_step = int(trace.step[rows[-1]])
     located = [b for b in trace.bifurcations if b.branch == 0 and b.step <= last_step and b.kind != "fold"]
     mobility = int(trace.mobility[rows].max())
