@@ -34,9 +34,9 @@ def search(
 ) -> None:
     """Trace every candidate of a study and judge it: candidates.csv/.parquet, ranked.csv, gallery.html in --out.
 
-    Re-running on the same --out continues an interrupted search (finished candidates are kept in
-    --out/.linkwork-search/). Exit codes: 0 some candidate passes; 2 bad input; 3 none passes (the closest is
-    printed, after every output is written).
+    Re-running on the same --out continues an interrupted search (its records are in --out/.linkwork-search/).
+
+    Exit codes: 0 some candidate passes; 2 bad input; 3 none passes (the closest is printed, outputs written).
     """
     from linkwork.errors import RequestNotMetError
     from linkwork.outputs.search import (
