@@ -165,6 +165,8 @@ def test_gallery_escapes_the_names_a_user_wrote(tmp_path: Path) -> None:
     assert search([str(file), "-o", str(out), "--workers", "0"])[0] == 3  # Guest's frame bifurcates
     page = (out / "gallery.html").read_text()
     assert "<script>" not in page and "&lt;script&gt;alert(1)&lt;/script&gt; &amp; co" in page
+    viewers = list((out / "viewers").glob("*.html"))
+    assert viewers and all("alert(1)</script>" not in v.read_text() for v in viewers)
 
 
 def test_a_distributed_scheduler_gives_the_same_table(tmp_path: Path) -> None:
