@@ -161,3 +161,15 @@ def test_cli_deployed_at_refusals(tmp_path: Path) -> None:
     )
     assert off.exit_code == 3 and "goes from 0 to 360" in off.output
     assert not out.exists()  # nothing written
+
+
+def test_a_frame_traced_from_its_flat_start_is_deployed_there() -> None:
+    """rect-frame starts flat: ``deployed_at = ("A", 0)`` picks the first point (exactly), whose named points are
+    the rectangle's corners and mid-sides in z = 0 (flatness 0, size the diagonal)."""
+    mech = lw.load("rect-frame")
+    tr = lw.trace(mech, max_steps=200)
+    dep = tr.deployment(("A", 0.0))
+    np.testing.assert_array_equal(dep.deployed_angles, tr.angles[0])
+    assert dep.flatness < 1e-15
+    assert dep.deployed_size == pytest.approx(np.hypot(2.0, 1.0), rel=1e-14)
+    assert dep.membrane_stretch > 0.0 and dep.bundle_ratio < 1.0
