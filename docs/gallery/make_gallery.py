@@ -1,6 +1,6 @@
 """Reproduce the papers' figures: ``python docs/gallery/make_gallery.py`` (writes the PNGs next to this file).
 
-Gan & Pellegrino (2006): Figs. 9-13, 15, 16. Shamsudin et al. (2013): Figs. 3, 6, 7, 8, 10, 13 (via 8 and 10), 14 (seat example).
+Gan & Pellegrino (2006): Figs. 9-13, 15, 16, and Sec. 7's membrane remark. Shamsudin et al. (2013): Figs. 3, 6, 7, 8, 10, 13 (via 8 and 10), 14 (seat example).
 Needs the ``viz`` extra (matplotlib, pillow). Takes about 20 s.
 """
 
@@ -74,6 +74,14 @@ def line_plot(plot, path, out: Path, **kwargs) -> Path:
     return out
 
 
+def hexagon_stretch(hexagon, out: Path) -> Path:
+    """Sec. 7: the membrane a deployed hexagon would carry must stretch on the way (docs/deployment.md)."""
+    from linkwork.viz.deployment_plots import stretch_figure
+
+    stretch_figure(hexagon).savefig(out, dpi=80)
+    return out
+
+
 def main() -> None:
     started = time.perf_counter()
     written = [fig09(HERE / "fig09_square_symmetric.png")]
@@ -86,6 +94,7 @@ def main() -> None:
     hexagon = trace(hedgepeth_rods(6), until=("A", deployed_angles(6)[0]), steps=200)
     written.append(line_plot(plot_angles, hexagon, HERE / "fig12_hexagon_angles.png"))
     written.append(deployment_sequence(hexagon, HERE / "fig13_hexagon_sequence.png", dpi=80))
+    written.append(hexagon_stretch(hexagon, HERE / "sec7_hexagon_stretch.png"))
 
     frame = trace(guest_frame(), branches=True, max_steps=6000)
     written.append(line_plot(plot_singular_values, frame, HERE / "fig15_guest_singular_values.png", branch=0))

@@ -29,7 +29,7 @@ SKIP = re.compile(r"<!--\s*docs-test:\s*skip:\s*(\S.*?)\s*-->")
 FENCE = re.compile(r"^```(\w*)\s*$")
 #: Commands that start Dask worker processes: run by the shell, as a user would (their sockets and processes are
 #: not this test process's to keep).
-OWN_PROCESS = {"robustness", "sweep"}
+OWN_PROCESS = {"robustness", "search", "sweep"}
 
 
 def documented_commands(file: Path) -> list[str]:

@@ -206,6 +206,7 @@ EXPECTED = {
     "guest-frame": (6, 0),
     "hedgepeth": (0, 0),
     "hedgepeth-rods": (0, 0),
+    "rect-frame": (6, 0),  # its defaults are Guest's frame
     "sarrus": (2, 4),
     "slider-crank": (0, 0),  # the rod longer than crank + offset: no dead point
 }

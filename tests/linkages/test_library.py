@@ -25,6 +25,7 @@ from linkwork.linkages import bennett as bennett_module
 from linkwork.linkages import bricard as bricard_module
 from linkwork.linkages import goldberg as goldberg_module
 from linkwork.linkages import guest as guest_module
+from linkwork.linkages import rect_frame as rect_frame_module
 from linkwork.linkages import sarrus as sarrus_module
 from linkwork.linkages.registry import REGISTRY
 
@@ -103,6 +104,7 @@ MOBILE_6R: dict[str, Callable[[], Mechanism]] = {
     "bricard-threefold": bricard_module.bricard_threefold,
     "sarrus": sarrus_module.sarrus,
     "guest-frame": guest_module.guest_frame,
+    "rect-frame": rect_frame_module.rect_frame,
 }
 ALL: dict[str, Callable[[], Mechanism]] = {
     "bennett": bennett_module.bennett,

@@ -13,7 +13,19 @@ from typing import Annotated, Any
 
 import typer
 
-from linkwork.cli import demo, export, help, kernels, linkages, mechanize, robustness, sweep, synth, trace
+from linkwork.cli import (
+    demo,
+    export,
+    help,
+    kernels,
+    linkages,
+    mechanize,
+    robustness,
+    search,
+    sweep,
+    synth,
+    trace,
+)
 from linkwork.cli.common import fail
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -74,6 +86,7 @@ app.command("mechanize", cls=help.Command)(mechanize.mechanize)
 app.command("demo", cls=help.Command)(demo.demo)
 app.command("robustness", cls=help.Command)(robustness.robustness)
 app.command("sweep", cls=help.Command)(sweep.sweep)
+app.command("search", cls=help.Command)(search.search)
 app.command("compile", cls=help.Command)(kernels.compile_kernels)
 app.add_typer(export.app, name="export")
 

@@ -26,12 +26,17 @@ def linkages() -> None:
         entry = REGISTRY[name]
         defaults = entry.file_defaults()
         params = "\n".join(
-            f"{k} = {defaults[k]:g}{' deg' if p.unit == 'deg' else ''}: {p.help}"
+            f"{k} = {_default_text(defaults[k])}{' deg' if p.unit == 'deg' else ''}: {p.help}"
             for k, p in entry.params.items()
         )
         table.add_row(name, params or "-", entry.summary)
     console.print(table)
     console.print("use: linkwork trace NAME --set KEY=VALUE ...   or   linkwork show NAME > my.toml")
+
+
+def _default_text(value: float | int | str) -> str:
+    """A default as the table prints it: numbers with ``:g``, text quoted as in a TOML file."""
+    return f'"{value}"' if isinstance(value, str) else f"{value:g}"
 
 
 @friendly_errors

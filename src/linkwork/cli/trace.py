@@ -21,6 +21,7 @@ from linkwork.cli.common import (
     until_in_api_units,
 )
 from linkwork.errors import RequestNotMetError
+from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console
 
 MAX_STEP_DEG = 90.0
@@ -99,6 +100,14 @@ def trace(
             "link parameters are slightly inconsistent; report.json states it and the largest misfit met.",
         ),
     ] = 1e-12,
+    deployed_at: Annotated[
+        str | None,
+        typer.Option(
+            help="The deployed configuration for the deployment measures in report.json: where JOINT first "
+            "reaches VALUE (degrees) on branch 0, e.g. A=128.6822 (default: the last point of branch 0).",
+            show_default=False,
+        ),
+    ] = None,
     out: opt.OutFolder = Path("out"),
     no_plots: opt.NoPlots = False,
     animate: Annotated[
@@ -119,7 +128,8 @@ def trace(
 
     Exit codes: 0 done as asked; 2 bad input (one line saying which file, key or flag and what was expected);
     3 the request could not be met (the --until target is never reached on the path: its range is printed),
-    after path.csv, report.json and the figures of what was traced are written.
+    after path.csv, report.json and the figures of what was traced are written; or the --deployed-at value is
+    not reached on branch 0 (its range there is printed, nothing is written).
     """
     import numpy as np
 
@@ -141,6 +151,7 @@ def trace(
         mech = mech.with_couplings(parse_couple(couple), fixed or [])
     limits = _limits_in_api_units(mech, limits_file)
     until_rad = until_in_api_units(mech, target)
+    deployed_rad = until_in_api_units(mech, _parse_deployed_at(deployed_at))
 
     console.print(
         Text(mech.name, style="bold"),
@@ -160,14 +171,29 @@ def trace(
     )  # fmt: skip
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
 
+    deployment = traced.deployment(deployed_rad)  # a value not on branch 0: exit 3 before writing anything
     figures = write_trace_outputs(
-        traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate
+        traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate, deployment=deployment
     )
     print_trace_summary(traced)
     written = ["path.csv", "report.json", "points.csv", "mechanism.toml", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
     if traced.stats.unmet is not None:
         raise RequestNotMetError(traced.stats.unmet)
+
+
+def _parse_deployed_at(text: str | None) -> tuple[str, float] | None:
+    """``--deployed-at JOINT=VALUE`` (degrees, or a length), or None without the flag."""
+    if text is None:
+        return None
+    name, sep, raw = text.partition("=")
+    try:
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not sep or not name.strip() or not math.isfinite(value):
+        raise fail(f"--deployed-at {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=128.6822")
+    return name.strip(), value
 
 
 def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:

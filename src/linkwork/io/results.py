@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 
 from linkwork.deprecation import trace_keyword
+from linkwork.io.deployment_report import deployment_entry
+from linkwork.kinematics.deployment import Deployment
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
 
@@ -82,8 +84,11 @@ def branch_range(trace: Trace, branch: int) -> dict[str, list[float]]:
 
 
 @trace_keyword
-def report_dict(trace: Trace, assembly: Any | None = None) -> dict[str, Any]:
-    """The content of ``report.json``."""
+def report_dict(
+    trace: Trace, assembly: Any | None = None, deployment: Deployment | None = None
+) -> dict[str, Any]:
+    """The content of ``report.json`` (``deployment``: the measures of :meth:`Trace.deployment`, default
+    deployed configuration unless given)."""
     mech = trace.mechanism
     names = list(mech.joint_names)
     cond = trace.condition()
@@ -113,6 +118,7 @@ def report_dict(trace: Trace, assembly: Any | None = None) -> dict[str, Any]:
         "branches": [_branch_entry(trace, br) for br in trace.branches],
         "seconds": trace.stats.seconds,
     }
+    out["deployment"] = deployment_entry(trace, deployment)
     if assembly is not None:
         out["assembly"] = _assembly_entry(assembly, names)
     return out
@@ -218,10 +224,12 @@ def _assembly_entry(assembly: Any, names: list[str]) -> dict[str, Any]:
 
 
 @trace_keyword
-def write_report_json(trace: Trace, file: Path, assembly: Any | None = None) -> None:
+def write_report_json(
+    trace: Trace, file: Path, assembly: Any | None = None, deployment: Deployment | None = None
+) -> None:
     """Write ``report.json``."""
     with open(file, "w") as fh:
-        json.dump(report_dict(trace, assembly), fh, indent=2)
+        json.dump(report_dict(trace, assembly, deployment), fh, indent=2)
         fh.write("\n")
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +17,9 @@ from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.normalization import condition_ratios
 from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_stats import TraceStats
+
+if TYPE_CHECKING:
+    from linkwork.kinematics.deployment import Deployment
 
 Array = NDArray[np.float64]
 
@@ -202,6 +205,14 @@ class Trace:
         from linkwork.kinematics.positions import poses_along
 
         return poses_along(self.mechanism, self.angles)
+
+    def deployment(self, deployed_at: tuple[str, float] | None = None) -> Deployment:
+        """The deployment measures of branch 0 (membrane stretch, bundle ratio, flatness, bifurcations on the
+        path; :func:`linkwork.kinematics.deployment.deployment`). ``deployed_at = (joint, value)`` in radians
+        chooses the deployed configuration (default: the last point of branch 0)."""
+        from linkwork.kinematics.deployment import deployment
+
+        return deployment(self, deployed_at)
 
     def plot(self, kind: str = "angles", *, branch: int = 0) -> Any:
         """A matplotlib ``Figure``: ``kind="angles"`` (every hinge angle against the drive, all branches) or

@@ -10,6 +10,7 @@ from linkwork.linkages import goldberg as _goldberg  # noqa: F401
 from linkwork.linkages import guest as _guest  # noqa: F401
 from linkwork.linkages import hedgepeth as _hedgepeth  # noqa: F401
 from linkwork.linkages import hedgepeth_rods as _hedgepeth_rods  # noqa: F401
+from linkwork.linkages import rect_frame as _rect_frame  # noqa: F401
 from linkwork.linkages import sarrus as _sarrus  # noqa: F401
 from linkwork.linkages import slider_crank as _slider_crank  # noqa: F401
 from linkwork.linkages.hedgepeth import deployed_angle, hedgepeth

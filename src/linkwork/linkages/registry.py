@@ -7,6 +7,7 @@ Parameters are given to constructors in API units (radians); ``unit = "deg"`` ma
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -27,18 +28,23 @@ DEFAULT_BOUNDS = {"length": (-1e6, 1e6), "deg": (-720.0, 720.0), "int": (0, 1000
 
 @dataclass(frozen=True)
 class Param:
-    """One parameter of a built-in linkage: default (API units), unit (``"deg"``, ``"length"``, ``"int"``), help,
-    and the range ``[low, high]`` a given value must be in (file units; :data:`DEFAULT_BOUNDS` when ``None``)."""
+    """One parameter of a built-in linkage: default (API units), unit (``"deg"``, ``"length"``, ``"int"``,
+    ``"text"``), help, and the range ``[low, high]`` a given value must be in (file units; :data:`DEFAULT_BOUNDS`
+    when ``None``). A ``"text"`` parameter is a string matching the regular expression ``pattern`` (whole
+    string); the constructor checks what the pattern cannot say."""
 
-    default: float | int
+    default: float | int | str
     unit: str
     help: str
     low: float | None = None
     high: float | None = None
+    pattern: str | None = None
 
     @property
     def bounds(self) -> tuple[float, float]:
-        """``(low, high)`` in file units (degrees for angles)."""
+        """``(low, high)`` in file units (degrees for angles); ``(nan, nan)`` for text."""
+        if self.unit == "text":
+            return (math.nan, math.nan)
         low, high = DEFAULT_BOUNDS[self.unit]
         return (low if self.low is None else self.low, high if self.high is None else self.high)
 
@@ -69,8 +75,14 @@ class LinkageEntry:
             kwargs[key] = param.default if key not in given else self._checked(key, param, given[key])
         return self.build(**kwargs)
 
-    def _checked(self, key: str, param: Param, value: Any) -> float | int:
+    def _checked(self, key: str, param: Param, value: Any) -> float | int | str:
         """``value`` (file units) checked against ``param`` and converted to API units."""
+        if param.unit == "text":
+            if not isinstance(value, str) or re.fullmatch(param.pattern or ".*", value) is None:
+                raise SpecError(
+                    f"{self.name}: parameter {key} expected {param.help}, got {show(value)}", key="--set"
+                )
+            return value
         low, high = param.bounds
         unit = " deg" if param.unit == "deg" else ""
         what = "a whole number" if param.unit == "int" else "a finite number"
@@ -89,7 +101,7 @@ class LinkageEntry:
             return int(number)
         return math.radians(number) if param.unit == "deg" else number
 
-    def file_defaults(self) -> dict[str, float | int]:
+    def file_defaults(self) -> dict[str, float | int | str]:
         """Defaults in file units (degrees for angles)."""
         return {
             k: (float(np.degrees(p.default)) if p.unit == "deg" else p.default)

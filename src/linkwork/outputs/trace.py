@@ -14,6 +14,7 @@ if TYPE_CHECKING:
     from rich.table import Table
 
     from linkwork.kinematics.chains import Assembly
+    from linkwork.kinematics.deployment import Deployment
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Trace
 
@@ -26,26 +27,30 @@ def write_trace_outputs(
     plots: bool = True,
     html: bool = False,
     animate: bool = False,
+    deployment: Deployment | None = None,
 ) -> list[Path]:
     """Write path.csv, report.json, (if matplotlib is there) the figures and the deployment sequence of the
     first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
     (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
-    ``viewer.html`` into ``out``, all or nothing. Returns the figures, animation and viewer written."""
+    ``viewer.html`` into ``out``, all or nothing; ``deployment`` (default ``trace.deployment()``) goes into
+    report.json and ``stretch.png``. Returns the figures, animation and viewer written."""
     from linkwork.io.results import write_path_csv, write_points_csv, write_report_json
 
     figures: list[Path] = []
     with staged_output(out) as stage:
         write_path_csv(trace, stage / "path.csv")
-        write_report_json(trace, stage / "report.json", assembly)
+        write_report_json(trace, stage / "report.json", assembly, deployment)
         write_points_csv(trace, stage / "points.csv")
         write_trace_mechanism(trace.mechanism, stage)
         if plots:
             if have_matplotlib():
+                from linkwork.viz.deployment_plots import plot_stretch
                 from linkwork.viz.snapshots import deployment_sequence
                 from linkwork.viz.trace_plots import write_trace_figures
 
                 figures = write_trace_figures(trace, stage)
                 figures.append(deployment_sequence(trace, stage / "sequence.png"))
+                figures.append(plot_stretch(trace, stage / "stretch.png", deployment))
                 if animate:
                     from linkwork.viz.animate import animate_path
 

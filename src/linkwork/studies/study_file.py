@@ -25,7 +25,7 @@ from linkwork.errors import SpecError
 from linkwork.io.toml_reader import TomlReader, read_toml, show
 
 SYNTHESIS_KEYS = ("piece_length", "segments", "design", "min_pieces", "starts", "merge_below")
-TOP_KEYS = ("name", "description", "linkage", "spec", "problem", "trace", "grid", "robustness")
+TOP_KEYS = ("name", "description", "linkage", "spec", "problem", "trace", "grid", "robustness", "criteria")
 TRACE_KEYS = ("until", "steps", "branches", "max_steps")
 ROBUSTNESS_KEYS = (
     "samples",
@@ -206,4 +206,5 @@ def load_study(path: str | Path) -> Study:
         max_steps=int(trace_table.get("max_steps", 5000)),
         robustness=robustness,
         source=path,
+        extra={"criteria": table["criteria"]} if "criteria" in table else {},  # linkwork search's table
     )

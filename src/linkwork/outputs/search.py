@@ -1,0 +1,240 @@
+"""The files of a search (``linkwork search``): the per-candidate records that make it resumable, and the tables,
+gallery and viewers written at the end through the staging layer (:func:`linkwork.outputs.staging.staged_output`).
+
+Records: ``OUT/.linkwork-search/records.jsonl``, a header line with the study's fingerprint, then one JSON line
+per finished candidate, appended and flushed batch by batch as they come back. Re-running the same study on the
+same ``OUT`` reads them and traces only the rest; a changed study starts afresh.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import asdict
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from linkwork.errors import SpecError
+from linkwork.io.toml_reader import show
+from linkwork.outputs.staging import console, staged_output
+from linkwork.studies.search import MEASURE_COLUMNS, SearchStudy, evaluate, ranked
+
+RECORDS = Path(".linkwork-search") / "records.jsonl"
+"""Where a search keeps its per-candidate records, inside its output folder."""
+
+OUTPUT_NAMES = (
+    "candidates.csv",
+    "candidates.parquet",
+    "ranked.csv",
+    "gallery.html",
+    "viewers",
+    "search.json",
+)
+"""What a search writes into its output folder at the end."""
+
+RECORD_FORMAT = "linkwork-search-records/1"
+
+VIEWER_POINTS = 150
+"""Points per branch in a gallery candidate's viewer page (thinned evenly, ends and bifurcations kept): pages stay
+small and quick to write; ``linkwork trace --html`` of the candidate gives every point."""
+
+
+class SearchRecords:
+    """The resumable record of a search in ``out``: :attr:`rows` already finished (by grid index), and
+    :meth:`add` to append more (flushed and synced, so an interruption keeps every batch that came back)."""
+
+    def __init__(self, out: Path, search: SearchStudy) -> None:
+        self.file = Path(out) / RECORDS
+        self.fingerprint = search.fingerprint()
+        self.rows: dict[int, dict[str, Any]] = {}
+        self.restarted = False
+        self._fh: Any = None
+
+    def __enter__(self) -> SearchRecords:
+        if self.file.exists():
+            self._read()
+        if not self.rows:
+            self.file.parent.mkdir(parents=True, exist_ok=True)
+            part = self.file.with_suffix(".part")
+            header = {"format": RECORD_FORMAT, "study": self.fingerprint}
+            part.write_text(json.dumps(header) + "\n", encoding="utf-8")
+            os.replace(part, self.file)
+        self._fh = self.file.open("a", encoding="utf-8")
+        return self
+
+    def _read(self) -> None:
+        lines = self.file.read_text(encoding="utf-8").splitlines()
+        try:
+            header = json.loads(lines[0]) if lines else {}
+        except ValueError:
+            header = {}
+        if not isinstance(header, dict) or header.get("format") != RECORD_FORMAT:
+            raise SpecError(
+                f"--out {show(str(self.file.parent.parent))}: {show(str(RECORDS))} exists and was not written by "
+                "linkwork search; move it away or choose another --out"
+            )
+        if header.get("study") != self.fingerprint:
+            self.restarted = True
+            return
+        for line in lines[1:]:
+            try:
+                row = json.loads(line)
+            except ValueError:  # a line cut short by an interruption: that candidate is traced again
+                continue
+            if isinstance(row, dict) and isinstance(row.get("index"), int):
+                self.rows[row["index"]] = row
+
+    def add(self, rows: list[dict[str, Any]]) -> None:
+        """Append finished candidates' rows."""
+        for row in rows:
+            self.rows[row["index"]] = row
+            self._fh.write(json.dumps(row) + "\n")
+        self._fh.flush()
+        os.fsync(self._fh.fileno())
+
+    def __exit__(
+        self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        if self._fh is not None:
+            self._fh.close()
+
+
+def columns(search: SearchStudy) -> list[str]:
+    """``index``, the grid parameters, the measures, then ``passes``, ``reason``, ``shortfall``, ``error``."""
+    return ["index", *search.study.grid, *MEASURE_COLUMNS, "passes", "reason", "shortfall", "error"]
+
+
+def write_search_outputs(
+    search: SearchStudy, rows: list[dict[str, Any]], out: Path, gallery: int = 12
+) -> dict[str, Any]:
+    """Write candidates.csv / .parquet (every candidate in grid order), ranked.csv (the passing ones, best first,
+    with ``rank``), search.json (the summary), and gallery.html with one viewer page per drawn candidate in
+    ``viewers/`` (the best ``gallery``, or the closest when none passes), all or nothing. Returns the summary."""
+    from linkwork.outputs.sweep import write_table
+    from linkwork.studies.search import closest
+
+    rows = sorted(rows, key=lambda r: r["index"])
+    best = ranked(search, rows)
+    for rank, row in enumerate(best, start=1):
+        row["rank"] = rank
+    cols = columns(search)
+    near = closest(rows)
+    summary = {
+        "name": search.study.name,
+        "linkage": search.study.target,
+        "candidates": len(rows),
+        "passing": len(best),
+        "failed_to_trace": sum(1 for r in rows if r["error"]),
+        "criteria": asdict(search.criteria),
+        "best": {k: best[0].get(k) for k in ["index", *search.study.grid, "membrane_stretch"]}
+        if best
+        else None,
+        "closest": None
+        if best or near is None
+        else {k: near.get(k) for k in ["index", *search.study.grid, "reason", "shortfall"]},
+    }
+    with staged_output(out) as stage:
+        write_table(rows, cols, stage / "candidates.parquet", stage / "candidates.csv")
+        _write_ranked(best, ["rank", *cols], stage / "ranked.csv")
+        (stage / "search.json").write_text(
+            json.dumps(_finite(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8"
+        )
+        drawn = best[:gallery] if best else sorted(rows, key=lambda r: (r["shortfall"], r["index"]))[:gallery]
+        _write_gallery(search, drawn, stage, none_pass=not best)
+    return summary
+
+
+def _finite(value: Any) -> Any:
+    """``value`` for strict JSON: infinite and NaN numbers become ``null``, tuples lists."""
+    if isinstance(value, dict):
+        return {str(k): _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _write_ranked(rows: list[dict[str, Any]], cols: list[str], file: Path) -> None:
+    import csv
+
+    with file.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(cols)
+        for row in rows:
+            writer.writerow(["" if row.get(c) is None else row.get(c) for c in cols])
+
+
+def _write_gallery(search: SearchStudy, rows: list[dict[str, Any]], stage: Path, none_pass: bool) -> None:
+    """gallery.html and ``viewers/candidate-NNNNN.html`` for ``rows`` (traced again here to draw them)."""
+    from linkwork.viz.gallery import deployment_svg, gallery_page
+    from linkwork.viz.viewer import write_trace_viewer
+
+    points = search.study.points()
+    cards = []
+    (stage / "viewers").mkdir()
+    for row in rows:
+        again = evaluate(search, points[row["index"]])
+        svg = link = ""
+        if again.trace is not None and again.deployment is not None:
+            svg = deployment_svg(again.trace, again.deployment)
+            name = f"candidate-{row['index']:05d}.html"
+            title = f"{search.study.name}: candidate {row['index']}"
+            write_trace_viewer(again.trace, stage / "viewers" / name, title=title, max_points=VIEWER_POINTS)
+            link = f"viewers/{name}"
+        cards.append(({**again.row, "index": row["index"], "rank": row.get("rank")}, svg, link))
+    what = "the closest candidates (none passes)" if none_pass else f"the best {len(rows)} passing candidates"
+    summary = f"{search.study.target}: {search.total} candidates; {what}, ranked by {', '.join(search.criteria.rank_by)}."
+    page = gallery_page(
+        f"{search.study.name}: search gallery",
+        summary,
+        cards,
+        list(search.study.grid),
+        [
+            "mobility_start",
+            "mobility_max",
+            "bifurcations_on_path",
+            "membrane_stretch",
+            "bundle_ratio",
+            "flatness",
+        ],
+    )
+    (stage / "gallery.html").write_text(page, encoding="utf-8")
+
+
+def print_search_summary(search: SearchStudy, rows: list[dict[str, Any]], top: int = 15) -> None:
+    """Print the best candidates (or the closest when none passes) as a table."""
+    from rich.table import Table
+
+    best = ranked(search, rows)
+    show_rows = best[:top]
+    title = f"{search.study.name}: {len(best)} of {len(rows)} candidate(s) pass"
+    table = Table(title=title, title_justify="left")
+    keys = [
+        "rank",
+        *search.study.grid,
+        "mobility_max",
+        "bifurcations_on_path",
+        "membrane_stretch",
+        "bundle_ratio",
+        "flatness",
+    ]
+    heads = {"mobility_max": "mob.", "bifurcations_on_path": "bif.", "membrane_stretch": "stretch",
+             "bundle_ratio": "bundle", "flatness": "flat"}  # fmt: skip
+    for key in keys:
+        table.add_column(heads.get(key, key), justify="right", overflow="fold")
+    for row in show_rows:
+        table.add_row(*[_fmt(row.get(k)) for k in keys])
+    console.print(table)
+    if len(best) > top:
+        console.print(f"... {len(best) - top} more in ranked.csv")
+
+
+def _fmt(value: Any) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return str(value)
