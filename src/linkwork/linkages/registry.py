@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import SpecError
-from linkwork.io.toml_reader import show
+from linkwork.io.toml_reader import closest, show
 from linkwork.kinematics.mechanism import Mechanism
 
 MAX_RODS = 100
@@ -114,4 +114,6 @@ def get(name: str) -> LinkageEntry:
     for entry in REGISTRY.values():
         if entry.name == key:
             return entry
-    raise SpecError(f"unknown linkage {name!r}; built-ins are {', '.join(sorted(REGISTRY))}")
+    close = closest(key, sorted(REGISTRY))
+    hint = f"did you mean {close!r}? " if close else ""
+    raise SpecError(f"unknown linkage {name!r}; {hint}built-ins are {', '.join(sorted(REGISTRY))}")
