@@ -35,6 +35,10 @@ class _SummaryConsole(Console):
             return size
         return ConsoleDimensions(max(size.width, FILE_WIDTH), size.height)
 
+    @size.setter
+    def size(self, new_size: tuple[int, int]) -> None:
+        self._width, self._height = new_size
+
 
 console: Console = _SummaryConsole(markup=False)
 """The console every summary is printed on (standard output). Markup is off: names, files and notes a user wrote
