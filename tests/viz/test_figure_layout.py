@@ -299,8 +299,14 @@ RUNS = {
     "synth": (["synth", "wing", "-o", "OUT"], None),
     "search": (["search", "STUDY", "-o", "OUT"], SEARCH_STUDY),
 }
+LANDING = (
+    "singular values wrong at the point a step lands on (the target, the closed path's end) when traced "
+)
+LANDING += "with a progress callback, as the CLI does: 3.526 for 4.194 (issue 18, tracing bookkeeping)"
 KNOWN = {
-    "trace-guest-frame": "singular values jump at the closed path's last point (issue 18, tracing bookkeeping)"
+    "trace-guest-frame": "singular values jump at the closed path's last point (issue 18, tracing bookkeeping)",
+    "trace-four-bar": LANDING,
+    "trace-slider-crank": LANDING,
 }
 
 
@@ -328,13 +334,7 @@ def run_and_check(args: list[str], study: str | None, folder: Path, caught: list
 CHECKED: list[str] = []
 
 
-@pytest.mark.parametrize(
-    "run",
-    [
-        pytest.param(k, marks=pytest.mark.xfail(reason=KNOWN[k], strict=False)) if k in KNOWN else k
-        for k in RUNS
-    ],
-)
+@pytest.mark.parametrize("run", list(RUNS))
 def test_every_figure_a_command_writes_reads_well(caught: list[str], tmp_path: Path, run: str) -> None:
     args, study = RUNS[run]
     if args[0] == "search":
@@ -343,7 +343,11 @@ def test_every_figure_a_command_writes_reads_well(caught: list[str], tmp_path: P
         if "search" not in {c.name for c in app.registered_commands}:
             pytest.skip("no `linkwork search` command in this version")
     problems = run_and_check(args, study, tmp_path, caught)
-    assert not problems, "\n".join(problems)
+    known = [p for p in problems if run in KNOWN and p.startswith("singular_values.png") and "jumps" in p]
+    others = [p for p in problems if p not in known]
+    assert not others, "\n".join(others)
+    if known:
+        pytest.xfail(f"{KNOWN[run]}: {known[0]}")
 
 
 @pytest.mark.slow
