@@ -24,6 +24,9 @@ DRAWING_PX = 220
 MAX_ROWS = 40
 """Rows of the joints table shown before it is cut (a hoop of 100 rods lists its first 40)."""
 
+MAX_NAME = 60
+"""The longest mechanism name a summary shows whole."""
+
 _TYPES = {"R": "revolute", "P": "prismatic"}
 
 
@@ -47,7 +50,8 @@ def summary(mech: Mechanism) -> str:
         loops,
         "planar" if mech.planar else "spatial",
     ]
-    return f"<Mechanism {mech.name!r}: " + "; ".join(parts + extra) + ">"
+    name = mech.name if len(mech.name) <= MAX_NAME else mech.name[: MAX_NAME - 3] + "..."
+    return f"<Mechanism {name!r}: " + "; ".join(parts + extra) + ">"
 
 
 def _couplings(mech: Mechanism) -> list[str]:
@@ -64,7 +68,8 @@ def _start(mech: Mechanism, j: int) -> str:
 
 
 def _vector(x: NDArray[np.float64]) -> str:
-    return "(" + ", ".join(f"{v:.4g}" + "" for v in (0.0 if abs(v) < 5e-13 else v for v in x)) + ")"
+    """``(x, y, z)`` with 4 significant digits, round-off next to zero shown as 0."""
+    return "(" + ", ".join(f"{0.0 if abs(v) < 5e-13 else v:.4g}" for v in x) + ")"
 
 
 def card(mech: Mechanism) -> str:
