@@ -37,7 +37,10 @@ def test_every_trace_plot_kind_draws_every_built_in(name: str) -> None:
         assert isinstance(fig, Figure) and fig.axes and any(ax.lines for ax in fig.axes)
 
 
-@pytest.mark.parametrize("example", ["wing", pytest.param("closed", marks=pytest.mark.slow)])
+@pytest.mark.parametrize(
+    "example",
+    ["wing", *(pytest.param(e, marks=pytest.mark.slow) for e in ("closed", "fixed-end", "seat", "wing-six"))],
+)
 def test_every_synthesis_plot_kind_draws_the_bundled_examples(example: str) -> None:
     """``result.plot("compound")`` raised ValueError on the README's wing (no compound stage, merge_below = 0);
     it now draws the joined chain with each joint's range of motion, and the compound stage when there is one."""
