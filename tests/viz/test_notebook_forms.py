@@ -109,3 +109,14 @@ def test_the_inline_viewer_stays_small_for_every_built_in(name: str) -> None:
     assert len(page) < INLINE_LIMIT, f"{name}: {len(page)} characters"
     assert len(traced.angles) == before
     assert f"&quot;points_traced&quot;: {before}" in page or f"&quot;points_traced&quot;:{before}" in page
+
+
+def test_a_linkage_too_large_to_embed_gets_a_short_note(monkeypatch: pytest.MonkeyPatch) -> None:
+    """When even the thinned viewer is over the limit (the solids of a hoop of many rods), the inline form is the
+    summary and where to find the full viewer, not a page over the limit."""
+    from linkwork.viz import inline
+
+    monkeypatch.setattr(inline, "INLINE_BYTES", 50_000)  # below the viewer's own size
+    traced = lw.trace(lw.load("bennett"), max_steps=40)
+    page = traced._repr_html_()
+    assert len(page) < 50_000 and "write_trace_viewer" in page and html.escape(traced.mechanism.name) in page

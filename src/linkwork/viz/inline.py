@@ -47,6 +47,15 @@ def trace_html(trace: Trace) -> str:
     while len(page) > INLINE_BYTES and points > fewest:
         points = max(fewest, int(points * 0.6))
         page = iframe(trace_viewer_page(trace, max_points=points), title=title)
+    if (
+        len(page) > INLINE_BYTES
+    ):  # the solids alone are too large (a hoop of many rods): say so, in a few lines
+        return (
+            f"<pre>{html.escape(repr(trace))}</pre><p>The interactive viewer of this linkage is "
+            f"{len(page) // 1000} kB even with its path thinned to {points} points, too large to embed: write it "
+            "with <code>linkwork.viz.viewer.write_trace_viewer(trace, 'viewer.html')</code> or "
+            "<code>linkwork trace --html</code>.</p>"
+        )
     return page
 
 
