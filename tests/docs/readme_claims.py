@@ -127,6 +127,16 @@ def _mjcf_four_bar(folder: Path, output: str) -> None:
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     assert np.abs(data.efc_pos[data.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY]).max() < 1e-9
+    import pinocchio as pin
+
+    pmodel, _, welds_pin = pin.buildModelAndConstraintsFromMJCF(str(folder / "four-bar.xml"))
+    assert {"A", "B", "C", "D"} <= set(pmodel.names) and len(welds_pin) == 1
+    pdata = pmodel.createData()
+    pin.forwardKinematics(pmodel, pdata, pmodel.referenceConfigurations["qpos0"])
+    weld = welds_pin[0]
+    oMc1 = pdata.oMi[weld.joint1_id] * weld.joint1_placement
+    oMc2 = pdata.oMi[weld.joint2_id] * weld.joint2_placement
+    assert np.linalg.norm(pin.log6(oMc1.inverse() * oMc2).vector) < 1e-9  # closed at the start, as in MuJoCo
 
 
 def _dxf_four_bar(folder: Path, output: str) -> None:
