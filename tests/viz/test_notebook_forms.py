@@ -96,8 +96,8 @@ def test_a_branched_trace_describes_each_branch(guest: lw.Trace) -> None:
         assert moved, line
         for joint, first, last in moved:
             j = guest.mechanism.index(joint)
-            assert float(first) == pytest.approx(values[0, j], abs=1e-4)
-            assert float(last) == pytest.approx(values[-1, j], abs=1e-4)
+            assert float(first) == pytest.approx(values[0, j], abs=0.01)  # printed with 5 digits
+            assert float(last) == pytest.approx(values[-1, j], abs=0.01)
 
 
 @pytest.mark.parametrize("name", sorted(REGISTRY))

@@ -206,9 +206,9 @@ def _names(names: tuple[str, ...], most: int = 12) -> str:
     return ", ".join(names[: most - 2]) + f", ... , {names[-1]}"
 
 
-def _num(value: float) -> str:
-    """A joint value for a summary: 6 significant digits, round-off next to zero shown as 0."""
-    return f"{0.0 if abs(value) < 5e-10 else value:.6g}"
+def _num(value: float, digits: int = 6) -> str:
+    """A joint value for a summary: ``digits`` significant digits, round-off next to zero shown as 0."""
+    return f"{0.0 if abs(value) < 5e-10 else value:.{digits}g}"
 
 
 def _branch_motion(trace: Trace, branch: int) -> str:
@@ -225,12 +225,12 @@ def _branch_motion(trace: Trace, branch: int) -> str:
     first, last = values[0, d], values[-1, d]
     lo, hi = values[:, d].min(), values[:, d].max()
     if hi - lo > 1e-6:
-        passed = f" (via {_num(lo)} to {_num(hi)})" if hi - lo > abs(last - first) + 1e-6 else ""
-        return f", {trace.drive} {_num(first)} -> {_num(last)} {units[d]}".rstrip() + passed
+        passed = f" (via {_num(lo, 5)} to {_num(hi, 5)})" if hi - lo > abs(last - first) + 1e-6 else ""
+        return f", {trace.drive} {_num(first, 5)} -> {_num(last, 5)} {units[d]}".rstrip() + passed
     j = int(np.argmax(np.ptp(values, axis=0)))
     return (
-        f", {trace.drive} stays at {_num(first)} {units[d]}".rstrip()
-        + f"; {mech.joint_names[j]} {_num(values[0, j])} -> {_num(values[-1, j])} {units[j]}".rstrip()
+        f", {trace.drive} at {_num(first, 5)} {units[d]}".rstrip()
+        + f", {mech.joint_names[j]} {_num(values[0, j], 5)} -> {_num(values[-1, j], 5)} {units[j]}".rstrip()
     )
 
 
@@ -257,9 +257,9 @@ def _summary_lines(trace: Trace) -> list[str]:
             f"{float(np.max(trace.residual)):.2e}; max condition {trace.max_condition:.4g}"
         )
     for br in trace.branches[:4]:
-        origin = "start" if br.parent is None else f"bifurcation {br.bifurcation} on branch {br.parent}"
+        origin = "start" if br.parent is None else f"bifurcation {br.bifurcation} (branch {br.parent})"
         run = _branch_motion(trace, br.id) if several else ""
-        lines.append(f"  branch {br.id}: {br.steps} steps from {origin}{run}, ended: {br.end_reason}")
+        lines.append(f"  branch {br.id}: {br.steps} steps from {origin}{run}; {br.end_reason}")
     if len(trace.branches) > 4:
         lines.append(f"  ... {len(trace.branches) - 4} more branches (trace.branches)")
     lines.append("  .angles (N, n) rad, .positions() (N, n, 3), .poses(), .plot(), .sigma, .bifurcations")
