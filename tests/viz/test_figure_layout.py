@@ -336,7 +336,13 @@ def run_and_check(args: list[str], study: str | None, folder: Path, caught: list
 CHECKED: list[str] = []
 
 
-@pytest.mark.parametrize("run", list(RUNS))
+#: Runs whose figures are of a kind another run already checks (still run in CI, marked slow).
+SLOW_RUNS = {"trace-slider-crank", "robustness-closed-path", "sweep-lines"}
+
+
+@pytest.mark.parametrize(
+    "run", [pytest.param(k, marks=pytest.mark.slow) if k in SLOW_RUNS else k for k in RUNS]
+)
 def test_every_figure_a_command_writes_reads_well(caught: list[str], tmp_path: Path, run: str) -> None:
     args, study = RUNS[run]
     if args[0] == "search":
