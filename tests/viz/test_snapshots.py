@@ -248,3 +248,21 @@ def test_a_grounded_mechanism_keeps_its_ground_still() -> None:
     np.testing.assert_allclose(
         [g.vertices for g in ground], np.repeat(ground[0].vertices[None], len(ground), axis=0), atol=1e-12
     )
+
+
+def test_the_viewer_draws_a_closed_path_s_ends_alike() -> None:
+    """The viewer's steady mode uses the same fits: Bennett's closed loop ends in the pose it began in."""
+    import linkwork as lw
+    from linkwork.viz.snapshots import mesh_clouds
+    from linkwork.viz.viewer import _steady_rows
+
+    path = trace(lw.load("bennett"))
+    idx = np.flatnonzero(path.branch == 0)
+    rows = _steady_rows(path, [idx])
+    moves = np.zeros((len(rows), 4, 4))
+    moves[:, :3, :3] = rows[:, :9].reshape(-1, 3, 3)
+    moves[:, :3, 3] = rows[:, 9:]
+    ends = mesh_clouds(path.mechanism, path.angles[idx[[0, -1]]])
+    first = ends[0] @ moves[0, :3, :3].T + moves[0, :3, 3]
+    last = ends[1] @ moves[-1, :3, :3].T + moves[-1, :3, 3]
+    assert np.abs(first - last).max() < 1e-9 * float(np.ptp(first, axis=0).max())
