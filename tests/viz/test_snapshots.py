@@ -251,18 +251,20 @@ def test_a_grounded_mechanism_keeps_its_ground_still() -> None:
 
 
 def test_the_viewer_draws_a_closed_path_s_ends_alike() -> None:
-    """The viewer's steady mode uses the same fits: Bennett's closed loop ends in the pose it began in."""
+    """The viewer's steady mode uses the same fits: Bennett's closed loop ends in the pose it began in (the page
+    carries the moves as float32)."""
     import linkwork as lw
     from linkwork.viz.snapshots import mesh_clouds
-    from linkwork.viz.viewer import _steady_rows
+    from linkwork.viz.viewer import trace_viewer_data
+    from linkwork.viz.viewer_page import unpack
 
     path = trace(lw.load("bennett"))
-    idx = np.flatnonzero(path.branch == 0)
-    rows = _steady_rows(path, [idx])
+    assert len(path.branches) == 1 and path.branches[0].end_reason == "closed path"
+    rows = unpack(trace_viewer_data(path)["steady"]).astype(float)
     moves = np.zeros((len(rows), 4, 4))
     moves[:, :3, :3] = rows[:, :9].reshape(-1, 3, 3)
     moves[:, :3, 3] = rows[:, 9:]
-    ends = mesh_clouds(path.mechanism, path.angles[idx[[0, -1]]])
+    ends = mesh_clouds(path.mechanism, path.angles[[0, -1]])
     first = ends[0] @ moves[0, :3, :3].T + moves[0, :3, 3]
     last = ends[1] @ moves[-1, :3, :3].T + moves[-1, :3, 3]
-    assert np.abs(first - last).max() < 1e-9 * float(np.ptp(first, axis=0).max())
+    assert np.abs(first - last).max() < 1e-5 * float(np.ptp(first, axis=0).max())  # float32 round-off
