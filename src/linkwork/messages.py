@@ -6,10 +6,12 @@ built-ins, the writers and the command line all quote values the same way.
 
 from __future__ import annotations
 
+import difflib
 import re
+from collections.abc import Sequence
 from typing import Any
 
-__all__ = ["SHOW_CHARS", "escape_line", "show"]
+__all__ = ["SHOW_CHARS", "closest", "escape_line", "show"]
 
 SHOW_CHARS = 40
 """The longest string :func:`show` quotes whole; a longer one is cut, ending in ``...``."""
@@ -42,3 +44,14 @@ _CONTROL = re.compile(r"[\x00-\x1f\x7f\u0085\u2028\u2029]")
 def escape_line(text: str) -> str:
     """``text`` with line breaks and other control characters written as escapes (``\\n``, ``\\x1b``)."""
     return _CONTROL.sub(lambda m: repr(m.group(0))[1:-1], text)
+
+
+def closest(word: str, choices: Sequence[str], cutoff: float = 0.6) -> str | None:
+    """The choice closest to a mistyped ``word`` (ignoring case), or ``None`` when none is close."""
+    if len(word) > 100:
+        return None
+    lowered = {choice.lower(): choice for choice in choices}
+    if word.lower() in lowered:
+        return lowered[word.lower()]
+    close = difflib.get_close_matches(word.lower(), list(lowered), n=1, cutoff=cutoff)
+    return lowered[close[0]] if close else None

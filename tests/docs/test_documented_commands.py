@@ -7,7 +7,9 @@ command can use what an earlier one wrote, and the wing is synthesised once for 
 is left out only when the line before its fence says why: ``<!-- docs-test: skip: REASON -->`` (installing the
 package, for instance). Commands added to the docs later are picked up without touching this file. ``linkwork``
 commands run in this process through typer's test runner (the shell would pay the start-up and kernel loading
-once per command); anything else goes to the shell.
+once per command); anything else goes to the shell. After a README command, the property its comment claims is
+checked on what it wrote (readme_claims.py: the flat hexagon's solids are one rod section thick, the coupler
+curve closes, ...), and every README command has such a claim.
 """
 
 from __future__ import annotations
@@ -19,9 +21,11 @@ import shutil
 import subprocess
 import sys
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from readme_claims import CLAIMS
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
@@ -115,14 +119,34 @@ def test_documented_commands_run(
         if key in done:
             continue
         done[key] = doc.name
-        code, errors = run_documented(command, folder)
+        code, errors, output = run_documented(command, folder)
         assert code == 0, f"{doc.name}: `{command}` exited {code}: {errors[-2000:]}"
         assert "Traceback" not in errors, f"{doc.name}: `{command}`: {errors[-2000:]}"
+        if doc.name == "README.md":
+            for check in claims_of(command):
+                check(folder, output)
 
 
-def run_documented(command: str, folder: Path) -> tuple[int, str]:
+def claims_of(command: str) -> list[Callable[[Path, str], None]]:
+    """The checks of what a README command claims to show (readme_claims.CLAIMS)."""
+    return [check for pattern, check in CLAIMS.items() if re.search(pattern, command)]
+
+
+def test_every_readme_command_has_its_claim_checked() -> None:
+    """Each README command is checked against what it says it shows, and each claim names exactly one command
+    (a claim whose command was edited away would otherwise pass unseen)."""
+    commands = documented_commands(ROOT / "README.md")
+    unchecked = [c for c in commands if not claims_of(c)]
+    assert not unchecked, f"README commands with no claim in tests/docs/readme_claims.py: {unchecked}"
+    for pattern in CLAIMS:
+        matching = [c for c in commands if re.search(pattern, c)]
+        assert len(matching) == 1, f"claim {pattern!r} matches {matching}"
+
+
+def run_documented(command: str, folder: Path) -> tuple[int, str, str]:
     """Run one documented command in ``folder``: a plain ``linkwork ...`` (optionally ``> FILE``) in this process
-    (the compiled kernels stay loaded, so the docs test stays affordable), anything else by the shell."""
+    (the compiled kernels stay loaded, so the docs test stays affordable), anything else by the shell. Returns the
+    exit code, standard error and standard output."""
     words = shlex.split(command)
     target = None
     if len(words) > 2 and words[-2] == ">":
@@ -141,12 +165,12 @@ def run_documented(command: str, folder: Path) -> tuple[int, str]:
             if result.exc_info and not isinstance(result.exc_info[1], SystemExit)
             else ""
         )
-        return result.exit_code, errors
+        return result.exit_code, errors, result.stdout
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
     run = subprocess.run(
         command, shell=True, cwd=folder, env=env, capture_output=True, text=True, timeout=900
     )
-    return run.returncode, run.stderr
+    return run.returncode, run.stderr, run.stdout
 
 
 def test_docs_refer_to_nothing_outside_the_repository() -> None:

@@ -1,14 +1,18 @@
-"""Every kind of figure linkwork writes, rendered and checked as a journal would: no text leaves the canvas (no
-clipped title or label), axes say their units, angle axes stay in a sensible window, and no number is printed as
-"-0" or as round-off ("from 0 to -4.97e-15").
+"""Every figure the CLI writes, rendered and checked as a journal would, from the matplotlib objects: no text
+leaves the canvas (no clipped title or label); every axis that shows numbers says its quantity and its unit in
+brackets or parentheses; no legend covers plotted data (lines, markers, band and bar outlines); log axes read in
+plain numbers (no mathtext powers such as "3x10^0"); no number is printed as "-0" or as round-off; and no plotted
+series jumps where its data do not (one step far larger than its neighbouring steps: a wrapped angle drawn
+across the figure, a bad last value).
 
-The figures are those the commands write (trace: angles, singular values, positions, deployment sequence;
-synthesis: profiles, M- and C-segments, chain; mechanization: the mechanism on every profile), caught as they are
-saved.
+The commands are run as a user runs them (trace, synth, mechanize, robustness, sweep, and ``search`` when it is
+there), every figure they save is caught and checked, and every PNG they leave in their folder must have been
+checked: a figure added to a command later is covered without touching this file.
 """
 
 from __future__ import annotations
 
+import itertools
 import re
 from pathlib import Path
 
@@ -76,10 +80,150 @@ def check_figure(fig: Figure, name: str) -> list[str]:
     for ax in fig.axes:
         if ax.name == "3d" or not ax.axison:
             continue
-        for label in (ax.get_xlabel(), ax.get_ylabel()):
-            if label and not re.search(r"\(.+\)|step|\bunit", label):
-                problems.append(f"{name}: axis label {label!r} has no unit")
+        for axis in (ax.xaxis, ax.yaxis):
+            if not axis.get_visible() or not _shown_ticks(axis):
+                continue  # a twin's shared axis, a panel whose tick labels its neighbour shows
+            label = axis.get_label_text()
+            if not UNIT.search(label):
+                problems.append(f"{name}: axis label {label!r} has no quantity and unit in brackets")
+            powers = [t for t in _shown_ticks(axis) if MATHTEXT_POWER.search(t)]
+            if powers or MATHTEXT_POWER.search(axis.get_offset_text().get_text()):
+                problems.append(f"{name}: {label!r} ticks read as powers {powers[:3]}, not plain numbers")
+        problems += [f"{name}: {p}" for p in jumps(ax)]
+    problems += [f"{name}: {p}" for p in legends_over_data(fig, renderer)]
     return problems
+
+
+#: A quantity and its unit: something in parentheses or brackets after the name, e.g. "hinge angle (deg)".
+UNIT = re.compile(r"\w.*[(\[][^)\]]*\S[^)\]]*[)\]]")
+#: A tick label in mathtext powers ("$\mathdefault{10^{-3}}$", "$3\times10^{0}$").
+MATHTEXT_POWER = re.compile(r"\$.*(\^|\\times).*\$")
+#: A step of a plotted line this many times its neighbours' (median) is a jump, when it also spans more than
+#: JUMP_SPAN of the axes.
+JUMP_RATIO = 10.0
+JUMP_SPAN = 0.08
+#: Neighbouring steps on each side that a step is compared with; lines with fewer points are not judged.
+JUMP_WINDOW = 6
+JUMP_MIN_POINTS = 8
+#: Spacing (pixels) of the points a line is sampled at between its vertices for the legend check.
+SAMPLE_PX = 2.0
+
+
+def _shown_ticks(axis) -> list[str]:  # type: ignore[no-untyped-def]
+    """The texts of the tick labels an axis draws (inside its view)."""
+    low, high = sorted(axis.get_view_interval())
+    texts = []
+    for tick in (*axis.get_major_ticks(), *axis.get_minor_ticks()):
+        loc = tick.get_loc()
+        if loc is None or not low - 1e-12 * abs(low) <= loc <= high + 1e-12 * abs(high):
+            continue
+        for lab in (tick.label1, tick.label2):
+            if lab.get_visible() and lab.get_text().strip():
+                texts.append(lab.get_text())
+    return texts
+
+
+def _line_segments(ax) -> list[np.ndarray]:  # type: ignore[no-untyped-def]
+    """Every plotted line of ``ax`` in axes coordinates (0..1 across the view, log scales applied), split
+    where the line is broken (NaN)."""
+    out = []
+    to_axes = ax.transAxes.inverted()
+    for line in ax.get_lines():
+        if not line.get_visible() or line.get_linestyle() in ("None", "none", " ", ""):
+            continue
+        xy = np.asarray(line.get_xydata(), dtype=float)
+        if len(xy) < 2:
+            continue
+        with np.errstate(all="ignore"):
+            pts = to_axes.transform(line.get_transform().transform(xy))
+        finite = np.all(np.isfinite(pts), axis=1)
+        breaks = np.flatnonzero(np.diff(finite.astype(int)) != 0) + 1
+        for piece, ok in zip(np.split(pts, breaks), np.split(finite, breaks), strict=True):
+            if ok.all() and len(piece) >= 2:
+                out.append(piece)
+    return out
+
+
+def jumps(ax) -> list[str]:  # type: ignore[no-untyped-def]
+    """Plotted steps far larger than the same line's neighbouring steps (see :data:`JUMP_RATIO`)."""
+    found = []
+    for piece in _line_segments(ax):
+        if len(piece) < JUMP_MIN_POINTS:
+            continue
+        steps = np.linalg.norm(np.diff(piece, axis=0), axis=1)
+        for i, step in enumerate(steps):
+            if step < JUMP_SPAN:
+                continue
+            around = np.concatenate([steps[max(0, i - JUMP_WINDOW) : i], steps[i + 1 : i + 1 + JUMP_WINDOW]])
+            if step > JUMP_RATIO * max(float(np.median(around)), 1e-3):
+                found.append(
+                    f"a line jumps by {step:.2f} of the axes at its point {i + 1} of {len(piece)} "
+                    f"(neighbouring steps {np.median(around):.3g}) in {ax.get_ylabel()!r}"
+                )
+                break
+    return found
+
+
+def _densified(points: np.ndarray) -> np.ndarray:
+    """Points along a polyline (display coordinates) every :data:`SAMPLE_PX` pixels, vertices included."""
+    out = [points[:1]]
+    for a, b in itertools.pairwise(points):
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+            continue
+        n = int(min(np.linalg.norm(b - a) / SAMPLE_PX, 2000)) + 1
+        out.append(a + np.outer(np.linspace(0.0, 1.0, n + 1)[1:], b - a))
+    return np.concatenate(out)
+
+
+def _data_points(ax) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Display coordinates of what ``ax`` plots: lines and their markers, scatter points, the outlines of bands
+    (fill_between) and bars, inside the axes' box."""
+    from matplotlib.collections import PathCollection, PolyCollection
+
+    clouds = [np.zeros((0, 2))]
+    for line in ax.get_lines():
+        if line.get_visible() and len(line.get_xydata()):
+            with np.errstate(all="ignore"):
+                clouds.append(
+                    _densified(line.get_transform().transform(np.asarray(line.get_xydata(), float)))
+                )
+    for coll in ax.collections:
+        if not coll.get_visible():
+            continue
+        if isinstance(coll, PathCollection) and len(coll.get_offsets()):
+            clouds.append(coll.get_offset_transform().transform(np.asarray(coll.get_offsets(), float)))
+        elif isinstance(coll, PolyCollection):
+            for path in coll.get_paths():
+                clouds.append(_densified(coll.get_transform().transform(path.vertices)))
+    for patch in ax.patches:
+        if patch.get_visible():
+            clouds.append(_densified(patch.get_transform().transform(patch.get_path().vertices)))
+    pts = np.concatenate(clouds)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    box = ax.bbox
+    inside = (pts[:, 0] >= box.x0) & (pts[:, 0] <= box.x1) & (pts[:, 1] >= box.y0) & (pts[:, 1] <= box.y1)
+    return pts[inside]
+
+
+def legends_over_data(fig: Figure, renderer) -> list[str]:  # type: ignore[no-untyped-def]
+    """Legends (of an axes or of the figure) whose box covers a plotted point of any 2-D axes."""
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None] + list(fig.legends)
+    flat = [ax for ax in fig.axes if ax.name != "3d" and ax.axison]
+    found = []
+    for legend in legends:
+        if not legend.get_visible():
+            continue
+        box = legend.get_window_extent(renderer).padded(-1.0)
+        for ax in flat:
+            pts = _data_points(ax)
+            covered = (
+                (pts[:, 0] > box.x0) & (pts[:, 0] < box.x1) & (pts[:, 1] > box.y0) & (pts[:, 1] < box.y1)
+            )
+            if covered.any():
+                labels = [t.get_text() for t in legend.get_texts()][:3]
+                found.append(f"the legend {labels} covers {int(covered.sum())} plotted points")
+                break
+    return found
 
 
 @pytest.fixture
@@ -91,6 +235,7 @@ def caught(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     def savefig(self: Figure, fname, *args, **kwargs):  # type: ignore[no-untyped-def]
         if str(fname).endswith(".png"):
             problems.extend(check_figure(self, Path(str(fname)).name))
+            CHECKED.append(Path(str(fname)).name)
         return original(self, fname, *args, **kwargs)
 
     monkeypatch.setattr(Figure, "savefig", savefig)
@@ -102,18 +247,122 @@ def guest() -> lw.Trace:
     return lw.trace(lw.load("guest-frame"), branches=True, max_steps=3000)
 
 
-def test_trace_figures_fit_their_canvas(caught: list[str], tmp_path: Path, guest: lw.Trace) -> None:
-    from linkwork.outputs.trace import write_trace_outputs
+TINY_STUDY = """name = "tiny"
+linkage = "bennett"
+[grid]
+alpha1 = [30, 45]
+alpha2 = [70, 90]
+[robustness]
+samples = 8
+hinge_position_tol = 0.001
+hinge_direction_tol = 0.05
+"""
+LINE_STUDY = TINY_STUDY.replace("alpha2 = [70, 90]\n", "")
+SEARCH_STUDY = TINY_STUDY.split("[robustness]")[0] + "[criteria]\nmobility = 1\n"
 
-    runs = {
-        "guest": guest,
-        "hoop": lw.trace(lw.load("hedgepeth-rods", n=6)),
-        "four_bar": lw.trace(lw.load("four-bar"), drive="A", until=("A", np.radians(420.0))),
-    }
-    for name, path in runs.items():
-        write_trace_outputs(path, tmp_path / name)
-    assert (tmp_path / "four_bar" / "points.png").is_file()
-    assert not caught, "\n".join(caught)
+ROBUSTNESS = ["robustness", "--samples", "16", "--workers", "0", "--hinge-position-tol", "1e-3"]
+ROBUSTNESS += ["--hinge-direction-tol", "0.05"]
+
+ROBUSTNESS = ["robustness", "--samples", "16", "--workers", "0", "--hinge-position-tol", "1e-3"]
+ROBUSTNESS += ["--hinge-direction-tol", "0.05"]
+
+#: A run of a command that writes figures: its arguments (``OUT`` is its output folder) and the study file it
+#: needs, if any. Guest's frame's singular values jump at the closed path's last point (a wrong last value,
+#: fixed by the tracing bookkeeping of issue 18): the check catches it until that fix is in (KNOWN).
+RUNS = {
+    "trace-guest-frame": (["trace", "guest-frame", "--branches", "--max-steps", "3000", "-o", "OUT"], None),
+    "trace-hexagon": (
+        ["trace", "hedgepeth-rods", "--set", "n=6", "--until", "A=128.6822", "-o", "OUT"],
+        None,
+    ),
+    "trace-four-bar": (["trace", "four-bar", "--drive", "A", "--until", "A=420", "-o", "OUT"], None),
+    "trace-slider-crank": (["trace", "slider-crank", "-o", "OUT"], None),
+    "trace-bennett": (["trace", "bennett", "-o", "OUT"], None),
+    "robustness": (
+        [
+            *ROBUSTNESS,
+            "hedgepeth-rods",
+            "--set",
+            "n=6",
+            "--until",
+            "A=128.6822",
+            "--steps",
+            "60",
+            "-o",
+            "OUT",
+        ],
+        None,
+    ),
+    "robustness-closed-path": ([*ROBUSTNESS, "four-bar", "-o", "OUT"], None),
+    "sweep-heat-map": (["sweep", "STUDY", "--workers", "0", "-o", "OUT"], TINY_STUDY),
+    "sweep-lines": (["sweep", "STUDY", "--workers", "0", "-o", "OUT"], LINE_STUDY),
+    "synth": (["synth", "wing", "-o", "OUT"], None),
+    "search": (["search", "STUDY", "-o", "OUT"], SEARCH_STUDY),
+}
+LANDING = (
+    "singular values wrong at the point a step lands on (the target, the closed path's end) when traced "
+)
+LANDING += "with a progress callback, as the CLI does: 3.526 for 4.194 (issue 18, tracing bookkeeping)"
+KNOWN = {
+    "trace-guest-frame": "singular values jump at the closed path's last point (issue 18, tracing bookkeeping)",
+    "trace-four-bar": LANDING,
+    "trace-slider-crank": LANDING,
+}
+
+
+def run_and_check(args: list[str], study: str | None, folder: Path, caught: list[str]) -> list[str]:
+    """Run a command in-process, and return the problems of every figure it saved; every PNG it left in its
+    folder must have been checked."""
+    from typer.testing import CliRunner
+
+    from linkwork.cli import app
+
+    out = folder / "out"
+    if study is not None:
+        (folder / "study.toml").write_text(study)
+    words = [str(out) if a == "OUT" else str(folder / "study.toml") if a == "STUDY" else a for a in args]
+    checked_before = len(CHECKED)
+    result = CliRunner().invoke(app, words)
+    assert result.exit_code == 0, (words, result.stderr[-2000:], result.exception)
+    written = {p.name for p in out.rglob("*.png")}
+    if not written and args[0] == "search":
+        pytest.skip("`linkwork search` wrote no figure")
+    assert written, f"{args[0]} wrote no figure"
+    assert written <= set(CHECKED[checked_before:]), f"not checked: {written - set(CHECKED[checked_before:])}"
+    return list(caught)
+
+
+#: Names of the figures checked so far (the ``caught`` fixture appends).
+CHECKED: list[str] = []
+
+
+#: Runs whose figures are of a kind another run already checks (still run in CI, marked slow).
+SLOW_RUNS = {"trace-slider-crank", "robustness-closed-path", "sweep-lines"}
+
+
+@pytest.mark.parametrize(
+    "run", [pytest.param(k, marks=pytest.mark.slow) if k in SLOW_RUNS else k for k in RUNS]
+)
+def test_every_figure_a_command_writes_reads_well(caught: list[str], tmp_path: Path, run: str) -> None:
+    args, study = RUNS[run]
+    if args[0] == "search":
+        from linkwork.cli import app
+
+        if "search" not in {c.name for c in app.registered_commands}:
+            pytest.skip("no `linkwork search` command in this version")
+    problems = run_and_check(args, study, tmp_path, caught)
+    known = [p for p in problems if run in KNOWN and p.startswith("singular_values.png") and "jumps" in p]
+    others = [p for p in problems if p not in known]
+    assert not others, "\n".join(others)
+    if known:
+        pytest.xfail(f"{KNOWN[run]}: {known[0]}")
+
+
+@pytest.mark.slow
+def test_synthesis_and_mechanism_figures_read_well(caught: list[str], tmp_path: Path) -> None:
+    problems = run_and_check(["synth", "wing/mechanize.toml", "-o", "OUT"], None, tmp_path, caught)
+    assert (tmp_path / "out" / "mechanism.png").is_file() and (tmp_path / "out" / "profiles.png").is_file()
+    assert not problems, "\n".join(problems)
 
 
 def test_angle_axes_stay_in_one_turn(guest: lw.Trace) -> None:
@@ -132,15 +381,6 @@ def test_angle_axes_stay_in_one_turn(guest: lw.Trace) -> None:
         assert np.nanmax(steps) < 90.0  # no line crosses the figure at a wrap
 
 
-@pytest.mark.slow
-def test_synthesis_and_mechanism_figures_fit_their_canvas(caught: list[str], tmp_path: Path) -> None:
-    from linkwork.outputs.synthesis import run_synthesis_example
-
-    run_synthesis_example(tmp_path / "wing", "wing", file="mechanize.toml")
-    assert (tmp_path / "wing" / "mechanism.png").is_file() and (tmp_path / "wing" / "profiles.png").is_file()
-    assert not caught, "\n".join(caught)
-
-
 def test_the_checker_sees_a_clipped_title(tmp_path: Path) -> None:
     fig = Figure(figsize=(3.0, 2.0), dpi=100)
     ax = fig.add_subplot()
@@ -149,5 +389,73 @@ def test_the_checker_sees_a_clipped_title(tmp_path: Path) -> None:
     ax.set_ylabel("-0.0")
     problems = check_figure(fig, "bad")
     assert any("leaves the canvas" in p for p in problems)
-    assert any("no unit" in p for p in problems)
+    assert any("no quantity and unit" in p for p in problems)
     assert any("-0" in p for p in problems)
+
+
+def _figure_with(plot) -> Figure:  # type: ignore[no-untyped-def]
+    fig = Figure(figsize=(5.0, 3.5), dpi=100, layout="constrained")
+    ax = fig.add_subplot()
+    plot(ax)
+    ax.set_xlabel("drive A (deg)")
+    ax.set_ylabel("misfit (length unit)")
+    return fig
+
+
+def test_the_checker_passes_a_clean_figure() -> None:
+    def plot(ax) -> None:  # type: ignore[no-untyped-def]
+        x = np.linspace(0.0, 120.0, 100)
+        ax.plot(x, np.sin(np.radians(x)), label="sine")
+        ax.legend(loc="lower center")
+        ax.set_ylim(-1.5, 1.2)
+
+    assert check_figure(_figure_with(plot), "clean") == []
+
+
+def test_the_checker_sees_a_legend_over_the_data() -> None:
+    def plot(ax) -> None:  # type: ignore[no-untyped-def]
+        x = np.linspace(0.0, 1.0, 50)
+        for k in range(6):
+            ax.plot(x, x + 0.1 * k, label=f"curve {k}")
+        ax.legend(loc="center")
+
+    assert any("covers" in p for p in check_figure(_figure_with(plot), "covered"))
+
+
+def test_the_checker_sees_mathtext_powers_on_a_log_axis() -> None:
+    """The misfit bands' ratio axis read "3x10^0"; plain_log_ticks writes 3."""
+    from linkwork.viz.labels import plain_log_ticks
+
+    def plot(ax) -> None:  # type: ignore[no-untyped-def]
+        ax.semilogy([0, 1, 2], [2.0, 3.0, 5.0])
+
+    assert any("powers" in p for p in check_figure(_figure_with(plot), "powers"))
+    fig = _figure_with(plot)
+    plain_log_ticks(fig.axes[0].yaxis)
+    assert check_figure(fig, "plain") == []
+    assert "3" in _shown_ticks(fig.axes[0].yaxis)
+
+
+def test_the_checker_sees_a_jump_the_data_do_not_have(guest: lw.Trace) -> None:
+    """Two real cases: an angle plotted without breaking it where it wraps (a line across the figure), and a
+    singular value that is wrong at a branch's last point (Guest's frame: 1.41 where the neighbouring steps are
+    about 0.013)."""
+
+    def wrapped(ax) -> None:  # type: ignore[no-untyped-def]
+        x = np.linspace(0.0, 720.0, 200)
+        ax.plot(x, (x + 180.0) % 360.0 - 180.0)
+
+    assert any("jumps" in p for p in check_figure(_figure_with(wrapped), "wrapped"))
+
+    def spike(ax) -> None:  # type: ignore[no-untyped-def]
+        s = guest.sigma[guest.branch == 0].copy()
+        s[-1, 0] += 1.4  # the size of the jump Guest's figure showed
+        ax.plot(np.arange(len(s)), s[:, 0])
+
+    assert any("jumps" in p for p in check_figure(_figure_with(spike), "spike"))
+
+    def smooth(ax) -> None:  # type: ignore[no-untyped-def]
+        s = guest.sigma[guest.branch == 0]
+        ax.plot(np.arange(len(s) - 1), s[:-1, 0])
+
+    assert not any("jumps" in p for p in check_figure(_figure_with(smooth), "smooth"))

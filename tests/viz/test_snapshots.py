@@ -193,3 +193,78 @@ def test_failing_ffmpeg_leaves_no_mp4(guest: Trace, tmp_path: Path, monkeypatch:
     with pytest.raises(LinkworkError, match=r"ffmpeg failed writing guest\.mp4: encoder exploded"):
         animate_path(guest, tmp_path / "out" / "guest.mp4", branch=0, max_frames=3, size=80)
     assert list((tmp_path / "out").iterdir()) == []  # exact: no half-written .mp4 (and no GIF)
+
+
+def _moved(mech: Any, angles: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Every body mesh's vertices as the steady drawing places them, per configuration."""
+    from linkwork.viz.snapshots import mesh_clouds
+
+    clouds = mesh_clouds(mech, angles)
+    moves = steady_transforms(mech, angles)
+    return np.einsum("nij,nvj->nvi", moves[:, :3, :3], clouds) + moves[:, None, :3, 3]
+
+
+@pytest.mark.parametrize(
+    ("name", "until_deg"), [("four-bar", 420.0), ("bennett", None), ("bricard-threefold", None)]
+)
+def test_the_same_configuration_is_drawn_the_same_way(name: str, until_deg: float | None) -> None:
+    """sequence.png drew the four-bar's frames (a) and (f), A = 60 and 420 deg (one configuration), in
+    different poses: chained fits drift around a closed path (Bennett's ends 0.73 apart). A grounded mechanism is
+    now drawn on its ground, and a closed path's drift is spread back along it: both ends coincide, and no frame
+    moves much more than the chained fits moved it."""
+    import linkwork as lw
+    from linkwork.viz.snapshots import follow, mesh_clouds
+
+    mech = lw.load(name)
+    until = None if until_deg is None else ("A", float(np.radians(until_deg)))
+    path = trace(mech, drive="A", until=until)
+    rows = path.angles[branch_indices(path, 0, 0)]
+    gap = (rows[-1] - rows[0] + np.pi) % (2 * np.pi) - np.pi
+    assert np.abs(gap).max() < 1e-9  # the path ends where it began
+    moved = _moved(mech, rows)
+    size = float(np.ptp(moved[0], axis=0).max())
+    assert np.abs(moved[-1] - moved[0]).max() < 1e-9 * size
+    clouds = mesh_clouds(mech, rows)
+    chained = follow(clouds)
+    before = np.einsum("nij,nvj->nvi", chained[:, :3, :3], clouds) + chained[:, None, :3, 3]
+    step_now = np.abs(np.diff(moved, axis=0)).max()
+    step_before = np.abs(np.diff(before, axis=0)).max()
+    ground_moves = mech.bodies[0] == "ground"  # drawn on its ground, the other links move more than the fit
+    assert step_now < (3.0 if ground_moves else 1.2) * step_before
+
+
+def test_a_grounded_mechanism_keeps_its_ground_still() -> None:
+    import linkwork as lw
+    from linkwork.viz.solids import body_meshes, place
+
+    mech = lw.load("four-bar")
+    path = trace(mech, drive="A", until=("A", float(np.radians(200.0))))
+    moves = steady_transforms(mech, path.angles)
+    bodies = body_meshes(mech)
+    ground = [
+        place(mech, {"ground": bodies["ground"]}, [], row)[0].transformed(T)
+        for row, T in zip(path.angles, moves, strict=True)
+    ]
+    np.testing.assert_allclose(
+        [g.vertices for g in ground], np.repeat(ground[0].vertices[None], len(ground), axis=0), atol=1e-12
+    )
+
+
+def test_the_viewer_draws_a_closed_path_s_ends_alike() -> None:
+    """The viewer's steady mode uses the same fits: Bennett's closed loop ends in the pose it began in (the page
+    carries the moves as float32)."""
+    import linkwork as lw
+    from linkwork.viz.snapshots import mesh_clouds
+    from linkwork.viz.viewer import trace_viewer_data
+    from linkwork.viz.viewer_page import unpack
+
+    path = trace(lw.load("bennett"))
+    assert len(path.branches) == 1 and path.branches[0].end_reason == "closed path"
+    rows = unpack(trace_viewer_data(path)["steady"]).astype(float)
+    moves = np.zeros((len(rows), 4, 4))
+    moves[:, :3, :3] = rows[:, :9].reshape(-1, 3, 3)
+    moves[:, :3, 3] = rows[:, 9:]
+    ends = mesh_clouds(path.mechanism, path.angles[[0, -1]])
+    first = ends[0] @ moves[0, :3, :3].T + moves[0, :3, 3]
+    last = ends[1] @ moves[-1, :3, :3].T + moves[-1, :3, 3]
+    assert np.abs(first - last).max() < 1e-5 * float(np.ptp(first, axis=0).max())  # float32 round-off

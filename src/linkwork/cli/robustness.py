@@ -19,6 +19,7 @@ from linkwork.cli.common import (
     progress_bar,
     until_in_api_units,
 )
+from linkwork.cli.out_folder import out_help, run_folder, spec_label
 from linkwork.outputs.staging import console
 
 if TYPE_CHECKING:
@@ -61,10 +62,14 @@ def robustness(
             "--spatial-errors", help="Planar mechanisms: tilt and shift hinges out of the plane too."
         ),
     ] = False,
-    out: opt.OutFolder = Path("out"),
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help=out_help("robustness", "hedgepeth-rods-n=6"), show_default=False),
+    ] = None,
     no_plots: opt.NoPlots = False,
 ) -> None:
-    """Imperfection sensitivity: robustness.json, samples.parquet and figures in --out."""
+    """Imperfection sensitivity: robustness.json, samples.parquet and figures in --out (default
+    out/NAME-robustness/, NAME the linkage's name with its --set values or the spec file's name)."""
     import numpy as np
 
     from linkwork.studies.imperfections import ImperfectionModel
@@ -74,6 +79,8 @@ def robustness(
     if steps is not None and until is None:
         raise fail("--steps needs --until JOINT=VALUE")
     target = parse_until(until)
+    if out is None:
+        out = run_folder("robustness", spec_label(spec, parse_assignments(set_, "--set")))
     mech = _mechanism(spec, set_, couple, fixed)
     model = ImperfectionModel(
         position_tol=hinge_position_tol,

@@ -10,6 +10,7 @@ from rich.text import Text
 
 from linkwork.cli import options as opt
 from linkwork.cli.common import check_range, check_workers, friendly_errors, progress_bar
+from linkwork.cli.out_folder import file_label, out_help, run_folder
 from linkwork.outputs.staging import check_output_folder, console
 
 MAX_GALLERY = 500
@@ -26,7 +27,10 @@ def search(
     ],
     scheduler: opt.Scheduler = None,
     workers: opt.Workers = None,
-    out: opt.OutFolder = Path("out"),
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help=out_help("search", "rect-frame-search"), show_default=False),
+    ] = None,
     gallery: Annotated[
         int,
         typer.Option(help="How many of the best candidates gallery.html draws (each with a viewer page)."),
@@ -34,7 +38,7 @@ def search(
 ) -> None:
     """Trace every candidate of a study and judge it: candidates.csv/.parquet, ranked.csv, gallery.html in --out.
 
-    Re-running on the same --out continues an interrupted search (its records are in --out/.linkwork-search/).
+    The default --out is out/NAME-search/, NAME the study file's name. Re-running on the same --out continues an interrupted search (its records are in --out/.linkwork-search/).
 
     Exit codes: 0 some candidate passes; 2 bad input; 3 none passes (the closest is printed, outputs written).
     """
@@ -50,6 +54,8 @@ def search(
     check_workers(workers)
     check_range("--gallery", gallery, 0, MAX_GALLERY, "a number of candidates")
     search_study = load_search(study_file)
+    if out is None:
+        out = run_folder("search", file_label(study_file))
     check_output_folder(out, OUTPUT_NAMES)
     total = search_study.total
     console.print(Text(search_study.study.name, style="bold"), f"search of {total} candidate(s)", sep=": ")

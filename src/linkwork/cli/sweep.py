@@ -10,6 +10,7 @@ from rich.text import Text
 
 from linkwork.cli import options as opt
 from linkwork.cli.common import check_workers, friendly_errors, progress_bar
+from linkwork.cli.out_folder import file_label, out_help, run_folder
 from linkwork.outputs.staging import console
 
 
@@ -20,10 +21,14 @@ def sweep(
     ],
     scheduler: opt.Scheduler = None,
     workers: opt.Workers = None,
-    out: opt.OutFolder = Path("out"),
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help=out_help("sweep", "bennett-twists"), show_default=False),
+    ] = None,
     no_plots: opt.NoPlots = False,
 ) -> None:
-    """Run every grid point of a study: sweep.parquet, sweep.csv and plots in --out."""
+    """Run every grid point of a study: sweep.parquet, sweep.csv and plots in --out (default out/NAME-sweep/,
+    NAME the study file's name)."""
 
     from linkwork.errors import RequestNotMetError
     from linkwork.outputs.sweep import print_sweep_summary, write_sweep_outputs
@@ -32,6 +37,8 @@ def sweep(
 
     check_workers(workers)
     study = prepare_study(load_study(study_file))
+    if out is None:
+        out = run_folder("sweep", file_label(study_file))
     total = len(study.points())
     console.print(Text(study.name, style="bold"), f"{study.kind} study of {total} grid point(s)", sep=": ")
     with progress_bar("grid points", total) as report:

@@ -15,6 +15,7 @@ import typer
 
 from linkwork.cli import mechanize_flags as mf
 from linkwork.cli.common import friendly_errors, progress_bar
+from linkwork.cli.out_folder import out_help, problem_label, run_folder
 from linkwork.errors import SpecError
 from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
 
@@ -30,7 +31,9 @@ def synth(
             show_default=False,
         ),
     ],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Folder to write the results into.")] = Path("out"),
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help=out_help("synth", "wing"), show_default=False)
+    ] = None,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="Do not draw the figures.")] = False,
     html: Annotated[bool, typer.Option("--html", help="Also write an interactive HTML viewer.")] = False,
     search: Annotated[
@@ -61,8 +64,8 @@ def synth(
 ) -> None:
     """Synthesise a chain of rigid segments, revolute and prismatic joints, that approximates every profile.
 
-    Writes chain.json, target_profiles.csv, outline.svg, outline.dxf and the figures (PNG and SVG) into --out,
-    and prints a summary: the profiles, the design vector, the segment and error matrices, E_max and E_mean
+    Writes chain.json, target_profiles.csv, outline.svg, outline.dxf and the figures (PNG and SVG) into --out
+    (default out/NAME-synth/, NAME the bundled example's or the problem file's name), and prints a summary: the profiles, the design vector, the segment and error matrices, E_max and E_mean
     before and after joining, and the joints merged into compound segments. A copy of the problem and its
     profiles goes to --out/problem/ (for `linkwork mechanize OUT`). With mechanization (the problem's
     `mechanize = true`, --mechanize or any mechanization flag) the chain's files are written first; if no
@@ -73,6 +76,8 @@ def synth(
     from linkwork.outputs.synthesis import print_synthesis_summary, write_synthesis_outputs
     from linkwork.synthesis import synthesize
 
+    if out is None:
+        out = run_folder("synth", problem_label(problem))
     check_output_folder(out, ["chain.json", "target_profiles.csv", "outline.svg", "outline.dxf"])
     if search not in ("paper", "refined"):
         raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")

@@ -20,6 +20,7 @@ from linkwork.cli.common import (
     progress_bar,
     until_in_api_units,
 )
+from linkwork.cli.out_folder import out_help, run_folder, spec_label
 from linkwork.errors import RequestNotMetError
 from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console
@@ -108,7 +109,10 @@ def trace(
             show_default=False,
         ),
     ] = None,
-    out: opt.OutFolder = Path("out"),
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help=out_help("trace", "hedgepeth-rods-n=6"), show_default=False),
+    ] = None,
     no_plots: opt.NoPlots = False,
     animate: Annotated[
         bool,
@@ -124,7 +128,8 @@ def trace(
         ),
     ] = False,
 ) -> None:
-    """Trace a closed-loop linkage: path.csv, report.json and figures in --out.
+    """Trace a closed-loop linkage: path.csv, report.json and figures in --out (default out/NAME-trace/, NAME the
+    linkage's name with its --set values or the spec file's name).
 
     Exit codes: 0 done as asked; 2 bad input (one line saying which file, key or flag and what was expected);
     3 the request could not be met (the --until target is never reached on the path: its range is printed),
@@ -135,12 +140,14 @@ def trace(
 
     from linkwork.kinematics.tracer import trace as run_trace
 
+    params = parse_assignments(set_, "--set")
+    if out is None:
+        out = run_folder("trace", spec_label(spec, params))
     check_output_folder(out, ["path.csv", "report.json"])
     check_range("--max-step", max_step, 0.0, MAX_STEP_DEG, "a number of degrees", open_low=True)
     check_range("--max-steps", max_steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
     if steps is not None:
         check_range("--steps", steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
-    params = parse_assignments(set_, "--set")
     target = parse_until(until)
     limits_file = _parse_limits(limit)
     if not (math.isfinite(closure_tol) and closure_tol > 0):

@@ -6,7 +6,11 @@ Every body's frame is the world frame in the mechanism's reference configuration
 ``axis`` are its axis line there and its ``qpos`` is our displacement ``q = value - offset`` (MuJoCo's ``qpos0 =
 0`` is the reference). The bodies form a spanning tree of the body graph rooted at ``ground`` (or the first body),
 fixed to the world. A joint that closes a loop (not in the tree) is cut: its hinge goes on an extra body
-``<before>__cut_<joint>`` hung from the body before it, and a ``weld`` holds that body on the body after it. A
+``<before>__cut_<joint>`` hung from the body before it, and a ``weld`` holds that body on the body after it, in
+the relative pose the two have at ``qpos0`` (``relpose`` with a zero quaternion). That is the one spelling MuJoCo
+and pinocchio read alike: an explicit ``relpose`` is body2's pose in body1's *body* frame for MuJoCo, but in the
+frame of body1's *joint* (placed at the hinge) for ``pinocchio.buildModelAndConstraintsFromMJCF``, so the identity
+``relpose`` welded the two hinge points together there (a violation of 2.0 for the four-bar at the start). A
 position actuator named ``drive`` turns the drive joint. Links are drawn as capsules between their joints (no
 contacts), which also gives the bodies mass.
 """
@@ -20,6 +24,9 @@ import numpy as np
 
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.positions import joint_points
+
+#: A weld's ``relpose`` that means "as at qpos0" to MuJoCo and pinocchio alike (the quaternion part all zeros).
+QPOS0_RELPOSE = "0 0 0 0 0 0 0"
 
 #: Capsule radius and pin length as fractions of the median distance between a body's joints.
 CAPSULE_RADIUS = 0.03
@@ -110,7 +117,7 @@ def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
     welds = [
         f"    <weld name={quoteattr('loop_' + mech.joint_names[j])} "
         f"body1={quoteattr(cut_body(mech.joint_bodies[j][0], mech.joint_names[j]))} "
-        f'body2={quoteattr(mech.joint_bodies[j][1])} relpose="0 0 0 1 0 0 0"/>'
+        f'body2={quoteattr(mech.joint_bodies[j][1])} relpose="{QPOS0_RELPOSE}"/>'
         for j in cuts
     ]
     welds += _coupling_constraints(mech)

@@ -10,7 +10,6 @@ the third ``[[loop.joints]]`` block, ``profiles[0]`` the first profile of a prob
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 import tomllib
@@ -22,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
-from linkwork.messages import escape_line, show
+from linkwork.messages import closest, escape_line, show
 from linkwork.names import MAX_NAME_CHARS
 
 __all__ = [
@@ -41,17 +40,6 @@ MAX_FILE_BYTES = 16 * 1024 * 1024
 
 MAX_MAGNITUDE = 1e12
 """The largest absolute value of a number in a file (a length, a coordinate, an angle)."""
-
-
-def closest(word: str, choices: Sequence[str], cutoff: float = 0.6) -> str | None:
-    """The choice closest to a mistyped ``word`` (ignoring case), or ``None`` when none is close."""
-    if len(word) > 100:
-        return None
-    lowered = {choice.lower(): choice for choice in choices}
-    if word.lower() in lowered:
-        return lowered[word.lower()]
-    close = difflib.get_close_matches(word.lower(), list(lowered), n=1, cutoff=cutoff)
-    return lowered[close[0]] if close else None
 
 
 def key_path(path: str, key: str | int) -> str:

@@ -95,6 +95,18 @@ class Mechanism:
         if len(set(self.joint_names)) != n:
             raise SpecError(f"joint names must be unique, got {list(self.joint_names)}")
 
+    def __repr__(self) -> str:
+        """One line: name, joints by type and name, bodies, loops, planar or spatial (not the arrays)."""
+        from linkwork.viz.mechanism_card import summary
+
+        return summary(self)
+
+    def _repr_html_(self) -> str:
+        """In Jupyter: the joints and bodies as tables beside a small drawing of the start (inline SVG)."""
+        from linkwork.viz.mechanism_card import card
+
+        return card(self)
+
     # ----------------------------------------------------------------------------------------------------
     # sizes and index helpers
     @property

@@ -230,7 +230,8 @@ class Trace:
         return "\n".join(_summary_lines(self))
 
     def _repr_html_(self) -> str:
-        """The interactive viewer (the same page ``linkwork trace --html`` writes), inline in Jupyter."""
+        """The interactive viewer (the same page ``linkwork trace --html`` writes), inline in Jupyter, its path
+        thinned to stay under :data:`linkwork.viz.inline.INLINE_BYTES` (the data here stay whole)."""
         from linkwork.viz.inline import trace_html
 
         return trace_html(self)
@@ -243,6 +244,34 @@ def _names(names: tuple[str, ...], most: int = 12) -> str:
     return ", ".join(names[: most - 2]) + f", ... , {names[-1]}"
 
 
+def _num(value: float, digits: int = 6) -> str:
+    """A joint value for a summary: ``digits`` significant digits, round-off next to zero shown as 0."""
+    return f"{0.0 if abs(value) < 5e-10 else value:.{digits}g}"
+
+
+def _branch_motion(trace: Trace, branch: int) -> str:
+    """What moves along one branch: the drive from its first to its last value, or, where the drive stays put
+    (a branch of a bifurcation on which the drive is locked), the joint that moves most."""
+    mech = trace.mechanism
+    on = trace.branch == branch
+    if not np.any(on):
+        return ""
+    scale = np.where(np.array(mech.joint_types) == "R", 180.0 / np.pi, 1.0)
+    values = trace.angles[on] * scale
+    units = ["deg" if t == "R" else "" for t in mech.joint_types]
+    d = mech.index(trace.drive)
+    first, last = values[0, d], values[-1, d]
+    lo, hi = values[:, d].min(), values[:, d].max()
+    if hi - lo > 1e-6:
+        passed = f" (via {_num(lo, 5)} to {_num(hi, 5)})" if hi - lo > abs(last - first) + 1e-6 else ""
+        return f", {trace.drive} {_num(first, 5)} -> {_num(last, 5)} {units[d]}".rstrip() + passed
+    j = int(np.argmax(np.ptp(values, axis=0)))
+    return (
+        f", {trace.drive} at {_num(first, 5)} {units[d]}".rstrip()
+        + f", {mech.joint_names[j]} {_num(values[0, j], 5)} -> {_num(values[-1, j], 5)} {units[j]}".rstrip()
+    )
+
+
 def _summary_lines(trace: Trace) -> list[str]:
     mech = trace.mechanism
     n_points = len(trace.angles)
@@ -250,11 +279,15 @@ def _summary_lines(trace: Trace) -> list[str]:
     unit, scale = ("deg", 180.0 / np.pi) if mech.joint_types[d] == "R" else ("", 1.0)
     drive = trace.angles[:, d] * scale if n_points else np.zeros(1)
     mobility = trace.mobility
+    several = len(trace.branches) > 1
+    if several and n_points:  # the first and last points are on different branches: give the range covered
+        extent = f"over {_num(drive.min())} to {_num(drive.max())} {unit} on all branches"
+    else:
+        extent = f"from {_num(drive[0])} to {_num(drive[-1])} {unit}"
     lines = [
         f"Trace of {mech.name!r}: {n_points} points, {len(trace.branches)} branch(es), "
         f"{len(trace.bifurcations)} bifurcation point(s)",
-        f"  joints ({mech.n_joints}): {_names(mech.joint_names)}; drive {trace.drive} "
-        f"from {drive[0]:.6g} to {drive[-1]:.6g} {unit}".rstrip(),
+        f"  joints ({mech.n_joints}): {_names(mech.joint_names)}; drive {trace.drive} {extent}".rstrip(),
     ]
     if n_points:
         lines.append(
@@ -262,8 +295,9 @@ def _summary_lines(trace: Trace) -> list[str]:
             f"{float(np.max(trace.residual)):.2e}; max condition {trace.max_condition:.4g}"
         )
     for br in trace.branches[:4]:
-        origin = "start" if br.parent is None else f"bifurcation {br.bifurcation} on branch {br.parent}"
-        lines.append(f"  branch {br.id}: {br.steps} steps from {origin}, ended: {br.end_reason}")
+        origin = "start" if br.parent is None else f"bifurcation {br.bifurcation} (branch {br.parent})"
+        run = _branch_motion(trace, br.id) if several else ""
+        lines.append(f"  branch {br.id}: {br.steps} steps from {origin}{run}; {br.end_reason}")
     if len(trace.branches) > 4:
         lines.append(f"  ... {len(trace.branches) - 4} more branches (trace.branches)")
     lines.append("  .angles (N, n) rad, .positions() (N, n, 3), .poses(), .plot(), .sigma, .bifurcations")

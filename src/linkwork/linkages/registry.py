@@ -16,7 +16,7 @@ import numpy as np
 
 from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.messages import show
+from linkwork.messages import closest, show
 
 MAX_RODS = 100
 """The largest ``n`` of a built-in hoop (Hedgepeth's n rods)."""
@@ -126,4 +126,6 @@ def get(name: str) -> LinkageEntry:
     for entry in REGISTRY.values():
         if entry.name == key:
             return entry
-    raise SpecError(f"unknown linkage {name!r}; built-ins are {', '.join(sorted(REGISTRY))}")
+    close = closest(key, sorted(REGISTRY))
+    hint = f"did you mean {close!r}? " if close else ""
+    raise SpecError(f"unknown linkage {name!r}; {hint}built-ins are {', '.join(sorted(REGISTRY))}")

@@ -14,12 +14,33 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from types import FrameType
 
-from rich.console import Console
+from rich.console import Console, ConsoleDimensions
 
 from linkwork.errors import SpecError
 from linkwork.io.toml_reader import show
 
-console = Console(markup=False)
+FILE_WIDTH = 10_000
+"""The width (characters) of the console when standard output is a file or a pipe and ``COLUMNS`` is not set."""
+
+
+class _SummaryConsole(Console):
+    """A console as wide as a terminal on a terminal, and :data:`FILE_WIDTH` wide on a file or a pipe (unless
+    ``COLUMNS`` says otherwise), so a table saved to a file keeps its full headers and rows ("transmission", not
+    "transmiss...") instead of being squeezed into 80 columns."""
+
+    @property
+    def size(self) -> ConsoleDimensions:
+        size = super().size
+        if self.is_terminal or self._width is not None or "COLUMNS" in os.environ:
+            return size
+        return ConsoleDimensions(max(size.width, FILE_WIDTH), size.height)
+
+    @size.setter
+    def size(self, new_size: tuple[int, int]) -> None:
+        self._width, self._height = new_size
+
+
+console: Console = _SummaryConsole(markup=False)
 """The console every summary is printed on (standard output). Markup is off: names, files and notes a user wrote
 are printed as text (``[/]`` in a joint name is two brackets and a slash); styled words are :class:`rich.text.Text`."""
 

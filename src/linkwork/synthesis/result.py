@@ -435,7 +435,8 @@ class SynthesisResult:
     def plot(self, kind: str = "chain") -> Any:
         """A matplotlib ``Figure``: ``kind="chain"`` (the chain before and after joining, Fig. 8),
         ``"profiles"`` (design and target profiles, Fig. 3), ``"errors"`` (every segment's error on every
-        profile, Eq. 21) or ``"compound"`` (merged joints, Fig. 10). Needs ``linkwork[viz]``."""
+        profile, Eq. 21) or ``"compound"`` (merged joints, Fig. 10; without a compound stage, ``merge_below = 0``,
+        the joined chain with every joint's range of motion, Eq. 34). Needs ``linkwork[viz]``."""
         from linkwork.viz import synthesis_plots
 
         kinds = {

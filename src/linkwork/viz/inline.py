@@ -27,11 +27,36 @@ def iframe(page: str, *, title: str, height: int = HEIGHT) -> str:
     )
 
 
+INLINE_BYTES = 280_000
+"""The most characters of a trace's inline viewer: a notebook holding several stays light. The path shown is
+thinned evenly to fit (its ends and bifurcation points kept); the :class:`Trace` keeps every point, and
+``linkwork trace --html`` (or :func:`linkwork.viz.viewer.write_trace_viewer`) writes the full page."""
+
+INLINE_POINTS = 400
+"""Points of the path the inline viewer shows at most, before the size check."""
+
+
 def trace_html(trace: Trace) -> str:
-    """The inline viewer of a traced motion (``Trace._repr_html_``)."""
+    """The inline viewer of a traced motion (``Trace._repr_html_``), under :data:`INLINE_BYTES`."""
     from linkwork.viz.viewer import trace_viewer_page
 
-    return iframe(trace_viewer_page(trace), title=f"linkwork viewer: {trace.mechanism.name}")
+    title = f"linkwork viewer: {trace.mechanism.name}"
+    points = min(INLINE_POINTS, len(trace.branch))
+    page = iframe(trace_viewer_page(trace, max_points=points), title=title)
+    fewest = 2 * max(1, len(trace.branches))  # both ends of every branch
+    while len(page) > INLINE_BYTES and points > fewest:
+        points = max(fewest, int(points * 0.6))
+        page = iframe(trace_viewer_page(trace, max_points=points), title=title)
+    if (
+        len(page) > INLINE_BYTES
+    ):  # the solids alone are too large (a hoop of many rods): say so, in a few lines
+        return (
+            f"<pre>{html.escape(repr(trace))}</pre><p>The interactive viewer of this linkage is "
+            f"{len(page) // 1000} kB even with its path thinned to {points} points, too large to embed: write it "
+            "with <code>linkwork.viz.viewer.write_trace_viewer(trace, 'viewer.html')</code> or "
+            "<code>linkwork trace --html</code>.</p>"
+        )
+    return page
 
 
 def synthesis_html(result: SynthesisResult) -> str:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import re
 
-__all__ = ["number", "plain", "subscript"]
+__all__ = ["number", "plain", "plain_log_ticks", "subscript"]
 
 
 def number(value: float, fmt: str = ".4g", *, scale: float = 1.0) -> str:
@@ -37,3 +37,13 @@ def subscript(symbol: str, name: str) -> str:
     if re.fullmatch(r"[A-Za-z0-9]{1,12}", name):
         return rf"${symbol}_{{{name}}}$"
     return f"${symbol}$ " + plain(name)
+
+
+def plain_log_ticks(axis: object) -> None:
+    """Label a log-scaled axis (``ax.xaxis`` or ``ax.yaxis``) with plain numbers (``0.001``, ``3``, ``1e-18``)
+    instead of mathtext powers (``10^{-3}``, ``3x10^0``), on its major and minor ticks; matplotlib's own choice
+    of which minor ticks to label is kept."""
+    from matplotlib.ticker import LogFormatter
+
+    axis.set_major_formatter(LogFormatter(labelOnlyBase=False))  # type: ignore[attr-defined]
+    axis.set_minor_formatter(LogFormatter(labelOnlyBase=False, minor_thresholds=(1, 0.4)))  # type: ignore[attr-defined]

@@ -141,6 +141,8 @@ def plot_profiles_mechanism(found: Mechanization) -> Figure:
         if j == 0:
             ax.set_ylabel("y (profile unit)")
             ax.legend(fontsize=7, loc="best")
+        else:  # the same y range as the first panel, which labels it
+            ax.tick_params(labelleft=False)
     fig.suptitle(f"{plain(design.name)}: DOF {check.dof}, drive {plain(str(design.drive))}", fontsize=10)
     return fig
 

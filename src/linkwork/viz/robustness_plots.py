@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from linkwork.viz.labels import plain_log_ticks
+
 if TYPE_CHECKING:  # a type only: viz sits below studies
     from linkwork.studies.robustness import RobustnessResult
 
@@ -43,13 +45,13 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
         ax.set_yscale("log")
         # The start (where the imperfect structure is assembled) has no misfit: show five decades below the top.
         ax.set_ylim(bottom=10.0 ** (np.floor(np.log10(top)) - 4.0), top=top * 2.0)
-    unit = " (deg)" if key == "drive_deg" else ""
+    unit = "deg" if key == "drive_deg" else "length unit"
     if monotonic:
-        ax.set_xlabel(f"drive {summary['drive']}{unit}")
+        ax.set_xlabel(f"drive {summary['drive']} ({unit})")
     else:
         ax.set_xlabel(
-            f"point along the nominal path (drive {summary['drive']} between {drive.min():.4g} and "
-            f"{drive.max():.4g}{unit.replace('(', '').replace(')', '')})"
+            f"point along the nominal path (count), drive {summary['drive']} between {drive.min():.4g} and "
+            f"{drive.max():.4g} {unit}"
         )
     ax.set_ylabel(f"closure misfit (length units, L = {summary['scale']['length']:.3g})")
     ratio = _positive(b["ratio"])
@@ -60,10 +62,14 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     )
     if np.any(np.isfinite(ratio)):
         twin.set_yscale("log")
-    twin.set_ylabel("largest / smallest non-zero singular value")
+        plain_log_ticks(twin.yaxis)
+    if ax.get_yscale() == "log":
+        plain_log_ticks(ax.yaxis)
+    twin.set_ylabel("largest / smallest non-zero singular value (-)")
     lines = ax.get_legend_handles_labels()
     more = twin.get_legend_handles_labels()
-    ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="upper left")
+    # Below the axes, never over the curves.
+    fig.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="outside lower center", ncol=4)
     tol = summary["tolerances"]
     ax.set_title(
         f"{summary['linkage']}: {summary['samples']} samples, hinges within {tol['hinge_position']:g} and "
@@ -92,7 +98,9 @@ def plot_histogram(result: RobustnessResult, summary: dict[str, Any], file: Path
 
         edges = np.geomspace(both.min(), both.max(), 50)
         ax.set_xscale("log")
-        ax.xaxis.set_minor_formatter(NullFormatter())
+        plain_log_ticks(ax.xaxis)
+        if both.max() > 100.0 * both.min():  # two decades or more: the decades alone are labelled
+            ax.xaxis.set_minor_formatter(NullFormatter())
     else:
         edges = np.linspace(
             float(mc.min()) if mc.size else 0.0, float(mc.max()) + 1e-300 if mc.size else 1.0, 50
@@ -100,7 +108,7 @@ def plot_histogram(result: RobustnessResult, summary: dict[str, Any], file: Path
     ax.hist(mc, bins=list(edges), alpha=0.6, label="Monte Carlo")
     ax.hist(fo, bins=list(edges), histtype="step", lw=1.5, label="first order")
     ax.set_xlabel("largest misfit along the path (length units)")
-    ax.set_ylabel("samples")
+    ax.set_ylabel("samples (count)")
     kept = summary["mobility_kept"]
     ax.set_title(
         f"{summary['linkage']}: mobility kept by {100.0 * (kept or 0.0):.1f} % of samples", fontsize=10

@@ -16,7 +16,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from linkwork.deprecation import trace_keyword
 from linkwork.errors import LinkworkError
+from linkwork.geometry.angles import wrap
 from linkwork.geometry.fit import kabsch
+from linkwork.geometry.se3 import exp_se3, inverse, log_se3
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
 from linkwork.viz.labels import plain, subscript
@@ -119,15 +121,47 @@ def configuration_meshes(mech: Mechanism, angles: ArrayLike, steady: bool = True
 def steady_transforms(mech: Mechanism, angles: ArrayLike) -> Array:
     """Rigid motions ``(N, 4, 4)`` of the whole mechanism, one per configuration, for a steady drawing.
 
-    Body poses hold the first body still, so a hoop seen that way tumbles as it deploys. Each configuration is
-    instead fitted (least squares, Kabsch) onto the previous one as a whole and centred at the origin, which
-    keeps a symmetric motion's symmetry axis still; finally everything is turned so that the normal of the
-    flattest (most spread-out) configuration points up (+z). Consecutive rows should be close: pass the whole
-    branch and pick frames afterwards.
+    A mechanism whose first body is ``ground`` (a four-bar, a slider-crank, a mechanized chain) is drawn on its
+    ground: one and the same move for every row. Otherwise body poses hold the first body still, so a hoop seen
+    that way tumbles as it deploys: each configuration is instead fitted (least squares, Kabsch) onto the previous
+    one as a whole and centred at the origin, which keeps a symmetric motion's symmetry axis still. Chained fits
+    drift: a path that comes back to its first configuration would end in another pose, so the drift is spread
+    back along the path (:func:`close_drift`) and the same configuration is drawn the same way at both ends.
+    Finally everything is turned so that the normal of the flattest (most spread-out) configuration points up
+    (+z). Consecutive rows should be close: pass the whole branch and pick frames afterwards.
     """
+    angles = np.atleast_2d(np.asarray(angles, dtype=float))
     clouds = mesh_clouds(mech, angles)
-    moves = follow(clouds)
+    if mech.bodies and mech.bodies[0] == "ground":
+        centre = np.eye(4)
+        centre[:3, 3] = -clouds.reshape(-1, 3).mean(axis=0)
+        moves = np.repeat(centre[None], len(clouds), axis=0)
+    else:
+        moves = close_drift(mech, angles, follow(clouds))
     return np.einsum("ij,njk->nik", leveling(clouds, moves), moves)
+
+
+#: Two rows of joint values closer than this (radians or lengths, revolute joints modulo a turn) are one
+#: configuration.
+SAME_CONFIGURATION = 1e-7
+
+
+def close_drift(mech: Mechanism, angles: Array, moves: Array) -> Array:
+    """``moves`` corrected so that a path ending where it began (the same configuration, revolute joints modulo
+    a full turn) is drawn in the same pose at both ends: the mismatch ``C = moves[0] moves[-1]^-1`` is applied in
+    growing fractions ``exp(t log C)``, ``t`` the fraction of the path's length in the joints, so no frame jumps."""
+    if len(angles) < 3:
+        return moves
+    step = np.diff(angles, axis=0)
+    revolute = np.array([t == "R" for t in mech.joint_types])
+    gap = angles[-1] - angles[0]
+    gap[revolute] = wrap(gap[revolute])
+    if np.max(np.abs(gap)) > SAME_CONFIGURATION:
+        return moves
+    mismatch = log_se3(moves[0] @ inverse(moves[-1]))
+    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(step, axis=1))])
+    t = length / length[-1] if length[-1] > 0 else np.linspace(0.0, 1.0, len(angles))
+    return np.array([exp_se3(f * mismatch) @ m for f, m in zip(t, moves, strict=True)])
 
 
 def mesh_clouds(mech: Mechanism, angles: ArrayLike) -> Array:

@@ -23,6 +23,50 @@ METRICS = {
 }
 
 
+#: The unit of each result, for its axis label.
+METRIC_UNITS = {
+    "ratio_max": "-",
+    "bifurcations": "count",
+    "mobility": "degrees of freedom",
+    "misfit_p50": "length unit",
+    "mobility_kept": "-",
+    "e_max": "profile unit",
+    "e_mean": "profile unit",
+}
+
+#: The unit of a synthesis study's grid settings (problem keys).
+SETTING_UNITS = {
+    "piece_length": "profile unit",
+    "merge_below": "deg",
+    "segments": "count",
+    "min_pieces": "count",
+    "starts": "count",
+}
+
+#: Built-in parameter units (``Param.unit``) as axis units.
+PARAM_UNITS = {"deg": "deg", "length": "length unit", "int": "count"}
+
+
+def metric_label(metric: str) -> str:
+    """A result's axis label with its unit, e.g. ``bifurcations found (count)``."""
+    return f"{METRICS[metric]} ({METRIC_UNITS.get(metric, '-')})"
+
+
+def parameter_label(study: Study, name: str) -> str:
+    """A grid parameter's axis label with its unit: a built-in's parameter unit (degrees for angles, as in the
+    study file), a synthesis setting's, or ``-``."""
+    unit = None
+    if study.kind == "linkage":
+        from linkwork.linkages import REGISTRY
+
+        entry = REGISTRY.get(str(study.target).replace("_", "-").lower())
+        param = entry.params.get(name) if entry is not None else None
+        unit = PARAM_UNITS.get(param.unit) if param is not None else None
+    else:
+        unit = SETTING_UNITS.get(name)
+    return f"{name} ({unit or '-'})"
+
+
 def _numeric(rows: list[dict[str, Any]], key: str) -> np.ndarray:
     out = []
     for row in rows:
@@ -55,8 +99,8 @@ def plot_lines(study: Study, rows: list[dict[str, Any]], metric: str, file: Path
                 for q, v in zip(others, key, strict=True)
             )
             ax.plot(x[mask][order], y[mask][order], "o-", ms=3, label=label or None)
-        ax.set_xlabel(p)
-        ax.set_ylabel(METRICS[metric])
+        ax.set_xlabel(parameter_label(study, p))
+        ax.set_ylabel(metric_label(metric))
         if others and len(set(keys)) <= 8:
             ax.legend(fontsize=7)
     fig.suptitle(f"{study.name}: {METRICS[metric]}", fontsize=10)
@@ -79,9 +123,9 @@ def plot_heatmap(study: Study, rows: list[dict[str, Any]], metric: str, file: Pa
     im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis")
     ax.set_xticks(range(len(xs)), [f"{v:g}" if isinstance(v, int | float) else str(v) for v in xs])
     ax.set_yticks(range(len(ys)), [f"{v:g}" if isinstance(v, int | float) else str(v) for v in ys])
-    ax.set_xlabel(q)
-    ax.set_ylabel(p)
-    fig.colorbar(im, ax=ax, label=METRICS[metric])
+    ax.set_xlabel(parameter_label(study, q))
+    ax.set_ylabel(parameter_label(study, p))
+    fig.colorbar(im, ax=ax, label=metric_label(metric))
     ax.set_title(f"{study.name}: {METRICS[metric]}", fontsize=10)
     fig.savefig(file, dpi=110)
     plt.close(fig)

@@ -284,26 +284,32 @@ def plot_chain(result: SynthesisResult) -> Figure:
 
 def plot_compound(result: SynthesisResult) -> Figure:
     """The joined chain and the chain after merging small-motion joints into compound segments (paper's
-    Fig. 10), with each joint's range of motion.
+    Fig. 10), with each joint's range of motion (Eq. 34).
 
-    Raises
-    ------
-    ValueError
-        If the result has no compound stage (``merge_below`` was 0).
+    A result without a compound stage (``merge_below = 0``) gets the joined chain alone, with the same ranges,
+    which say which joints a ``merge_below`` would merge.
     """
+    from linkwork.synthesis.compound import joint_angles, joint_ranges
+
     compound = result.compound
+    unit = length_unit(result)
+    panels = 1 if compound is None else 2
+    figure, axes = _figure(panels, _extent([t.points for t in result.targets]), unit=unit)
     if compound is None:
-        raise ValueError("Expected a result with a compound stage (merge_below > 0), got compound = None")
-    figure, axes = _figure(2, _extent([t.points for t in result.targets]), unit=length_unit(result))
-    merged_per_panel: tuple[tuple[int, ...], ...] = ((), compound.merged)
-    for ax, chains, fused in zip(axes, (result.joined, compound.profiles), merged_per_panel, strict=True):
+        ranges = joint_ranges(joint_angles(result.joined, result.segment_matrix))
+        stages: list[tuple[Any, tuple[int, ...]]] = [(result.joined, ())]
+    else:
+        ranges = compound.joint_ranges
+        stages = [(result.joined, ()), (compound.profiles, compound.merged)]
+    for ax, (chains, fused) in zip(axes, stages, strict=True):
         _draw_targets(ax, result, label=ax is axes[0])
         for j, chain in enumerate(chains):
             _draw_chain(ax, chain, _colour(j), f"chain on {_name(result, j)}", merged=fused)
+    merged = () if compound is None else compound.merged
     # Label every joint with its range of motion (Eq. 34) next to its position on profile 1.
-    for i, motion in enumerate(compound.joint_ranges):
+    for i, motion in enumerate(ranges):
         x, y = result.joined[0].joints[i + 1]
-        is_merged = i in compound.merged
+        is_merged = i in merged
         axes[0].annotate(
             f"{i + 1}: {math.degrees(motion):.1f}°",
             (x, y),
@@ -313,11 +319,14 @@ def plot_compound(result: SynthesisResult) -> Figure:
             color="black" if is_merged else "dimgray",
             weight="bold" if is_merged else "normal",
         )
-    unit = length_unit(result)
+    joined = f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {unit}"
+    if compound is None:
+        _titles_and_legends(axes, joined.removeprefix("(a) ") + " (no joints merged: merge_below = 0)")
+        return figure
     merged_list = ", ".join(str(i + 1) for i in compound.merged) or "none"
     _titles_and_legends(
         axes,
-        f"(a) joined, joint ranges in degrees: E_max = {result.joined_e_max:.3g} {unit}",
+        joined,
         f"(b) joints merged (< {math.degrees(compound.threshold):.3g}°): {merged_list}; "
         f"E_max = {compound.e_max:.3g} {unit}",
     )

@@ -13,7 +13,7 @@ import numpy as np
 
 from linkwork.deprecation import trace_keyword
 from linkwork.kinematics.trace_result import Trace
-from linkwork.viz.labels import plain
+from linkwork.viz.labels import plain, plain_log_ticks
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -105,9 +105,17 @@ def plot_singular_values(trace: Trace, file: Path, branch: int = 0) -> Path:
     return _save(singular_values_figure(trace, branch), file)
 
 
+ROUND_OFF = 1e-12
+"""A singular value below this times the largest at the same point is zero (round-off of the SVD)."""
+
+ZERO_FLOOR = 1e-16
+"""Where the log panel of :func:`singular_values_figure` draws a zero singular value."""
+
+
 @trace_keyword
 def singular_values_figure(trace: Trace, branch: int = 0) -> Figure:
-    """Singular values of the Jacobian along one branch against the drive angle (log scale), like Fig. 15."""
+    """Singular values of the Jacobian along one branch against the step (linear, like Fig. 15, and log scale,
+    where a zero singular value, one at round-off, is drawn at :data:`ZERO_FLOOR`)."""
     from matplotlib.figure import Figure
 
     from linkwork.viz.labels import number
@@ -125,15 +133,20 @@ def singular_values_figure(trace: Trace, branch: int = 0) -> Figure:
     # right: all of them on a log scale, the null ones at round-off.
     for i in range(min(rank, s.shape[1])):
         axes[0].plot(steps, s[:, i], lw=1.3, label=f"σ{i + 1}")
-    axes[0].set_xlabel("step")
+    axes[0].set_xlabel(f"step along branch {branch} (count)")
     axes[0].set_ylim(0, None)
+    # A singular value at round-off (below ROUND_OFF * sigma_1) is a zero: drawn on the floor, not as the noise
+    # of the SVD, which reads on a log scale as spikes of several decades.
+    zero = s < ROUND_OFF * s[:, :1]
+    shown = np.where(zero, ZERO_FLOOR, np.maximum(s, ZERO_FLOOR))
     for i in range(s.shape[1]):
-        axes[1].semilogy(steps, np.maximum(s[:, i], 1e-17), lw=1.3, label=f"σ{i + 1}")
+        axes[1].semilogy(steps, shown[:, i], lw=1.3, label=f"σ{i + 1}")
     unit = "°" if mech.joint_types[d] == "R" else ""
     span = float(np.ptp(x)) if len(x) else 1.0
     low, high = (number(v, scale=max(span, 1.0)) for v in (x[0], x[-1]))
-    axes[1].set_xlabel(f"step (θ{plain(str(trace.drive))} from {low}{unit} to {high}{unit})")
-    axes[1].set_ylim(1e-17, None)
+    axes[1].set_xlabel(f"step (count), θ{plain(str(trace.drive))} from {low}{unit} to {high}{unit}")
+    axes[1].set_ylim(ZERO_FLOOR / 10.0, None)
+    plain_log_ticks(axes[1].yaxis)
     for ax in axes:
         ax.set_ylabel("singular value (1 and length per rad)")
         ax.grid(alpha=0.3, which="both")

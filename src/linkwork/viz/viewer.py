@@ -184,7 +184,7 @@ def _steady_rows(trace: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[n
     (:func:`linkwork.viz.snapshots.follow`), a branch leaving a bifurcation point starting from the pose its
     parent has there, and everything levelled by the flattest configuration of the first branch. A grounded
     mechanism (a body called ``ground``) is held by its ground: no motion at all."""
-    from linkwork.viz.snapshots import follow, leveling, mesh_clouds
+    from linkwork.viz.snapshots import close_drift, follow, leveling, mesh_clouds
 
     mech = trace.mechanism
     if "ground" in mech.bodies:
@@ -203,7 +203,8 @@ def _steady_rows(trace: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[n
             k = int(np.argmin(np.linalg.norm(d, axis=1)))
             p_clouds, p_moves = done[pbi]
             reference = p_clouds[k] @ p_moves[k][:3, :3].T + p_moves[k][:3, 3]
-        done[bi] = (clouds, follow(clouds, reference))
+        # a branch that ends where it began is drawn in the same pose at both ends (snapshots.close_drift)
+        done[bi] = (clouds, close_drift(mech, trace.angles[idx], follow(clouds, reference)))
     if not done:
         return np.zeros((0, 12))
     level = leveling(*done[0])
