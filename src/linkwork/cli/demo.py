@@ -128,15 +128,14 @@ def _wing(out: Path, plots: bool) -> Section:
 
 def _mechanized_wing(out: Path, plots: bool) -> Section:
     """Part 4: the wing chain mechanized to one degree of freedom and verified by tracing."""
-    import json
-
+    from linkwork.io.readback import read_chain, read_mechanization
     from linkwork.outputs.synthesis import run_synthesis_example
 
     _heading("4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)")
     folder = out / "mechanism-wing"
     run_synthesis_example(folder, "wing", plots=plots, file="mechanize.toml")
-    report = json.loads((folder / "mechanization.json").read_text())
-    design = json.loads((folder / "chain.json").read_text())["design"]
+    report = read_mechanization(folder / "mechanization.json")
+    design = read_chain(folder / "chain.json")["design"]
     errors = ", ".join(f"{p['e_max']:.4f}" for p in report["profiles"])
     text = (
         f"The wing chain (design {design}) with binary links added by rigid-body "

@@ -114,9 +114,9 @@ def dxf(
 
     path = Path(spec)
     if units is None and (path / "chain.json").is_file():
-        import json
+        from linkwork.io.readback import read_chain
 
-        units = json.loads((path / "chain.json").read_text()).get("units")
+        units = read_chain(path / "chain.json").get("units")
     if units is not None and units not in LENGTH_UNITS:
         raise SpecError(f"--units: expected one of {', '.join(LENGTH_UNITS)}, got {units!r}")
     if (path / "path.csv").is_file():
@@ -131,10 +131,9 @@ def dxf(
 
 def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None]:
     """The mechanism of SPEC (built-in, file or trace folder) and the drive the trace used, if any."""
-    import json
-
     from linkwork.errors import SpecError
     from linkwork.export.trace_folder import read_mechanism
+    from linkwork.io.readback import read_report
     from linkwork.io.spec import resolve_spec
 
     path = Path(spec)
@@ -146,6 +145,13 @@ def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None
         if set_:
             raise SpecError("--set applies to built-in linkages only, not to a trace folder", key="--set")
         report = path / "report.json"
-        drive = json.loads(report.read_text()).get("drive") if report.is_file() else None
-        return read_mechanism(path), drive
+        drive = read_report(report).get("drive") if report.is_file() else None
+        mech = read_mechanism(path)
+        if drive is not None and drive not in mech.joint_names:
+            raise SpecError(
+                f"expected one of the joints {', '.join(mech.joint_names)} of mechanism.toml, got {drive!r}",
+                source=str(report),
+                key="drive",
+            )
+        return mech, drive
     return resolve_spec(spec, parse_assignments(set_, "--set")).mechanism, None
