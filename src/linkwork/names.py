@@ -212,7 +212,7 @@ def dxf_layers(names: Iterable[str], taken: Collection[str] = ()) -> NameMap:
     wanted: list[str] = []
     reasons: dict[str, str] = {}
     for name in names:
-        clean = _DXF_FORBIDDEN.sub("_", name).strip()[:250] or "_"
+        clean = _DXF_FORBIDDEN.sub("_", name).strip()[:240] or "_"
         if clean != name:
             reasons[name] = "characters a DXF layer name may not hold"
         wanted.append(clean)

@@ -11,7 +11,7 @@ import typer
 from linkwork.cli import help
 from linkwork.cli import options as opt
 from linkwork.cli.common import friendly_errors, parse_assignments
-from linkwork.outputs.staging import console
+from linkwork.outputs.staging import check_output_file, console
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
@@ -51,8 +51,9 @@ def stl(
     suffix = out.suffix.lower()
     if suffix not in (".stl", ".3mf"):
         raise SpecError(f"{out}: expected a file name ending in .stl or .3mf")
-    if not scale > 0.0:
-        raise SpecError(f"--scale: expected a positive factor, got {scale}")
+    if not 0.0 < scale < float("inf"):
+        raise SpecError(f"--scale: expected a positive finite factor, got {scale}")
+    check_output_file(out)
     folder = read_trace_folder(trace_dir)
     meshes = parts(folder.mechanism, folder.point(branch, point), scale)
     write_whole(out, lambda tmp: (write_3mf if suffix == ".3mf" else write_stl)(tmp, meshes))
@@ -78,9 +79,10 @@ def mjcf(
     from linkwork.export.files import write_whole
     from linkwork.export.mjcf import mjcf as to_mjcf
 
+    check_output_file(out)
     mech, traced_drive = _mechanism(spec, set_)
     text = to_mjcf(mech, drive or traced_drive)
-    write_whole(out, lambda tmp: tmp.write_text(text))
+    write_whole(out, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     console.print(
         f"wrote {out}: {len(mech.bodies)} bodies, {mech.n_joints} joints, {len(mech.loops)} loop(s)"
     )
@@ -112,6 +114,7 @@ def dxf(
     from linkwork.export.trace_folder import read_trace_folder
     from linkwork.io.profiles import LENGTH_UNITS
 
+    check_output_file(out)
     path = Path(spec)
     if units is None and (path / "chain.json").is_file():
         from linkwork.io.readback import read_chain

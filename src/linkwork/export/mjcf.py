@@ -18,6 +18,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from linkwork.io.writer import require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.positions import joint_points
 
@@ -80,7 +81,8 @@ def _capsules(mech: Mechanism, body: str, points: np.ndarray, radius: float) -> 
 def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
     """The MJCF text of ``mech`` (see the module docstring); ``drive`` (default: the first joint) gets a position
     actuator."""
-    points = joint_points(mech)
+    points = require_finite(joint_points(mech), f"{mech.name}: the joints' positions")
+    require_finite(mech.twists, f"{mech.name}: the joints' axes")
     spread = np.linalg.norm(points - points.mean(axis=0), axis=1)
     radius = CAPSULE_RADIUS * float(np.median(spread[spread > 0])) if np.any(spread > 0) else 0.03
     root, children, cuts = spanning_tree(mech)

@@ -7,13 +7,13 @@ down, so every SVG coordinate written here has its y negated.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 
 from linkwork.io.curves import Points, _size
+from linkwork.names import xml_text
 
 __all__ = ["LENGTH_UNITS", "new_dxf", "svg_d", "svg_document", "svg_path", "xml_escape"]
 
@@ -68,16 +68,9 @@ def svg_document(
 
 
 def xml_escape(text: str) -> str:
-    """``text`` as XML character data or attribute value: markup characters escaped, characters XML 1.0 does
-    not allow (control characters but tab, line feed and carriage return) replaced by U+FFFD."""
-    text = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]", "\ufffd", text)
-    return (
-        text.replace("&", "&amp;")
-        .replace("<", "&lt;")
-        .replace(">", "&gt;")
-        .replace('"', "&quot;")
-        .replace("'", "&apos;")
-    )
+    """``text`` as XML character data or attribute value (the name policy's :func:`linkwork.names.xml_text`):
+    markup characters escaped, characters XML 1.0 does not allow replaced by U+FFFD."""
+    return xml_text(text)
 
 
 def new_dxf(units: str | None = None) -> Any:

@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 
 from linkwork.deprecation import trace_keyword
+from linkwork.io.readback import path_columns
+from linkwork.io.writer import require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
 
@@ -34,8 +36,10 @@ def _display(trace: Trace, values: np.ndarray) -> np.ndarray:
 
 @trace_keyword
 def path_rows(trace: Trace) -> tuple[list[str], list[list[Any]]]:
-    """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual``."""
-    names = list(trace.mechanism.joint_names)
+    """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual`` (a joint whose name
+    is one of the fixed columns is written ``joint:<name>``, :func:`linkwork.io.readback.path_columns`)."""
+    columns = path_columns(trace.mechanism.joint_names)
+    names = [columns[n] for n in trace.mechanism.joint_names]
     k = trace.sigma.shape[1]
     header = ["branch", "step", "s", *names, *[f"sigma_{i + 1}" for i in range(k)], "residual"]
     angles = _display(trace, trace.angles)
@@ -59,7 +63,8 @@ def path_rows(trace: Trace) -> tuple[list[str], list[list[Any]]]:
 def write_path_csv(trace: Trace, file: Path) -> None:
     """Write ``path.csv`` (floats with 17 significant digits, so nothing is lost)."""
     header, rows = path_rows(trace)
-    with open(file, "w", newline="") as fh:
+    require_finite([[v for v in row if isinstance(v, float)] for row in rows], "path.csv: the traced values")
+    with open(file, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
         for row in rows:
@@ -223,7 +228,8 @@ def write_points_csv(trace: Trace, file: Path) -> None:
     if mu is not None:
         header.append("transmission")
         xyz = np.column_stack([xyz, np.degrees(mu)])
-    with open(file, "w", newline="") as fh:
+    require_finite(xyz, "points.csv: the positions")
+    with open(file, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
         for b, s, row in zip(trace.branch, trace.step, xyz, strict=True):

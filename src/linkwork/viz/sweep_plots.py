@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.studies.study_file import Study
+from linkwork.viz.labels import plain
 
 #: Results plotted, when present, with their axis labels.
 METRICS = {
@@ -50,15 +51,15 @@ def plot_lines(study: Study, rows: list[dict[str, Any]], metric: str, file: Path
             mask = np.array([k == key for k in keys])
             order = np.argsort(x[mask])
             label = ", ".join(
-                f"{q}={v:g}" if isinstance(v, int | float) else f"{q}={v}"
+                f"{plain(q)}={v:g}" if isinstance(v, int | float) else f"{plain(q)}={plain(str(v))}"
                 for q, v in zip(others, key, strict=True)
             )
             ax.plot(x[mask][order], y[mask][order], "o-", ms=3, label=label or None)
-        ax.set_xlabel(p)
+        ax.set_xlabel(plain(p))
         ax.set_ylabel(METRICS[metric])
         if others and len(set(keys)) <= 8:
             ax.legend(fontsize=7)
-    fig.suptitle(f"{study.name}: {METRICS[metric]}", fontsize=10)
+    fig.suptitle(f"{plain(study.name)}: {METRICS[metric]}", fontsize=10)
     fig.savefig(file, dpi=110)
     plt.close(fig)
     return file
@@ -78,10 +79,10 @@ def plot_heatmap(study: Study, rows: list[dict[str, Any]], metric: str, file: Pa
     im = ax.imshow(Z, origin="lower", aspect="auto", cmap="viridis")
     ax.set_xticks(range(len(xs)), [f"{v:g}" if isinstance(v, int | float) else str(v) for v in xs])
     ax.set_yticks(range(len(ys)), [f"{v:g}" if isinstance(v, int | float) else str(v) for v in ys])
-    ax.set_xlabel(q)
-    ax.set_ylabel(p)
+    ax.set_xlabel(plain(q))
+    ax.set_ylabel(plain(p))
     fig.colorbar(im, ax=ax, label=METRICS[metric])
-    ax.set_title(f"{study.name}: {METRICS[metric]}", fontsize=10)
+    ax.set_title(f"{plain(study.name)}: {METRICS[metric]}", fontsize=10)
     fig.savefig(file, dpi=110)
     plt.close(fig)
     return file
