@@ -11,7 +11,8 @@ one place they are applied. One function per format:
 - :func:`xml_text` -- XML character data and attribute values (MJCF, 3MF, SVG): markup escaped, characters XML
   1.0 forbids replaced by U+FFFD.
 - :func:`xml_names` -- names that must be unique and may be reserved (MJCF bodies: ``world`` is MuJoCo's).
-- :func:`stl_names` -- ASCII STL ``solid`` names: one word of printable ASCII, unique per file.
+- :func:`stl_names` -- ASCII STL ``solid`` names: one word of letters, digits and ``_.-`` holding no STL keyword,
+  unique per file.
 - :func:`dxf_layers` -- DXF layer names: none of ``<>/\\":;?*|=,`` or control characters, unique.
 - :func:`mathtext` -- matplotlib text: every ``$`` escaped, so mathtext never starts inside a name.
 - :func:`html_text` -- HTML text and attribute values.
@@ -49,8 +50,17 @@ MJCF_RESERVED = frozenset({"world"})
 """Body names MuJoCo reserves (the world body)."""
 
 _XML_FORBIDDEN = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
-_DXF_FORBIDDEN = re.compile(r'[<>/\\":;?*|=,`\x00-\x1f\x7f]')
-_STL_FORBIDDEN = re.compile(r"[^!-~]")  # anything but printable ASCII without the space
+_DXF_FORBIDDEN = re.compile('[<>/\\\\":;?*|=,`\x00-\x1f\x7f\ud800-\udfff]')
+_SURROGATE = re.compile("[\ud800-\udfff]")
+_STL_FORBIDDEN = re.compile(r"[^A-Za-z0-9_.-]")
+_STL_KEYWORDS = re.compile(r"(?i)solid|facet|loop|vertex|normal|outer")
+
+
+def _stl_word(name: str) -> str:
+    """One STL solid name: letters, digits and ``_.-`` (anything else becomes ``_``), and no STL keyword inside
+    it (``solid`` is written ``s_olid``), so a reader that looks for keywords in a line is not misled."""
+    word = _STL_FORBIDDEN.sub("_", name)
+    return _STL_KEYWORDS.sub(lambda m: m.group(0)[0] + "_" + m.group(0)[1:], word) or "part"
 
 
 @dataclass(frozen=True)
@@ -143,9 +153,17 @@ def csv_columns(
     for name in names:
         columns = [name + s for s in suffixes]
         clash = [c for c in columns if c in fixed or any(p.fullmatch(c) for p in compiled)]
-        if clash or name.startswith(COLUMN_PREFIX):
-            written[name] = COLUMN_PREFIX + name
-            reasons[name] = f"{clash[0]!r} is a fixed column" if clash else f"starts with {COLUMN_PREFIX!r}"
+        encodable = not _SURROGATE.search(name)
+        if clash or name.startswith(COLUMN_PREFIX) or not encodable:
+            # a lone surrogate (only a Python caller can make one) cannot be written as UTF-8: its escape is
+            written[name] = COLUMN_PREFIX + name.encode("utf-8", "backslashreplace").decode("utf-8")
+            reasons[name] = (
+                f"{clash[0]!r} is a fixed column"
+                if clash
+                else f"starts with {COLUMN_PREFIX!r}"
+                if encodable
+                else "not encodable as UTF-8"
+            )
         else:
             written[name] = name
     return NameMap(fmt, written, reasons)
@@ -190,16 +208,14 @@ def xml_names(fmt: str, names: Iterable[str], reserved: Collection[str] = ()) ->
 
 
 def stl_names(names: Sequence[str]) -> tuple[list[str], NameMap]:
-    """ASCII STL ``solid`` names of parts (in order; two parts may bear the same name): one word of printable
-    ASCII (every other character, spaces and line breaks included, becomes ``_``), never empty, unique within
-    the file. Returns the names in order and the changes."""
-    wanted = [_STL_FORBIDDEN.sub("_", name) or "part" for name in names]
+    """ASCII STL ``solid`` names of parts (in order; two parts may bear the same name): one word (see
+    :func:`_stl_word`; spaces and line breaks become ``_``), never empty, unique within the file. Returns the
+    names in order and the changes."""
+    wanted = [_stl_word(name) for name in names]
     written = _unique(wanted)
     changed = {n: w for n, w in zip(names, written, strict=True) if n != w}
     reasons = {
-        n: "made unique"
-        if _STL_FORBIDDEN.sub("_", n) == n
-        else "an STL solid name is one word of printable ASCII"
+        n: "made unique" if _stl_word(n) == n else "an STL solid name is one word of letters, digits and _.-"
         for n in changed
     }
     return written, NameMap("STL solid", changed, reasons)
@@ -222,12 +238,12 @@ def dxf_layers(names: Iterable[str], taken: Collection[str] = ()) -> NameMap:
 def mathtext(text: str) -> str:
     """``text`` drawn literally by matplotlib: each ``$`` escaped as ``\\$``, so mathtext never starts inside a
     name (a backslash outside mathtext is drawn as it is)."""
-    return text.replace("$", r"\$")
+    return _SURROGATE.sub("\ufffd", text).replace("$", r"\$")
 
 
 def html_text(text: str) -> str:
     """``text`` as HTML text or a quoted attribute value (``<>&"'`` escaped)."""
-    return html.escape(text, quote=True)
+    return html.escape(_SURROGATE.sub("\ufffd", text), quote=True)
 
 
 def _distinct(names: Iterable[str]) -> list[str]:

@@ -15,6 +15,7 @@ from linkwork.outputs.staging import check_output_file, console
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
+    from linkwork.names import NameMap
 
 app = typer.Typer(
     cls=help.Group,
@@ -45,7 +46,7 @@ def stl(
     Parts are the links or rods and a pin on every joint; an STL has one `solid` per part, a 3MF one object."""
     from linkwork.errors import SpecError
     from linkwork.export.files import write_whole
-    from linkwork.export.solids import parts, write_3mf, write_stl
+    from linkwork.export.solids import parts, renamed_parts, write_3mf, write_stl
     from linkwork.export.trace_folder import read_trace_folder
 
     suffix = out.suffix.lower()
@@ -58,6 +59,7 @@ def stl(
     meshes = parts(folder.mechanism, folder.point(branch, point), scale)
     write_whole(out, lambda tmp: (write_3mf if suffix == ".3mf" else write_stl)(tmp, meshes))
     console.print(f"wrote {out}: {len(meshes)} parts (branch {branch}, point {point})")
+    _report_names(renamed_parts(meshes))
 
 
 @app.command("mjcf", cls=help.Command)
@@ -78,6 +80,7 @@ def mjcf(
     A body per link, hinges named after our joints, one weld closing each loop, a position actuator on the drive."""
     from linkwork.export.files import write_whole
     from linkwork.export.mjcf import mjcf as to_mjcf
+    from linkwork.export.mjcf import mjcf_names
 
     check_output_file(out)
     mech, traced_drive = _mechanism(spec, set_)
@@ -86,6 +89,7 @@ def mjcf(
     console.print(
         f"wrote {out}: {len(mech.bodies)} bodies, {mech.n_joints} joints, {len(mech.loops)} loop(s)"
     )
+    _report_names(*mjcf_names(mech))
 
 
 @app.command("dxf", cls=help.Command)
@@ -158,3 +162,12 @@ def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None
             )
         return mech, drive
     return resolve_spec(spec, parse_assignments(set_, "--set")).mechanism, None
+
+
+def _report_names(*maps: NameMap) -> None:
+    """Print the names the file format made us write differently (the name policy's report)."""
+    from linkwork.names import describe
+
+    line = describe(*maps)
+    if line:
+        console.print(line)
