@@ -7,7 +7,6 @@ Angles are written in degrees (prismatic joints in length units); the column and
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +14,7 @@ import numpy as np
 
 from linkwork.deprecation import trace_keyword
 from linkwork.io.readback import path_columns
-from linkwork.io.writer import require_finite
+from linkwork.io.writer import json_text, require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
 
@@ -208,9 +207,7 @@ def _assembly_entry(assembly: Any, names: list[str]) -> dict[str, Any]:
 @trace_keyword
 def write_report_json(trace: Trace, file: Path, assembly: Any | None = None) -> None:
     """Write ``report.json``."""
-    with open(file, "w") as fh:
-        json.dump(report_dict(trace, assembly), fh, indent=2)
-        fh.write("\n")
+    Path(file).write_text(json_text(report_dict(trace, assembly)), encoding="utf-8")
 
 
 @trace_keyword

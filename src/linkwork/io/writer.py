@@ -49,6 +49,7 @@ __all__ = [
     "Manifest",
     "check_output_file",
     "check_output_folder",
+    "json_text",
     "require_finite",
     "staged_output",
     "write_file",
@@ -218,7 +219,8 @@ def _write_failed(exc: OSError, out: Path, flag: str, staging: Path) -> Exceptio
 def _stage_beside(out: Path, flag: str, *, folder: bool) -> Path:
     """A new staging folder (or file) in ``out``'s folder (same file system: the final move is a rename)."""
     try:
-        parent = out.absolute().parent
+        # beside the real folder (an --out that is a link to a folder elsewhere): the final move is a rename
+        parent = (out.resolve() if folder else out.absolute()).parent
         parent.mkdir(parents=True, exist_ok=True)
         if folder:
             return Path(tempfile.mkdtemp(prefix=".linkwork-", dir=parent))
@@ -341,6 +343,25 @@ def write_file(file: str | Path, write: Callable[[Path], Any], *, flag: str = "-
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
     return file
+
+
+def json_text(value: Any, indent: int | None = 2) -> str:
+    """``value`` as standard JSON text (with a final newline): numpy numbers and arrays as JSON numbers and lists,
+    and a computed quantity that is not finite (undefined, such as a condition number at a singular point)
+    written as ``null``, never as the ``NaN`` or ``Infinity`` that strict JSON readers refuse."""
+
+    def plain(v: Any) -> Any:
+        if isinstance(v, dict):
+            return {str(k): plain(x) for k, x in v.items()}
+        if isinstance(v, list | tuple | np.ndarray):
+            return [plain(x) for x in v]
+        if isinstance(v, np.generic):
+            v = v.item()
+        if isinstance(v, float) and not np.isfinite(v):
+            return None
+        return v
+
+    return json.dumps(plain(value), indent=indent, allow_nan=False) + "\n"
 
 
 def require_finite(values: ArrayLike, what: str) -> np.ndarray:

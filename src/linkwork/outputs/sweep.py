@@ -4,10 +4,10 @@ robustness figures one folder per grid point."""
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 from typing import Any
 
+from linkwork.io.writer import json_text
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.study_file import Study
 
@@ -74,9 +74,7 @@ def write_sweep_outputs(
                 folder.mkdir(parents=True)
                 summary = robustness_dict(res, study.target)
                 summary["parameters"] = {k: rows[i].get(k) for k in study.grid}
-                (folder / "robustness.json").write_text(
-                    json.dumps(summary, indent=2) + "\n", encoding="utf-8"
-                )
+                (folder / "robustness.json").write_text(json_text(summary), encoding="utf-8")
                 write_robustness_figures(res, summary, folder)
         elif plots:
             console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")

@@ -4,7 +4,7 @@ summary."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from linkwork.deprecation import trace_keyword
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
@@ -69,25 +69,11 @@ def write_trace_mechanism(mech: Mechanism, folder: Path) -> None:
     """Write what rebuilds the traced mechanism next to its path: ``mechanism.toml`` (a spec file, read back by
     ``linkwork trace`` and ``linkwork export``) and ``drawing.json`` (the constructor's parameters, which choose
     how its solids are drawn: Hedgepeth's and Guest's rods)."""
-    import json
-
     from linkwork.io.spec import dump_spec
+    from linkwork.io.writer import json_text
 
     (folder / "mechanism.toml").write_text(dump_spec(mech))
-    (folder / "drawing.json").write_text(json.dumps(_plain(dict(mech.meta)), indent=1) + "\n")
-
-
-def _plain(value: Any) -> Any:
-    """``value`` with numpy scalars and arrays turned into JSON numbers and lists."""
-    import numpy as np
-
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
+    (folder / "drawing.json").write_text(json_text(dict(mech.meta), indent=1), encoding="utf-8")
 
 
 @trace_keyword
