@@ -356,3 +356,39 @@ def test_require_finite_names_what() -> None:
     for bad in (float("nan"), float("inf"), -float("inf")):
         with pytest.raises(SpecError, match="the thing: expected finite numbers"):
             require_finite([[0.0, bad]], "the thing")
+
+
+DAMAGE = {
+    "empty path.csv": ("path.csv", lambda b: b""),
+    "truncated path.csv": ("path.csv", lambda b: b[: len(b) // 3]),
+    "binary path.csv": ("path.csv", lambda b: b"\x89PNG\r\n\x1a\n\x00\xff" + b[:100]),
+    "short-row path.csv": ("path.csv", lambda b: b + b"0,1,2\n"),
+    "nan in path.csv": ("path.csv", lambda b: b.replace(b"\n0,1,", b"\n0,1,nan,", 1)),
+    "truncated drawing.json": ("drawing.json", lambda b: b[: len(b) // 2]),
+    "truncated report.json": ("report.json", lambda b: b[: len(b) // 2]),
+    "mistyped report.json": ("report.json", lambda b: b'{"joints": "A", "drive": 3}'),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DAMAGE))
+@pytest.mark.parametrize("kind", ["stl", "mjcf", "dxf"])
+def test_a_damaged_trace_folder_is_one_line_exit_2(
+    tmp_path: Path, trace_dir: Path, case: str, kind: str
+) -> None:
+    """The campaign's cases: ``export`` on a damaged trace folder is one line naming the file, exit 2."""
+    import shutil
+
+    folder = tmp_path / "trace"
+    shutil.copytree(trace_dir, folder)
+    name, damage = DAMAGE[case]
+    (folder / name).write_bytes(damage((folder / name).read_bytes()))
+    result = invoke("export", kind, folder, "-o", tmp_path / f"x.{'xml' if kind == 'mjcf' else kind}")
+    if kind == "stl" and name == "report.json" or kind in ("mjcf",) and name == "path.csv":
+        assert result.exit_code == 0  # that command does not read that file
+        return
+    if kind == "dxf" and name == "report.json":
+        assert result.exit_code == 0
+        return
+    assert result.exit_code == 2, result.stdout
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(folder / name) in result.stderr.replace("\n", "")

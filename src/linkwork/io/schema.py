@@ -268,6 +268,12 @@ class CsvSchema:
         naming the file, the line and the column for any damage."""
         source = escape_line(str(path))
         text = read_text(path, self.what)
+        if not text.endswith("\n"):  # linkwork ends every row with a line end: the file was cut off
+            raise SpecError(
+                f"truncated (the last line has no line end); expected {self.what}",
+                source=source,
+                key=f"line {text.count(chr(10)) + 1}",
+            )
         reader = csv.reader(io.StringIO(text, newline=""))
         try:
             header = next(reader)
