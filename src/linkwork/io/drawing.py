@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.io.curves import Points, _size
+from linkwork.io.writer import require_finite
 from linkwork.names import xml_text
 
 __all__ = ["LENGTH_UNITS", "new_dxf", "svg_d", "svg_document", "svg_path", "xml_escape"]
@@ -48,7 +49,9 @@ def svg_document(
     """An SVG document whose viewBox holds every point of ``extents`` (profile coordinates, y up); with ``units``
     (a key of :data:`LENGTH_UNITS`) its width and height are the drawing's true size in that unit, else
     ``pixels`` across."""
-    everything = np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents])
+    everything = require_finite(
+        np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents]), "the drawing's coordinates"
+    )
     lo, hi = everything.min(axis=0), everything.max(axis=0)
     margin = 0.05 * _size(everything)
     x0, y0 = lo[0] - margin, -hi[1] - margin

@@ -4,6 +4,7 @@ robustness figures one folder per grid point."""
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 from typing import Any
 
@@ -30,12 +31,20 @@ def columns_of(rows: list[dict[str, Any]], study: Study) -> list[str]:
     return [*study.grid, *sorted(seen, key=lambda k: (group(k), seen.index(k))), "error"]
 
 
+def _value(value: Any) -> Any:
+    """A cell as written: a computed number that is not finite (undefined at that grid point) is missing (an
+    empty CSV cell, a Parquet null), never ``nan`` or ``inf``."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def write_table(rows: list[dict[str, Any]], cols: list[str], parquet: Path, csv_file: Path) -> None:
     """One row per grid point in both formats; missing values are empty (CSV) or null (Parquet)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    data = {c: [row.get(c) for row in rows] for c in cols}
+    data = {c: [_value(row.get(c)) for row in rows] for c in cols}
     arrays = {}
     for c, values in data.items():
         try:
@@ -47,7 +56,7 @@ def write_table(rows: list[dict[str, Any]], cols: list[str], parquet: Path, csv_
         writer = csv.writer(fh)
         writer.writerow(cols)
         for row in rows:
-            writer.writerow(["" if row.get(c) is None else row.get(c) for c in cols])
+            writer.writerow(["" if _value(row.get(c)) is None else row.get(c) for c in cols])
 
 
 def write_sweep_outputs(

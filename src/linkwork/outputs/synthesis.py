@@ -37,12 +37,15 @@ def write_synthesis_outputs(result: SynthesisResult, folder: Path, *, plots: boo
     :func:`linkwork.viz.synthesis_plots.write_synthesis_figures`.
     """
     from linkwork.io.profiles import write_outline_dxf, write_outline_svg
+    from linkwork.io.writer import require_finite
     from linkwork.synthesis import write_target_profiles_csv
 
     folder.mkdir(parents=True, exist_ok=True)
     chain = folder / "chain.json"
     chain.write_text(json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n", encoding="utf-8")
     targets = folder / "target_profiles.csv"
+    for target in result.targets:
+        require_finite(target.points, f"target profile {show(target.name)}: its points")
     write_target_profiles_csv(result.targets, targets)
     write_outline_svg(folder / "outline.svg", result)
     write_outline_dxf(folder / "outline.dxf", result)
