@@ -391,3 +391,29 @@ def test_a_damaged_trace_folder_is_one_line_exit_2(
     assert result.exit_code == 2, result.stdout
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and str(folder / name) in result.stderr.replace("\n", "")
+
+
+def test_a_folder_that_cannot_be_written_names_the_users_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The staging cannot be made (a read-only parent; patched, since the tests may run as root): exit 2 naming
+    --out; a refused write inside the staging: the same, never the staging's name."""
+    import tempfile
+
+    out = tmp_path / "results"
+
+    def refuse(*args: object, **kwargs: object) -> str:
+        raise PermissionError(errno.EACCES, "Permission denied", str(tmp_path))
+
+    with monkeypatch.context() as m:
+        m.setattr(tempfile, "mkdtemp", refuse)
+        with pytest.raises(SpecError) as info, staged_output(out):
+            pass
+    assert str(out) in str(info.value) and "Permission denied" in str(info.value)
+    with pytest.raises(SpecError) as info, staged_output(out) as stage:
+        raise PermissionError(errno.EACCES, "Permission denied", str(stage / "viewer.html"))
+    assert str(out) in str(info.value) and ".linkwork-" not in str(info.value)
+    assert not out.exists() and not leftovers(tmp_path)
+    # a file the command reads on the way (not in the staging) keeps its own error
+    with pytest.raises(FileNotFoundError), staged_output(out):
+        (tmp_path / "missing.toml").read_text()

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from linkwork.io.writer import json_text
+from linkwork.names import COLUMN_PREFIX
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.study_file import Study
 
@@ -104,6 +105,12 @@ def print_sweep_summary(study: Study, rows: list[dict[str, Any]]) -> None:
     console.print(table)
     if len(rows) > 30:
         console.print(f"... {len(rows) - 30} more rows in sweep.csv")
+    prefixed = sorted({c[: -len("_min")] for c in cols if c.startswith(COLUMN_PREFIX) and c.endswith("_min")})
+    if prefixed:
+        console.print(
+            "names changed for the file formats: sweep.csv: joints whose columns would clash with fixed ones are "
+            "written " + ", ".join(f"{c}_min, {c}_max" for c in prefixed)
+        )
 
 
 _HEADLINE = (
