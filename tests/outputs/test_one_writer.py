@@ -281,11 +281,11 @@ def test_a_file_size_limit_through_the_command_line(tmp_path: Path) -> None:
     out = tmp_path / "big"
 
     def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
 
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path), "NO_COLOR": "1"}
     done = subprocess.run(
-        [str(script), "trace", "hedgepeth", "--no-plots", "-o", str(out)],
+        [str(script), "trace", "four-bar", "--no-plots", "-o", str(out)],
         env=env,
         capture_output=True,
         text=True,

@@ -42,6 +42,7 @@ __all__ = [
     "PATH_PATTERNS",
     "SCHEMAS",
     "path_columns",
+    "points_columns",
     "read_chain",
     "read_drawing",
     "read_mechanization",
@@ -65,6 +66,12 @@ def path_columns(joints: Sequence[str]) -> NameMap:
     """The column of every joint in ``path.csv``: its name, or ``joint:<name>`` when the name clashes with a
     fixed column (:func:`linkwork.names.csv_columns`); the writer and the reader both use this."""
     return csv_columns("path.csv", joints, PATH_FIXED, patterns=PATH_PATTERNS)
+
+
+def points_columns(names: Sequence[str]) -> NameMap:
+    """The column stem of every joint and named point in ``points.csv`` (``<stem>_x``, ``_y``, ``_z``), by the
+    same rule as :func:`path_columns` (a stem never clashes with ``branch``, ``step`` or ``transmission``)."""
+    return csv_columns("points.csv", names, POINTS_FIXED, suffixes=("_x", "_y", "_z"))
 
 
 def _toml(reader: str) -> Any:

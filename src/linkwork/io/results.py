@@ -14,6 +14,7 @@ import numpy as np
 
 from linkwork.deprecation import trace_keyword
 from linkwork.io.readback import path_columns
+from linkwork.io.readback import points_columns as csv_stems
 from linkwork.io.writer import json_text, require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
@@ -220,7 +221,8 @@ def write_points_csv(trace: Trace, file: Path) -> None:
     mech = trace.mechanism
     joints, named = positions(mech, trace.angles)
     xyz = np.concatenate([joints, named], axis=1).reshape(len(trace.angles), -1)
-    header = ["branch", "step", *[f"{name}_{c}" for name in points_columns(mech) for c in "xyz"]]
+    stems = csv_stems(points_columns(mech))
+    header = ["branch", "step", *[f"{stems[name]}_{c}" for name in points_columns(mech) for c in "xyz"]]
     mu = transmission_angles(mech, joints)
     if mu is not None:
         header.append("transmission")

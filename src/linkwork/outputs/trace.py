@@ -31,12 +31,15 @@ def write_trace_outputs(
     first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
     (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
     ``viewer.html`` into ``out``, all or nothing. Returns the figures, animation and viewer written."""
-    from linkwork.io.readback import path_columns
+    from linkwork.io.readback import path_columns, points_columns
     from linkwork.io.results import write_path_csv, write_points_csv, write_report_json
+    from linkwork.kinematics.points import points_columns as position_names
     from linkwork.names import describe
 
     figures: list[Path] = []
-    renamed = describe(path_columns(trace.mechanism.joint_names))
+    renamed = describe(
+        path_columns(trace.mechanism.joint_names), points_columns(position_names(trace.mechanism))
+    )
     if renamed:
         console.print(renamed)
     with staged_output(out) as stage:
