@@ -272,6 +272,11 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
     manifest = Manifest.read(out)
     replaced = set(manifest.parts) if part == RUN else {part}
     stale = set().union(*(manifest.parts[p] for p in replaced if p in manifest.parts)) - set(names)
+    # first record the names about to move in (an interruption between two moves leaves only entries the
+    # manifest lists, which the next run may replace), then move
+    early = Manifest({k: set(v) for k, v in manifest.parts.items()}, set(manifest.files))
+    early.parts.setdefault(part, set()).update(names)
+    early.write(out)
     for name in names:
         target = out / name
         if target.is_dir() and not target.is_symlink():
