@@ -46,18 +46,22 @@ __all__ = [
 ]
 
 
-def read_text(path: Path, what: str) -> str:
-    """The UTF-8 text of ``path`` (at most :data:`MAX_FILE_BYTES`); a missing, unreadable, oversized, binary or
-    non-UTF-8 file is a :class:`SpecError` naming it and ``what`` was expected."""
+MAX_CSV_BYTES = 256 * 1024 * 1024
+"""The largest result table read back (256 MiB: a long trace of many branches writes tens of MiB)."""
+
+
+def read_text(path: Path, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:
+    """The UTF-8 text of ``path`` (at most ``max_bytes``); a missing, unreadable, oversized, binary or non-UTF-8
+    file is a :class:`SpecError` naming it and ``what`` was expected."""
     source = escape_line(str(path))
     expected = f"expected {what}"
     if not path.is_file():
         raise SpecError(f"{'is a folder' if path.is_dir() else 'file not found'}; {expected}", source=source)
     try:
         size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
+        if size > max_bytes:
             raise SpecError(
-                f"is {size} bytes, larger than the limit of {MAX_FILE_BYTES}; {expected}", source=source
+                f"is {size} bytes, larger than the limit of {max_bytes}; {expected}", source=source
             )
         text = path.read_bytes().decode("utf-8")
     except UnicodeDecodeError:
@@ -262,12 +266,13 @@ class CsvSchema:
     integers: tuple[str, ...] = ()
     texts: tuple[str, ...] = ()
     min_rows: int = 1
+    max_bytes: int = MAX_CSV_BYTES
 
     def read(self, path: Path, required: Iterable[str] = ()) -> CsvTable:
         """The checked rows of ``path``, with the columns ``fixed`` and ``required``; one :class:`SpecError`
         naming the file, the line and the column for any damage."""
         source = escape_line(str(path))
-        text = read_text(path, self.what)
+        text = read_text(path, self.what, self.max_bytes)
         if not text.endswith("\n"):  # linkwork ends every row with a line end: the file was cut off
             raise SpecError(
                 f"truncated (the last line has no line end); expected {self.what}",
