@@ -7,7 +7,6 @@ W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (10).
 
 from __future__ import annotations
 
-import html
 from pathlib import Path
 from typing import Annotated, NamedTuple
 
@@ -15,6 +14,7 @@ import typer
 from rich.text import Text
 
 from linkwork.cli.common import friendly_errors
+from linkwork.names import html_text
 from linkwork.outputs.staging import check_output_folder, console, staged_output
 
 
@@ -128,15 +128,14 @@ def _wing(out: Path, plots: bool) -> Section:
 
 def _mechanized_wing(out: Path, plots: bool) -> Section:
     """Part 4: the wing chain mechanized to one degree of freedom and verified by tracing."""
-    import json
-
+    from linkwork.io.readback import read_chain, read_mechanization
     from linkwork.outputs.synthesis import run_synthesis_example
 
     _heading("4. Mechanization: the wing chain brought to one degree of freedom (Sec. 7)")
     folder = out / "mechanism-wing"
     run_synthesis_example(folder, "wing", plots=plots, file="mechanize.toml")
-    report = json.loads((folder / "mechanization.json").read_text())
-    design = json.loads((folder / "chain.json").read_text())["design"]
+    report = read_mechanization(folder / "mechanization.json")
+    design = read_chain(folder / "chain.json")["design"]
     errors = ", ".join(f"{p['e_max']:.4f}" for p in report["profiles"])
     text = (
         f"The wing chain (design {design}) with binary links added by rigid-body "
@@ -172,23 +171,23 @@ def _write_index(out: Path, sections: list[Section]) -> None:
     for title, text, folder, figures in sections:
         rel = folder.relative_to(out)
         files = sorted(p.name for p in folder.iterdir() if p.is_file())
-        parts.append(f"<h2>{html.escape(title)}</h2><p>{html.escape(text)}</p>")
+        parts.append(f"<h2>{html_text(title)}</h2><p>{html_text(text)}</p>")
         if (folder / "viewer.html").is_file():
             hint = VIEWER_HINTS.get(str(rel), "drag the slider along the path")
             parts.append(
                 f"<p><a class='viewer' href='{rel}/viewer.html'>Open the interactive viewer</a> "
-                f"&nbsp;{html.escape(hint)}.</p>"
+                f"&nbsp;{html_text(hint)}.</p>"
             )
         parts.append("<p>files: ")
-        parts.append(", ".join(f"<a href='{rel}/{html.escape(f)}'>{html.escape(f)}</a>" for f in files))
+        parts.append(", ".join(f"<a href='{rel}/{html_text(f)}'>{html_text(f)}</a>" for f in files))
         parts.append("</p>")
         for fig in figures:
             if fig.endswith(".html") or (fig.endswith(".mp4") and fig[:-4] + ".gif" in figures):
                 continue  # the viewer has its own button; an MP4 next to its GIF is linked under "files"
-            src = f"{rel}/{html.escape(fig)}"
+            src = f"{rel}/{html_text(fig)}"
             if fig.endswith(".mp4"):
                 parts.append(f"<video src='{src}' controls loop muted></video>")
             else:
-                parts.append(f"<img src='{src}' alt='{html.escape(fig)}'>")
+                parts.append(f"<img src='{src}' alt='{html_text(fig)}'>")
     parts.append("</body></html>")
     (out / "index.html").write_text("\n".join(parts))

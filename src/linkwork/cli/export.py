@@ -11,10 +11,11 @@ import typer
 from linkwork.cli import help
 from linkwork.cli import options as opt
 from linkwork.cli.common import friendly_errors, parse_assignments
-from linkwork.outputs.staging import console
+from linkwork.outputs.staging import check_output_file, console
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
+    from linkwork.names import NameMap
 
 app = typer.Typer(
     cls=help.Group,
@@ -45,18 +46,20 @@ def stl(
     Parts are the links or rods and a pin on every joint; an STL has one `solid` per part, a 3MF one object."""
     from linkwork.errors import SpecError
     from linkwork.export.files import write_whole
-    from linkwork.export.solids import parts, write_3mf, write_stl
+    from linkwork.export.solids import parts, renamed_parts, write_3mf, write_stl
     from linkwork.export.trace_folder import read_trace_folder
 
     suffix = out.suffix.lower()
     if suffix not in (".stl", ".3mf"):
         raise SpecError(f"{out}: expected a file name ending in .stl or .3mf")
-    if not scale > 0.0:
-        raise SpecError(f"--scale: expected a positive factor, got {scale}")
+    if not 0.0 < scale < float("inf"):
+        raise SpecError(f"--scale: expected a positive finite factor, got {scale}")
+    check_output_file(out)
     folder = read_trace_folder(trace_dir)
     meshes = parts(folder.mechanism, folder.point(branch, point), scale)
     write_whole(out, lambda tmp: (write_3mf if suffix == ".3mf" else write_stl)(tmp, meshes))
     console.print(f"wrote {out}: {len(meshes)} parts (branch {branch}, point {point})")
+    _report_names(renamed_parts(meshes))
 
 
 @app.command("mjcf", cls=help.Command)
@@ -77,13 +80,16 @@ def mjcf(
     A body per link, hinges named after our joints, one weld closing each loop, a position actuator on the drive."""
     from linkwork.export.files import write_whole
     from linkwork.export.mjcf import mjcf as to_mjcf
+    from linkwork.export.mjcf import mjcf_names
 
+    check_output_file(out)
     mech, traced_drive = _mechanism(spec, set_)
     text = to_mjcf(mech, drive or traced_drive)
-    write_whole(out, lambda tmp: tmp.write_text(text))
+    write_whole(out, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     console.print(
         f"wrote {out}: {len(mech.bodies)} bodies, {mech.n_joints} joints, {len(mech.loops)} loop(s)"
     )
+    _report_names(*mjcf_names(mech))
 
 
 @app.command("dxf", cls=help.Command)
@@ -112,11 +118,12 @@ def dxf(
     from linkwork.export.trace_folder import read_trace_folder
     from linkwork.io.profiles import LENGTH_UNITS
 
+    check_output_file(out)
     path = Path(spec)
     if units is None and (path / "chain.json").is_file():
-        import json
+        from linkwork.io.readback import read_chain
 
-        units = json.loads((path / "chain.json").read_text()).get("units")
+        units = read_chain(path / "chain.json").get("units")
     if units is not None and units not in LENGTH_UNITS:
         raise SpecError(f"--units: expected one of {', '.join(LENGTH_UNITS)}, got {units!r}")
     if (path / "path.csv").is_file():
@@ -131,10 +138,9 @@ def dxf(
 
 def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None]:
     """The mechanism of SPEC (built-in, file or trace folder) and the drive the trace used, if any."""
-    import json
-
     from linkwork.errors import SpecError
     from linkwork.export.trace_folder import read_mechanism
+    from linkwork.io.readback import read_report
     from linkwork.io.spec import resolve_spec
 
     path = Path(spec)
@@ -146,6 +152,22 @@ def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None
         if set_:
             raise SpecError("--set applies to built-in linkages only, not to a trace folder", key="--set")
         report = path / "report.json"
-        drive = json.loads(report.read_text()).get("drive") if report.is_file() else None
-        return read_mechanism(path), drive
+        drive = read_report(report).get("drive") if report.is_file() else None
+        mech = read_mechanism(path)
+        if drive is not None and drive not in mech.joint_names:
+            raise SpecError(
+                f"expected one of the joints {', '.join(mech.joint_names)} of mechanism.toml, got {drive!r}",
+                source=str(report),
+                key="drive",
+            )
+        return mech, drive
     return resolve_spec(spec, parse_assignments(set_, "--set")).mechanism, None
+
+
+def _report_names(*maps: NameMap) -> None:
+    """Print the names the file format made us write differently (the name policy's report)."""
+    from linkwork.names import describe
+
+    line = describe(*maps)
+    if line:
+        console.print(line)

@@ -61,7 +61,10 @@ def mechanize(
     options = resolve_options(spec, flags)  # a bad flag stops here, before the synthesis is run again
     result = rerun_synthesis(folder, spec)
     target = out or folder
-    with staged_output(target) as stage, progress_bar("[bold]mechanizing[/]", None) as progress:
+    with (
+        staged_output(target, part="mechanize") as stage,
+        progress_bar("[bold]mechanizing[/]", None) as progress,
+    ):
         found, written = mechanize_into(
             result, stage, options=options, plots=not no_plots, progress=progress, html=html
         )

@@ -109,7 +109,10 @@ def synth(
         # the chain is on disk already: a mechanization that fails (exit 3) loses nothing of it
         from linkwork.outputs.mechanization import mechanize_into, print_mechanization
 
-        with staged_output(out) as stage, progress_bar("[bold]mechanizing[/]", None) as step:
+        with (
+            staged_output(out, part="mechanize") as stage,
+            progress_bar("[bold]mechanizing[/]", None) as step,
+        ):
             found, more = mechanize_into(
                 result, stage, options=options, plots=plots, progress=step, html=html
             )

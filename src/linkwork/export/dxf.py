@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 
 from linkwork.errors import SpecError
 from linkwork.io.profiles import new_dxf
+from linkwork.io.writer import require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.points import positions
 
@@ -26,7 +27,7 @@ def write_mechanism_dxf(
 ) -> None:
     """Write ``mech`` at joint values ``angles`` (radians) as a DXF drawing (see the module docstring)."""
     joints, _ = positions(mech, angles)
-    xyz = joints[0]
+    xyz = require_finite(joints[0], f"{mech.name}: the joints' positions")
     if np.ptp(xyz[:, 2]) > 1e-9 * max(float(np.ptp(xyz[:, :2])), 1.0):
         raise SpecError(f"{mech.name}: a DXF drawing needs a planar mechanism (every joint at one z)")
     xy = xyz[:, :2]

@@ -18,12 +18,13 @@ contacts), which also gives the bodies mass.
 from __future__ import annotations
 
 from collections import deque
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from linkwork.io.writer import require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.positions import joint_points
+from linkwork.names import MJCF_RESERVED, NameMap, xml_attribute, xml_names
 
 #: A weld's ``relpose`` that means "as at qpos0" to MuJoCo and pinocchio alike (the quaternion part all zeros).
 QPOS0_RELPOSE = "0 0 0 0 0 0 0"
@@ -61,10 +62,20 @@ def _vec(x: np.ndarray) -> str:
     return " ".join(f"{v:.12g}" for v in x)
 
 
-def _joint_xml(mech: Mechanism, j: int, points: np.ndarray, flip: bool) -> str:
+def mjcf_names(mech: Mechanism) -> tuple[NameMap, NameMap]:
+    """The MJCF names of the bodies (the cut bodies of :func:`cut_body` included) and of the joints: the name
+    policy's :func:`linkwork.names.xml_names` (MuJoCo's reserved ``world`` is mapped, characters XML forbids
+    replaced, every name unique); :func:`linkwork.names.describe` reports the changes."""
+    cuts = spanning_tree(mech)[2]
+    cut_names = [cut_body(mech.joint_bodies[j][0], mech.joint_names[j]) for j in cuts]
+    bodies = xml_names("MJCF body", [*mech.bodies, *cut_names], MJCF_RESERVED)
+    return bodies, xml_names("MJCF joint", mech.joint_names)
+
+
+def _joint_xml(mech: Mechanism, j: int, points: np.ndarray, flip: bool, joints: NameMap) -> str:
     """The MJCF joint of our joint ``j``; ``flip`` when the body it moves is the one *before* it."""
     sign = -1.0 if flip else 1.0
-    name = quoteattr(mech.joint_names[j])
+    name = xml_attribute(joints[mech.joint_names[j]])
     w, v = mech.twists[j, :3], mech.twists[j, 3:]
     if mech.joint_types[j] == "P":
         return f'<joint name={name} type="slide" pos="{_vec(points[j])}" axis="{_vec(sign * v)}"/>'
@@ -87,26 +98,27 @@ def _capsules(mech: Mechanism, body: str, points: np.ndarray, radius: float) -> 
 def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
     """The MJCF text of ``mech`` (see the module docstring); ``drive`` (default: the first joint) gets a position
     actuator."""
-    points = joint_points(mech)
+    points = require_finite(joint_points(mech), f"{mech.name}: the joints' positions")
+    require_finite(mech.twists, f"{mech.name}: the joints' axes")
     spread = np.linalg.norm(points - points.mean(axis=0), axis=1)
     radius = CAPSULE_RADIUS * float(np.median(spread[spread > 0])) if np.any(spread > 0) else 0.03
     root, children, cuts = spanning_tree(mech)
+    bodies, joints = mjcf_names(mech)
     lines: list[str] = []
 
     def emit(body: str, joint: int | None, depth: int) -> None:
         pad = " " * depth
-        lines.append(f'{pad}<body name={quoteattr(body)} pos="0 0 0">')
+        lines.append(f'{pad}<body name={xml_attribute(bodies[body])} pos="0 0 0">')
         if joint is not None:
-            lines.append(
-                pad + " " + _joint_xml(mech, joint, points, flip=mech.joint_bodies[joint][1] != body)
-            )
+            flip = mech.joint_bodies[joint][1] != body
+            lines.append(pad + " " + _joint_xml(mech, joint, points, flip, joints))
         lines.extend(pad + " " + g for g in _capsules(mech, body, points, radius))
         for j in cuts:
             if mech.joint_bodies[j][0] == body:
                 lines.append(
-                    f'{pad} <body name={quoteattr(cut_body(body, mech.joint_names[j]))} pos="0 0 0">'
+                    f'{pad} <body name={xml_attribute(bodies[cut_body(body, mech.joint_names[j])])} pos="0 0 0">'
                 )
-                lines.append(pad + "  " + _joint_xml(mech, j, points, flip=False))
+                lines.append(pad + "  " + _joint_xml(mech, j, points, False, joints))
                 lines.append(f'{pad}  <geom type="sphere" pos="{_vec(points[j])}" size="{radius:.6g}"/>')
                 lines.append(f"{pad} </body>")
         for j, child in children[body]:
@@ -115,15 +127,15 @@ def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
 
     emit(root, None, 4)
     welds = [
-        f"    <weld name={quoteattr('loop_' + mech.joint_names[j])} "
-        f"body1={quoteattr(cut_body(mech.joint_bodies[j][0], mech.joint_names[j]))} "
-        f'body2={quoteattr(mech.joint_bodies[j][1])} relpose="{QPOS0_RELPOSE}"/>'
+        f"    <weld name={xml_attribute('loop_' + joints[mech.joint_names[j]])} "
+        f"body1={xml_attribute(bodies[cut_body(mech.joint_bodies[j][0], mech.joint_names[j])])} "
+        f'body2={xml_attribute(bodies[mech.joint_bodies[j][1]])} relpose="{QPOS0_RELPOSE}"/>'
         for j in cuts
     ]
-    welds += _coupling_constraints(mech)
+    welds += _coupling_constraints(mech, joints)
     d = mech.index(drive if drive is not None else 0)
     head = [
-        f"<mujoco model={quoteattr(mech.name)}>",
+        f"<mujoco model={xml_attribute(mech.name)}>",
         "  <!-- written by linkwork: bodies at the world frame in the reference configuration; joint qpos is the",
         "       displacement from it (value - offset); one weld per loop closes it at a cut joint -->",
         '  <compiler angle="radian" autolimits="true"/>',
@@ -138,28 +150,28 @@ def mjcf(mech: Mechanism, drive: str | int | None = None) -> str:
         *welds,
         "  </equality>",
         "  <actuator>",
-        f'    <position name="drive" joint={quoteattr(mech.joint_names[d])} kp="1000" kv="50"/>',
+        f'    <position name="drive" joint={xml_attribute(joints[mech.joint_names[d]])} kp="1000" kv="50"/>',
         "  </actuator>",
         "</mujoco>",
     ]
     return "\n".join(head + lines + tail) + "\n"
 
 
-def _coupling_constraints(mech: Mechanism) -> list[str]:
+def _coupling_constraints(mech: Mechanism, joints: NameMap) -> list[str]:
     """``joint`` equality constraints for couplings (a coupled joint turns as the first of its group: equal
     displacements from the start) and fixed joints (held at the start)."""
     out = []
     for members in mech.group_members():
-        first = quoteattr(mech.joint_names[members[0]])
+        first = xml_attribute(joints[mech.joint_names[members[0]]])
         for j in members[1:]:
             out.append(
-                f"    <joint name={quoteattr('couple_' + mech.joint_names[j])} "
-                f'joint1={quoteattr(mech.joint_names[j])} joint2={first} polycoef="0 1 0 0 0"/>'
+                f"    <joint name={xml_attribute('couple_' + joints[mech.joint_names[j]])} "
+                f'joint1={xml_attribute(joints[mech.joint_names[j]])} joint2={first} polycoef="0 1 0 0 0"/>'
             )
     for k in np.flatnonzero(mech.groups < 0).tolist():
-        name = mech.joint_names[k]
+        name = joints[mech.joint_names[k]]
         out.append(
-            f'    <joint name={quoteattr("fixed_" + name)} joint1={quoteattr(name)} polycoef="0 0 0 0 0"/>'
+            f'    <joint name={xml_attribute("fixed_" + name)} joint1={xml_attribute(name)} polycoef="0 0 0 0 0"/>'
         )
     return out
 

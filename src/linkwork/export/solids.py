@@ -14,27 +14,46 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from linkwork.io.writer import require_finite
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.names import NameMap, stl_names, xml_attribute
 from linkwork.viz.solids import Mesh, posed_meshes
 
 
 def parts(mech: Mechanism, angles: ArrayLike, scale: float = 1.0) -> list[Mesh]:
     """Every body's solid, then a pin on every joint, at the joint values ``angles`` (radians), scaled."""
     T = np.diag([scale, scale, scale, 1.0])
-    return [mesh.transformed(T) for mesh in posed_meshes(mech, angles)]
+    meshes = [mesh.transformed(T) for mesh in posed_meshes(mech, angles)]
+    for mesh in meshes:
+        require_finite(
+            mesh.vertices, f"--scale {scale:g}: the solids' coordinates (the mechanism's lengths times it)"
+        )
+    return meshes
+
+
+def part_labels(meshes: Sequence[Mesh]) -> list[str]:
+    """The label of every part: the body's name, or ``pin_<joint>`` (two parts may share one)."""
+    return [f"pin_{m.name}" if m.kind == "pin" else m.name for m in meshes]
 
 
 def part_names(meshes: Sequence[Mesh]) -> list[str]:
-    """A unique name per part: the body's name, or ``pin_<joint>``."""
-    return [f"pin_{m.name}" if m.kind == "pin" else m.name for m in meshes]
+    """A unique STL solid name per part (:func:`linkwork.names.stl_names` of :func:`part_labels`): one word of
+    printable ASCII."""
+    return stl_names(part_labels(meshes))[0]
+
+
+def renamed_parts(meshes: Sequence[Mesh]) -> NameMap:
+    """The part labels written under another name in an STL (see :func:`part_names`)."""
+    return stl_names(part_labels(meshes))[1]
 
 
 def write_stl(file: str | Path, meshes: Sequence[Mesh]) -> None:
     """ASCII STL with one ``solid <name>`` per part (facet normals from the outward-oriented faces)."""
     out: list[str] = []
     for name, mesh in zip(part_names(meshes), meshes, strict=True):
-        tri = mesh.triangles
-        normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        tri = require_finite(mesh.triangles, "the STL's coordinates")
+        unit = tri / max(float(np.max(np.abs(tri), initial=0.0)), 1e-300)  # no overflow in the cross product
+        normals = np.cross(unit[:, 1] - unit[:, 0], unit[:, 2] - unit[:, 0])
         normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
         out.append(f"solid {name}")
         for n, (a, b, c) in zip(normals, tri, strict=True):
@@ -61,8 +80,6 @@ _RELS = """<?xml version="1.0" encoding="UTF-8"?>
 
 def write_3mf(file: str | Path, meshes: Sequence[Mesh]) -> None:
     """3MF (core specification): one ``object`` per part, every part a build item, unit millimetre."""
-    from xml.sax.saxutils import quoteattr
-
     body = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         '<model unit="millimeter" xml:lang="en-US" '
@@ -70,7 +87,8 @@ def write_3mf(file: str | Path, meshes: Sequence[Mesh]) -> None:
         "<resources>",
     ]
     for k, (name, mesh) in enumerate(zip(part_names(meshes), meshes, strict=True), start=1):
-        body.append(f'<object id="{k}" type="model" name={quoteattr(name)}><mesh><vertices>')
+        body.append(f'<object id="{k}" type="model" name={xml_attribute(name)}><mesh><vertices>')
+        require_finite(mesh.vertices, "the 3MF's coordinates")
         body += [f'<vertex x="{x:.9g}" y="{y:.9g}" z="{z:.9g}"/>' for x, y, z in mesh.vertices]
         body.append("</vertices><triangles>")
         body += [f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in mesh.faces]

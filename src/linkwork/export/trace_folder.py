@@ -3,8 +3,6 @@ traced joint values (``path.csv``), so that exports can rebuild any traced point
 
 from __future__ import annotations
 
-import csv
-import json
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -12,6 +10,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
+from linkwork.io.readback import read_drawing, read_path_csv
+from linkwork.io.toml_reader import show
 from linkwork.kinematics.mechanism import Mechanism
 
 
@@ -35,8 +35,13 @@ class TracedFolder:
         return self.angles[rows[point]]
 
 
+DRAWING_KEYS_FROM_SPEC = ("points",)
+"""Keys of ``drawing.json`` that ``mechanism.toml`` states (and that are taken from it, never from the drawing)."""
+
+
 def read_mechanism(folder: Path) -> Mechanism:
-    """The mechanism of a trace folder: ``mechanism.toml`` with the drawing parameters of ``drawing.json``."""
+    """The mechanism of a trace folder: ``mechanism.toml`` with the drawing parameters of ``drawing.json``
+    (both read through :mod:`linkwork.io.readback`: a damaged file is a :class:`SpecError` naming it)."""
     from linkwork.io.spec import load_spec
 
     spec = folder / "mechanism.toml"
@@ -46,31 +51,39 @@ def read_mechanism(folder: Path) -> Mechanism:
         )
     mech = load_spec(spec).mechanism
     drawing = folder / "drawing.json"
-    if drawing.is_file():
-        meta = json.loads(drawing.read_text())
-        if isinstance(meta, dict):
-            mech = replace(mech, meta={**meta, **mech.meta, "linkage": meta.get("linkage", "")})
+    if drawing.is_file() or drawing.is_symlink():
+        meta = {k: v for k, v in read_drawing(drawing).items() if k not in DRAWING_KEYS_FROM_SPEC}
+        for key, count in (("rods", mech.n_joints), ("n", mech.n_joints)):
+            given = meta.get(key)
+            if given is not None and (len(given) if isinstance(given, list) else given) != count:
+                raise SpecError(
+                    f"expected {count} (one per joint of mechanism.toml), got {show(given)}",
+                    source=str(drawing),
+                    key=key,
+                )
+        transmission = meta.get("transmission")
+        if transmission and any(j not in mech.joint_names for j in transmission["joints"]):
+            raise SpecError(
+                f"names joints {transmission['joints']} that mechanism.toml does not have",
+                source=str(drawing),
+                key="transmission.joints",
+            )
+        mech = replace(mech, meta={**meta, **mech.meta, "linkage": meta.get("linkage", "")})
     return mech
 
 
 def read_trace_folder(folder: str | Path) -> TracedFolder:
-    """Read a ``linkwork trace --out`` folder (``mechanism.toml``, ``drawing.json``, ``path.csv``)."""
+    """Read a ``linkwork trace --out`` folder (``mechanism.toml``, ``drawing.json``, ``path.csv``), every file
+    checked against its schema (:data:`linkwork.io.readback.SCHEMAS`)."""
     folder = Path(folder)
     if not folder.is_dir():
         raise SpecError(f"{folder}: expected a folder written by `linkwork trace --out`")
     mech = read_mechanism(folder)
-    with open(folder / "path.csv", newline="") as fh:
-        rows = list(csv.reader(fh))
-    header, body = rows[0], rows[1:]
-    missing = [n for n in mech.joint_names if n not in header]
-    if missing or not body:
-        raise SpecError(
-            f"{folder / 'path.csv'}: expected columns branch, step and {', '.join(mech.joint_names)}"
-        )
-    cols = [header.index(n) for n in mech.joint_names]
-    values = np.array([[float(r[c]) for c in cols] for r in body])
+    table, columns = read_path_csv(folder / "path.csv", mech.joint_names)
+    cols = [table.header.index(c) for c in columns]
+    values = np.array([[row[c] for c in cols] for row in table.rows], dtype=float).reshape(-1, len(cols))
     revolute = np.array([t == "R" for t in mech.joint_types])
     values[:, revolute] = np.radians(values[:, revolute])
-    branch = np.array([int(r[header.index("branch")]) for r in body], dtype=np.int64)
-    step = np.array([int(r[header.index("step")]) for r in body], dtype=np.int64)
+    branch = np.array(table.column("branch"), dtype=np.int64)
+    step = np.array(table.column("step"), dtype=np.int64)
     return TracedFolder(mechanism=mech, angles=values, branch=branch, step=step)

@@ -7,13 +7,14 @@ down, so every SVG coordinate written here has its y negated.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
 
 from linkwork.io.curves import Points, bounding_size
+from linkwork.io.writer import require_finite
+from linkwork.names import xml_text
 from linkwork.units import LENGTH_UNITS
 
 __all__ = ["LENGTH_UNITS", "new_dxf", "svg_d", "svg_document", "svg_path", "xml_escape"]
@@ -38,7 +39,9 @@ def svg_document(
     """An SVG document whose viewBox holds every point of ``extents`` (profile coordinates, y up); with ``units``
     (a key of :data:`LENGTH_UNITS`) its width and height are the drawing's true size in that unit, else
     ``pixels`` across."""
-    everything = np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents])
+    everything = require_finite(
+        np.vstack([np.asarray(e, dtype=float).reshape(-1, 2) for e in extents]), "the drawing's coordinates"
+    )
     lo, hi = everything.min(axis=0), everything.max(axis=0)
     margin = 0.05 * bounding_size(everything)
     x0, y0 = lo[0] - margin, -hi[1] - margin
@@ -58,16 +61,9 @@ def svg_document(
 
 
 def xml_escape(text: str) -> str:
-    """``text`` as XML character data or attribute value: markup characters escaped, characters XML 1.0 does
-    not allow (control characters but tab, line feed and carriage return) replaced by U+FFFD."""
-    text = re.sub("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]", "\ufffd", text)
-    return (
-        text.replace("&", "&amp;")
-        .replace("<", "&lt;")
-        .replace(">", "&gt;")
-        .replace('"', "&quot;")
-        .replace("'", "&apos;")
-    )
+    """``text`` as XML character data or attribute value (the name policy's :func:`linkwork.names.xml_text`):
+    markup characters escaped, characters XML 1.0 does not allow replaced by U+FFFD."""
+    return xml_text(text)
 
 
 def new_dxf(units: str | None = None) -> Any:

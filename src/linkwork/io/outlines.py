@@ -14,6 +14,7 @@ import numpy as np
 
 from linkwork.io.curves import bounding_size
 from linkwork.io.drawing import new_dxf, svg_d, svg_document, svg_path, xml_escape
+from linkwork.names import dxf_layers
 
 if TYPE_CHECKING:
     from linkwork.synthesis.result import JoinedProfile, SynthesisResult
@@ -94,27 +95,14 @@ def _live_joints(result: SynthesisResult) -> list[int]:
 _OUTLINE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b")
 
 
-def _dxf_layer_name(name: str) -> str:
-    """A DXF layer name: the characters DXF forbids in one (``<>/\\":;?*|=```) and control characters become
-    underscores, leading and trailing spaces go."""
-    cleaned = "".join("_" if ch in _DXF_FORBIDDEN or ord(ch) < 32 or ord(ch) == 127 else ch for ch in name)
-    return cleaned.strip()[:200] or "profile"
-
-
 def _dxf_layer_names(names: Sequence[str]) -> list[str]:
-    """One distinct layer name per profile: DXF layer names ignore case, and :func:`_dxf_layer_name` can map two
-    names onto one, so a repeat gets ``-2``, ``-3``, ... appended."""
-    out: list[str] = []
+    """One distinct layer name per profile (the name policy's :func:`linkwork.names.dxf_layers`: the characters
+    DXF forbids become ``_``, and since DXF layer names ignore case a repeat gets ``_2``, ``_3``, ...); a profile
+    without a name is ``profile``."""
+    layers: list[str] = []
     taken: set[str] = set()
     for name in names:
-        base = candidate = _dxf_layer_name(name)
-        number = 1
-        while candidate.casefold() in taken:
-            number += 1
-            candidate = f"{base}-{number}"
-        taken.add(candidate.casefold())
-        out.append(candidate)
-    return out
-
-
-_DXF_FORBIDDEN = frozenset('<>/\\":;?*|=`')
+        layer = dxf_layers([name or "profile"], taken=taken)[name or "profile"]
+        taken.add(layer)
+        layers.append(layer)
+    return layers

@@ -7,7 +7,6 @@ Angles are written in degrees (prismatic joints in length units); the column and
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +14,9 @@ import numpy as np
 
 from linkwork.deprecation import trace_keyword
 from linkwork.io.deployment_report import deployment_entry
+from linkwork.io.readback import path_columns
+from linkwork.io.readback import points_columns as csv_stems
+from linkwork.io.writer import json_text, require_finite
 from linkwork.kinematics.deployment import Deployment
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
@@ -36,8 +38,10 @@ def _display(trace: Trace, values: np.ndarray) -> np.ndarray:
 
 @trace_keyword
 def path_rows(trace: Trace) -> tuple[list[str], list[list[Any]]]:
-    """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual``."""
-    names = list(trace.mechanism.joint_names)
+    """Header and rows of ``path.csv``: ``branch,step,s,<joints>,sigma_1..sigma_k,residual`` (a joint whose name
+    is one of the fixed columns is written ``joint:<name>``, :func:`linkwork.io.readback.path_columns`)."""
+    columns = path_columns(trace.mechanism.joint_names)
+    names = [columns[n] for n in trace.mechanism.joint_names]
     k = trace.sigma.shape[1]
     header = ["branch", "step", "s", *names, *[f"sigma_{i + 1}" for i in range(k)], "residual"]
     angles = _display(trace, trace.angles)
@@ -61,7 +65,8 @@ def path_rows(trace: Trace) -> tuple[list[str], list[list[Any]]]:
 def write_path_csv(trace: Trace, file: Path) -> None:
     """Write ``path.csv`` (floats with 17 significant digits, so nothing is lost)."""
     header, rows = path_rows(trace)
-    with open(file, "w", newline="") as fh:
+    require_finite([[v for v in row if isinstance(v, float)] for row in rows], "path.csv: the traced values")
+    with open(file, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
         for row in rows:
@@ -228,9 +233,7 @@ def write_report_json(
     trace: Trace, file: Path, assembly: Any | None = None, deployment: Deployment | None = None
 ) -> None:
     """Write ``report.json``."""
-    with open(file, "w") as fh:
-        json.dump(report_dict(trace, assembly, deployment), fh, indent=2)
-        fh.write("\n")
+    Path(file).write_text(json_text(report_dict(trace, assembly, deployment)), encoding="utf-8")
 
 
 @trace_keyword
@@ -243,12 +246,14 @@ def write_points_csv(trace: Trace, file: Path) -> None:
     mech = trace.mechanism
     joints, named = positions(mech, trace.angles)
     xyz = np.concatenate([joints, named], axis=1).reshape(len(trace.angles), -1)
-    header = ["branch", "step", *[f"{name}_{c}" for name in points_columns(mech) for c in "xyz"]]
+    stems = csv_stems(points_columns(mech))
+    header = ["branch", "step", *[f"{stems[name]}_{c}" for name in points_columns(mech) for c in "xyz"]]
     mu = transmission_angles(mech, joints)
     if mu is not None:
         header.append("transmission")
         xyz = np.column_stack([xyz, np.degrees(mu)])
-    with open(file, "w", newline="") as fh:
+    require_finite(xyz, "points.csv: the positions")
+    with open(file, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(header)
         for b, s, row in zip(trace.branch, trace.step, xyz, strict=True):

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import json
 import shutil
-import tomllib
 from pathlib import Path, PurePosixPath
 from typing import Any
+
+from linkwork.io.toml_reader import read_toml
 
 #: The problem file's name inside the copy.
 PROBLEM_FILE = "problem.toml"
@@ -37,8 +38,7 @@ def copy_problem(problem_file: str | Path, folder: str | Path) -> list[Path]:
     source = Path(problem_file)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    with source.open("rb") as handle:
-        table = tomllib.load(handle)
+    table = read_toml(source, "a problem file (TOML)")  # the one checked TOML reader
     profiles = [str(name) for name in table.get("profiles", [])]
     written: list[Path] = []
     if all(_plain(name) for name in profiles):

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from linkwork.io.writer import json_text
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.progress import Progress
 from linkwork.studies.robustness import (
@@ -108,7 +108,7 @@ def run_and_write_robustness(
         with SampleWriter(stage / "samples.parquet", setup.drive_values, mech.joint_types[drive] == "R") as w:
             result = run_study(setup, samples, ratio_paper, sink=w.write, progress=progress, **(engine or {}))
         summary = robustness_dict(result, source)
-        (stage / "robustness.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+        (stage / "robustness.json").write_text(json_text(summary), encoding="utf-8")
         if plots:
             if have_matplotlib():
                 from linkwork.viz.robustness_plots import write_robustness_figures

@@ -4,10 +4,12 @@ robustness figures one folder per grid point."""
 from __future__ import annotations
 
 import csv
-import json
+import math
 from pathlib import Path
 from typing import Any
 
+from linkwork.io.writer import json_text
+from linkwork.names import COLUMN_PREFIX
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.study_file import Study
 
@@ -30,12 +32,20 @@ def columns_of(rows: list[dict[str, Any]], study: Study) -> list[str]:
     return [*study.grid, *sorted(seen, key=lambda k: (group(k), seen.index(k))), "error"]
 
 
+def _value(value: Any) -> Any:
+    """A cell as written: a computed number that is not finite (undefined at that grid point) is missing (an
+    empty CSV cell, a Parquet null), never ``nan`` or ``inf``."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def write_table(rows: list[dict[str, Any]], cols: list[str], parquet: Path, csv_file: Path) -> None:
     """One row per grid point in both formats; missing values are empty (CSV) or null (Parquet)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    data = {c: [row.get(c) for row in rows] for c in cols}
+    data = {c: [_value(row.get(c)) for row in rows] for c in cols}
     arrays = {}
     for c, values in data.items():
         try:
@@ -47,7 +57,7 @@ def write_table(rows: list[dict[str, Any]], cols: list[str], parquet: Path, csv_
         writer = csv.writer(fh)
         writer.writerow(cols)
         for row in rows:
-            writer.writerow(["" if row.get(c) is None else row.get(c) for c in cols])
+            writer.writerow(["" if _value(row.get(c)) is None else row.get(c) for c in cols])
 
 
 def write_sweep_outputs(
@@ -74,9 +84,7 @@ def write_sweep_outputs(
                 folder.mkdir(parents=True)
                 summary = robustness_dict(res, study.target)
                 summary["parameters"] = {k: rows[i].get(k) for k in study.grid}
-                (folder / "robustness.json").write_text(
-                    json.dumps(summary, indent=2) + "\n", encoding="utf-8"
-                )
+                (folder / "robustness.json").write_text(json_text(summary), encoding="utf-8")
                 write_robustness_figures(res, summary, folder)
         elif plots:
             console.print("figures skipped: install the plotting extra, pip install 'linkwork[viz]'")
@@ -97,6 +105,12 @@ def print_sweep_summary(study: Study, rows: list[dict[str, Any]]) -> None:
     console.print(table)
     if len(rows) > 30:
         console.print(f"... {len(rows) - 30} more rows in sweep.csv")
+    prefixed = sorted({c[: -len("_min")] for c in cols if c.startswith(COLUMN_PREFIX) and c.endswith("_min")})
+    if prefixed:
+        console.print(
+            "names changed for the file formats: sweep.csv: joints whose columns would clash with fixed ones are "
+            "written " + ", ".join(f"{c}_min, {c}_max" for c in prefixed)
+        )
 
 
 _HEADLINE = (

@@ -19,7 +19,7 @@ from rich.text import Text
 
 from linkwork.data import example
 from linkwork.errors import SpecError
-from linkwork.io.toml_reader import MAX_FILE_BYTES, escape_line, show
+from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 
 if TYPE_CHECKING:
@@ -37,12 +37,15 @@ def write_synthesis_outputs(result: SynthesisResult, folder: Path, *, plots: boo
     :func:`linkwork.viz.synthesis_plots.write_synthesis_figures`.
     """
     from linkwork.io.profiles import write_outline_dxf, write_outline_svg
+    from linkwork.io.writer import require_finite
     from linkwork.synthesis import write_target_profiles_csv
 
     folder.mkdir(parents=True, exist_ok=True)
     chain = folder / "chain.json"
     chain.write_text(json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n", encoding="utf-8")
     targets = folder / "target_profiles.csv"
+    for target in result.targets:
+        require_finite(target.points, f"target profile {show(target.name)}: its points")
     write_target_profiles_csv(result.targets, targets)
     write_outline_svg(folder / "outline.svg", result)
     write_outline_dxf(folder / "outline.dxf", result)
@@ -135,32 +138,12 @@ def rerun_synthesis(folder: Path, spec: Problem) -> SynthesisResult:
 
 
 def _read_chain_json(chain_file: Path) -> tuple[str, float]:
-    """``(design, joined E_max)`` of a ``chain.json``; anything else than the contract is a :class:`SpecError`."""
-    expected = "expected the chain.json that `linkwork synth` writes"
-    if chain_file.stat().st_size > MAX_FILE_BYTES:
-        raise SpecError(f"larger than {MAX_FILE_BYTES} bytes; {expected}", source=str(chain_file))
-    try:
-        saved = json.loads(chain_file.read_bytes().decode("utf-8"))
-    except UnicodeDecodeError:
-        raise SpecError(f"not a UTF-8 text file; {expected}", source=str(chain_file)) from None
-    except (ValueError, RecursionError) as exc:
-        raise SpecError(
-            f"not valid JSON ({escape_line(str(exc))}); {expected}", source=str(chain_file)
-        ) from None
-    if not isinstance(saved, dict):
-        raise SpecError(f"holds {show(saved)}, not an object; {expected}", source=str(chain_file))
-    design = saved.get("design")
-    if not isinstance(design, str):
-        raise SpecError(
-            f"expected a design vector string, got {show(design)}", source=str(chain_file), key="design"
-        )
-    joined = saved.get("joined")
-    if not isinstance(joined, dict):
-        raise SpecError(f"expected an object, got {show(joined)}", source=str(chain_file), key="joined")
-    e_max = joined.get("e_max")
-    if isinstance(e_max, bool) or not isinstance(e_max, int | float):
-        raise SpecError(f"expected a number, got {show(e_max)}", source=str(chain_file), key="joined.e_max")
-    return design, float(e_max)
+    """``(design, joined E_max)`` of a ``chain.json``, read through its schema
+    (:data:`linkwork.io.readback.SCHEMAS`): anything else than the contract is a :class:`SpecError`."""
+    from linkwork.io.readback import read_chain
+
+    saved = read_chain(chain_file)
+    return saved["design"], float(saved["joined"]["e_max"])
 
 
 def _table(title: str) -> Table:

@@ -4,7 +4,7 @@ summary."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from linkwork.deprecation import trace_keyword
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
@@ -34,9 +34,17 @@ def write_trace_outputs(
     (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
     ``viewer.html`` into ``out``, all or nothing; ``deployment`` (default ``trace.deployment()``) goes into
     report.json and ``stretch.png``. Returns the figures, animation and viewer written."""
+    from linkwork.io.readback import path_columns, points_columns
     from linkwork.io.results import write_path_csv, write_points_csv, write_report_json
+    from linkwork.kinematics.points import points_columns as position_names
+    from linkwork.names import describe
 
     figures: list[Path] = []
+    renamed = describe(
+        path_columns(trace.mechanism.joint_names), points_columns(position_names(trace.mechanism))
+    )
+    if renamed:
+        console.print(renamed)
     with staged_output(out) as stage:
         write_path_csv(trace, stage / "path.csv")
         write_report_json(trace, stage / "report.json", assembly, deployment)
@@ -69,25 +77,11 @@ def write_trace_mechanism(mech: Mechanism, folder: Path) -> None:
     """Write what rebuilds the traced mechanism next to its path: ``mechanism.toml`` (a spec file, read back by
     ``linkwork trace`` and ``linkwork export``) and ``drawing.json`` (the constructor's parameters, which choose
     how its solids are drawn: Hedgepeth's and Guest's rods)."""
-    import json
-
     from linkwork.io.spec import dump_spec
+    from linkwork.io.writer import json_text
 
     (folder / "mechanism.toml").write_text(dump_spec(mech))
-    (folder / "drawing.json").write_text(json.dumps(_plain(dict(mech.meta)), indent=1) + "\n")
-
-
-def _plain(value: Any) -> Any:
-    """``value`` with numpy scalars and arrays turned into JSON numbers and lists."""
-    import numpy as np
-
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
+    (folder / "drawing.json").write_text(json_text(dict(mech.meta), indent=1), encoding="utf-8")
 
 
 @trace_keyword

@@ -9,12 +9,14 @@ path ended (and the misfit percentiles with ``[robustness]``); for a synthesis t
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.names import NameMap, csv_columns
 from linkwork.progress import Progress
 from linkwork.studies.engine import map_chunks
 from linkwork.studies.study_file import Study
@@ -27,6 +29,33 @@ def _until_api(mech: Any, until: tuple[str, float] | None) -> tuple[str, float] 
         return None
     j = mech.index(until[0])
     return until[0], float(np.radians(until[1]) if mech.joint_types[j] == "R" else until[1])
+
+
+SWEEP_FIXED = (
+    "mobility",
+    "points",
+    "bifurcations",
+    "ratio_max",
+    "end",
+    "error",
+    "misfit_p50",
+    "misfit_p95",
+    "first_order_p50",
+    "mobility_kept",
+    "length_scale",
+    "design",
+    "segment_count",
+    "e_max",
+    "e_mean",
+)
+"""The fixed columns of ``sweep.csv`` (besides the grid parameters and ``<joint>_min``, ``<joint>_max``)."""
+
+
+def joint_columns(joints: Sequence[str], grid: Iterable[str] = ()) -> NameMap:
+    """The column stem of every joint in ``sweep.csv`` (``<stem>_min``, ``<stem>_max``): the joint's name, or
+    ``joint:<name>`` when a column would clash with a fixed one or a grid parameter (``ratio`` gives
+    ``joint:ratio_max``; :func:`linkwork.names.csv_columns`)."""
+    return csv_columns("sweep.csv", joints, {*SWEEP_FIXED, *grid}, suffixes=("_min", "_max"))
 
 
 def linkage_point(study: Study, index: int) -> tuple[Row, Any]:
@@ -51,10 +80,11 @@ def linkage_point(study: Study, index: int) -> tuple[Row, Any]:
         return row, None
     row["mobility"] = int(path.mobility[0])
     row["points"] = int(path.angles.shape[0])
+    stems = joint_columns(mech.joint_names, study.grid)
     for j, name in enumerate(mech.joint_names):
         deg = np.degrees(path.angles[:, j]) if mech.joint_types[j] == "R" else path.angles[:, j]
-        row[f"{name}_min"] = float(deg.min())
-        row[f"{name}_max"] = float(deg.max())
+        row[f"{stems[name]}_min"] = float(deg.min())
+        row[f"{stems[name]}_max"] = float(deg.max())
     row["bifurcations"] = len(path.bifurcations)
     row["ratio_max"] = float(path.max_condition_raw)  # the paper's Sec. 5 ratio, raw
     row["end"] = path.branches[0].end_reason if path.branches else ""

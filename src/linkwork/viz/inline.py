@@ -7,8 +7,9 @@ profile's name) can leave the attribute. The frame is sandboxed: its scripts run
 
 from __future__ import annotations
 
-import html
 from typing import TYPE_CHECKING
+
+from linkwork.names import html_text
 
 if TYPE_CHECKING:
     from linkwork.kinematics.trace_result import Trace
@@ -21,7 +22,7 @@ HEIGHT = 620
 def iframe(page: str, *, title: str, height: int = HEIGHT) -> str:
     """An ``<iframe>`` element showing the HTML document ``page``."""
     return (
-        f'<iframe srcdoc="{html.escape(page, quote=True)}" title="{html.escape(title, quote=True)}" '
+        f'<iframe srcdoc="{html_text(page)}" title="{html_text(title)}" '
         f'sandbox="allow-scripts" style="width: 100%; height: {int(height)}px; border: 1px solid #ddd;">'
         "</iframe>"
     )
@@ -51,7 +52,7 @@ def trace_html(trace: Trace) -> str:
         len(page) > INLINE_BYTES
     ):  # the solids alone are too large (a hoop of many rods): say so, in a few lines
         return (
-            f"<pre>{html.escape(repr(trace))}</pre><p>The interactive viewer of this linkage is "
+            f"<pre>{html_text(repr(trace))}</pre><p>The interactive viewer of this linkage is "
             f"{len(page) // 1000} kB even with its path thinned to {points} points, too large to embed: write it "
             "with <code>linkwork.viz.viewer.write_trace_viewer(trace, 'viewer.html')</code> or "
             "<code>linkwork trace --html</code>.</p>"

@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 import re
 
+from linkwork.names import mathtext
+
 __all__ = ["number", "plain", "plain_log_ticks", "subscript"]
 
 
@@ -27,8 +29,9 @@ def number(value: float, fmt: str = ".4g", *, scale: float = 1.0) -> str:
 
 
 def plain(text: str) -> str:
-    """``text`` drawn literally by matplotlib: each ``$`` escaped as ``\\$`` (mathtext never starts)."""
-    return text.replace("$", r"\$")
+    """``text`` drawn literally by matplotlib: each ``$`` escaped as ``\\$`` (mathtext never starts); the name
+    policy's :func:`linkwork.names.mathtext`."""
+    return mathtext(text)
 
 
 def subscript(symbol: str, name: str) -> str:

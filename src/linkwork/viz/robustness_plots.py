@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from linkwork.viz.labels import plain_log_ticks
+from linkwork.viz.labels import plain, plain_log_ticks
 
 if TYPE_CHECKING:  # a type only: viz sits below studies
     from linkwork.studies.robustness import RobustnessResult
@@ -47,10 +47,10 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
         ax.set_ylim(bottom=10.0 ** (np.floor(np.log10(top)) - 4.0), top=top * 2.0)
     unit = "deg" if key == "drive_deg" else "length unit"
     if monotonic:
-        ax.set_xlabel(f"drive {summary['drive']} ({unit})")
+        ax.set_xlabel(f"drive {plain(str(summary['drive']))} ({unit})")
     else:
         ax.set_xlabel(
-            f"point along the nominal path (count), drive {summary['drive']} between {drive.min():.4g} and "
+            f"point along the nominal path (count), drive {plain(str(summary['drive']))} between {drive.min():.4g} and "
             f"{drive.max():.4g} {unit}"
         )
     ax.set_ylabel(f"closure misfit (length units, L = {summary['scale']['length']:.3g})")
@@ -72,7 +72,7 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     fig.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="outside lower center", ncol=4)
     tol = summary["tolerances"]
     ax.set_title(
-        f"{summary['linkage']}: {summary['samples']} samples, hinges within {tol['hinge_position']:g} and "
+        f"{plain(str(summary['linkage']))}: {summary['samples']} samples, hinges within {tol['hinge_position']:g} and "
         f"{tol['hinge_direction_deg']:g} deg ({tol['distribution']}, {tol['errors']})",
         fontsize=10,
     )
@@ -111,7 +111,8 @@ def plot_histogram(result: RobustnessResult, summary: dict[str, Any], file: Path
     ax.set_ylabel("samples (count)")
     kept = summary["mobility_kept"]
     ax.set_title(
-        f"{summary['linkage']}: mobility kept by {100.0 * (kept or 0.0):.1f} % of samples", fontsize=10
+        f"{plain(str(summary['linkage']))}: mobility kept by {100.0 * (kept or 0.0):.1f} % of samples",
+        fontsize=10,
     )
     ax.legend(fontsize=8)
     fig.savefig(file, dpi=120)

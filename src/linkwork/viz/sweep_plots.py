@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from linkwork.viz.labels import plain
+
 if TYPE_CHECKING:  # a type only: viz sits below studies
     from linkwork.studies.study_file import Study
 
@@ -64,7 +66,7 @@ def parameter_label(study: Study, name: str) -> str:
         unit = PARAM_UNITS.get(param.unit) if param is not None else None
     else:
         unit = SETTING_UNITS.get(name)
-    return f"{name} ({unit or '-'})"
+    return f"{plain(name)} ({unit or '-'})"
 
 
 def _numeric(rows: list[dict[str, Any]], key: str) -> np.ndarray:
@@ -95,7 +97,7 @@ def plot_lines(study: Study, rows: list[dict[str, Any]], metric: str, file: Path
             mask = np.array([k == key for k in keys])
             order = np.argsort(x[mask])
             label = ", ".join(
-                f"{q}={v:g}" if isinstance(v, int | float) else f"{q}={v}"
+                f"{plain(q)}={v:g}" if isinstance(v, int | float) else f"{plain(q)}={plain(str(v))}"
                 for q, v in zip(others, key, strict=True)
             )
             ax.plot(x[mask][order], y[mask][order], "o-", ms=3, label=label or None)
@@ -103,7 +105,7 @@ def plot_lines(study: Study, rows: list[dict[str, Any]], metric: str, file: Path
         ax.set_ylabel(metric_label(metric))
         if others and len(set(keys)) <= 8:
             ax.legend(fontsize=7)
-    fig.suptitle(f"{study.name}: {METRICS[metric]}", fontsize=10)
+    fig.suptitle(f"{plain(study.name)}: {METRICS[metric]}", fontsize=10)
     fig.savefig(file, dpi=110)
     plt.close(fig)
     return file
@@ -126,7 +128,7 @@ def plot_heatmap(study: Study, rows: list[dict[str, Any]], metric: str, file: Pa
     ax.set_xlabel(parameter_label(study, q))
     ax.set_ylabel(parameter_label(study, p))
     fig.colorbar(im, ax=ax, label=metric_label(metric))
-    ax.set_title(f"{study.name}: {METRICS[metric]}", fontsize=10)
+    ax.set_title(f"{plain(study.name)}: {METRICS[metric]}", fontsize=10)
     fig.savefig(file, dpi=110)
     plt.close(fig)
     return file

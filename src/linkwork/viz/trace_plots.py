@@ -179,9 +179,9 @@ def plot_points(trace: Trace, file: Path) -> Path:
     ax = axes[0, 0]
     for j, name in enumerate(mech.joint_names):
         ax.plot(joints[:, j, 0], joints[:, j, 1], lw=0.8, color="0.6")
-        ax.annotate(name, joints[0, j, :2], fontsize=8)
+        ax.annotate(plain(name), joints[0, j, :2], fontsize=8)
     for k, point in enumerate(named_points(mech)):
-        ax.plot(named[:, k, 0], named[:, k, 1], lw=1.6, label=f"{point['name']} (on {point['body']})")
+        ax.plot(named[:, k, 0], named[:, k, 1], lw=1.6, label=plain(f"{point['name']} (on {point['body']})"))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (length unit of the mechanism)")
     ax.set_ylabel("y (length unit of the mechanism)")
@@ -195,12 +195,12 @@ def plot_points(trace: Trace, file: Path) -> Path:
             mask = trace.of_branch(br.id)
             axes[0, 1].plot(np.degrees(trace.angles[mask, d]), np.degrees(mu[mask]), lw=1.4)
         axes[0, 1].axhline(40.0, color="k", lw=0.8, ls="--", label="40 deg, a common lower limit")
-        axes[0, 1].set_xlabel(f"θ{trace.drive} (deg)")
+        axes[0, 1].set_xlabel(f"θ{plain(str(trace.drive))} (deg)")
         axes[0, 1].set_ylabel("transmission angle (deg)")
         axes[0, 1].set_title("transmission angle", fontsize=10)
         axes[0, 1].legend(fontsize=8)
         axes[0, 1].grid(alpha=0.3)
-    fig.suptitle(f"{mech.name}: positions", fontsize=10)
+    fig.suptitle(f"{plain(mech.name)}: positions", fontsize=10)
     fig.savefig(file, dpi=120)
     fig.savefig(Path(file).with_suffix(".svg"))
     plt.close(fig)

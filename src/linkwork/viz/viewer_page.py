@@ -9,7 +9,6 @@ style and the scripts are inlined, and the data is JSON with the bulky arrays as
 from __future__ import annotations
 
 import base64
-import html
 import json
 import re
 from dataclasses import dataclass
@@ -19,6 +18,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from linkwork.names import html_text
 
 __all__ = ["DATA_ID", "script_json", "unpack"]
 
@@ -59,7 +60,7 @@ def page_html(viewer: ViewerAssets, data: dict[str, Any]) -> str:
     from linkwork.version import __version__
 
     values = {
-        "TITLE": html.escape(data["title"]),
+        "TITLE": html_text(data["title"]),
         "CSS": _asset("viewer.css"),
         "DATA": script_json(data),
         "JS": "\n".join(_asset(s) for s in viewer.scripts).replace("</script", "<\\/script"),

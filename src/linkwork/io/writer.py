@@ -1,0 +1,383 @@
+"""The one writer of every output: output folders (:func:`staged_output`) and single files (:func:`write_file`).
+
+The rules every command inherits by writing through here:
+
+- **Ownership.** linkwork never replaces or deletes what it did not write. What it wrote into a folder is listed in
+  that folder's :data:`MANIFEST` (``.linkwork-manifest.json``): the entries of each *run* (``trace``, ``synth``
+  ...), and the single files written there (``export stl -o mine.stl`` records ``mine.stl`` in the manifest of
+  ``mine.stl``'s folder). An existing entry not listed there stops the command (exit 2) naming it.
+- **A run replaces its own earlier results as a whole.** The entries an earlier run wrote into the folder and this
+  run does not write are removed, so no stale file (an old ``viewer.html``) stays behind. A *part* of a run (the
+  mechanization a ``synth`` run adds, ``linkwork mechanize`` into a synth folder) replaces only the entries of the
+  same part. Single files are never removed by a run.
+- **No writing through symbolic links.** An entry to be written that is a symbolic link is refused (even if it is
+  listed: linkwork never writes links); the manifest and every file are written to new files and renamed into
+  place, so a link planted under a name linkwork uses is replaced, never followed.
+- **All or nothing.** Files are written into a staging folder (a temporary file for a single file) beside the
+  destination and moved into place only when all were written; the staging is removed on every exit path (an
+  error, Ctrl-C, SIGTERM, SIGHUP).
+- **Errors name the user's path.** A folder that cannot be written, a full disk or a file-size limit is one line
+  naming the ``--out`` given, never a staging file: exit 2 when the place cannot be written at all, exit 3 when
+  writing failed part way (nothing is left behind).
+- **Finite numbers.** :func:`require_finite` is the one check that every number a writer puts in a file is finite
+  (``--scale inf``, or lengths overflowing to infinity, are refused with exit 2 before anything is written).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import os
+import shutil
+import signal
+import tempfile
+import threading
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.io.toml_reader import escape_line, show
+
+__all__ = [
+    "MANIFEST",
+    "Manifest",
+    "check_output_file",
+    "check_output_folder",
+    "json_text",
+    "require_finite",
+    "staged_output",
+    "write_file",
+]
+
+MANIFEST = ".linkwork-manifest.json"
+"""The file in a folder listing the entries linkwork wrote there (the only ones it may replace or remove)."""
+
+RUN = "run"
+"""The part name of a whole run (see :func:`staged_output`)."""
+
+
+class Manifest:
+    """What linkwork wrote into one folder: ``parts`` (part name -> entries of that part of the last run) and
+    ``files`` (single files written there). Stored as JSON ``{"format": 2, "parts": {...}, "files": [...]}``; the
+    earlier format, a list of names, reads as one run."""
+
+    def __init__(self, parts: dict[str, set[str]] | None = None, files: set[str] | None = None) -> None:
+        self.parts = parts or {}
+        self.files = files or set()
+
+    @classmethod
+    def read(cls, folder: Path) -> Manifest:
+        """The manifest of ``folder`` (an absent, unreadable or linked manifest lists nothing)."""
+        file = folder / MANIFEST
+        try:
+            if file.is_symlink() or not file.is_file() or file.stat().st_size > 1 << 20:
+                return cls()
+            data = json.loads(file.read_text(encoding="utf-8"))
+        except (OSError, ValueError, RecursionError):
+            return cls()
+        if isinstance(data, list):
+            return cls({RUN: _names(data)})
+        if not isinstance(data, dict):
+            return cls()
+        parts = data.get("parts")
+        parts = parts if isinstance(parts, dict) else {}
+        return cls(
+            {str(k): _names(v) for k, v in parts.items() if isinstance(v, list)},
+            _names(data.get("files")),
+        )
+
+    def owned(self) -> set[str]:
+        """Every entry linkwork wrote into the folder."""
+        return set().union(*self.parts.values(), self.files)
+
+    def write(self, folder: Path) -> None:
+        """Store the manifest (a new file renamed into place: a link in its place is replaced, not followed)."""
+        data = {
+            "format": 2,
+            "parts": {k: sorted(v) for k, v in sorted(self.parts.items()) if v},
+            "files": sorted(self.files),
+        }
+        fd, name = tempfile.mkstemp(prefix=".linkwork-manifest-", dir=folder)
+        _usual_mode(Path(name))
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as handle:
+                handle.write(json.dumps(data, indent=1) + "\n")
+            os.replace(name, folder / MANIFEST)
+        finally:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(name)
+
+
+def _usual_mode(file: Path) -> None:
+    """Give a temporary file (created private) the mode a new file gets (``0o666`` less the umask)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    with contextlib.suppress(OSError):
+        file.chmod(0o666 & ~mask)
+
+
+def _names(value: Any) -> set[str]:
+    return (
+        {n for n in value if isinstance(n, str) and n and "/" not in n and n not in (".", "..")}
+        if isinstance(value, list)
+        else set()
+    )
+
+
+def _shown(path: Path) -> str:
+    """A path for a message: whole (up to 500 characters), quoted, control characters escaped."""
+    text = str(path)
+    text = text if len(text) <= 500 else text[:497] + "..."
+    return '"' + escape_line(text).replace('"', '\\"') + '"'
+
+
+def _exists(path: Path) -> bool:
+    return path.exists() or path.is_symlink()
+
+
+def check_output_folder(out: Path, names: Iterable[str] = (), flag: str = "--out") -> None:
+    """Refuse, before any work, an ``--out`` that is not a folder, or ``names`` in it that linkwork did not write
+    or that are symbolic links.
+
+    Raises
+    ------
+    SpecError
+        ``--out`` names an existing file, or an entry to be written exists in it without being listed in its
+        :data:`MANIFEST`, or is a symbolic link.
+    """
+    out = Path(out)
+    if _exists(out) and not out.is_dir():
+        raise SpecError(f"{flag} {_shown(out)}: is a file; expected a folder to write into")
+    if not out.is_dir():
+        return
+    ours = Manifest.read(out).owned()
+    for name in names:
+        target = out / name
+        if target.is_symlink():
+            raise SpecError(
+                f"{flag} {_shown(out)}: {show(name)} is a symbolic link; linkwork never writes through links, "
+                "move it away or choose another folder"
+            )
+        if _exists(target) and name not in ours:
+            raise SpecError(
+                f"{flag} {_shown(out)}: {show(name)} exists and was not written by linkwork; move it away "
+                f"or choose another {flag} (linkwork never overwrites what it did not write)"
+            )
+
+
+@contextlib.contextmanager
+def _cleanup_on_signals() -> Iterator[None]:
+    """While writing, turn SIGTERM (and SIGHUP) into an exception, so the staging is removed."""
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        raise SystemExit(128 + signum)
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    wanted = [signal.SIGTERM] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])
+    previous = {sig: signal.signal(sig, stop) for sig in wanted}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+_FULL = {errno.ENOSPC, errno.EFBIG, getattr(errno, "EDQUOT", errno.ENOSPC)}
+
+
+_WRITE_ERRNOS = _FULL | {errno.EACCES, errno.EPERM, errno.EROFS, errno.EIO}
+
+
+def _is_write_error(exc: OSError, staging: Path) -> bool:
+    """Whether ``exc`` is a failure to write into ``staging`` (by its file name, or, for a writer that names no
+    file, by its kind: a full disk, a size limit, a refused permission)."""
+    if exc.filename is not None:
+        return str(exc.filename).startswith(str(staging))
+    return exc.errno in _WRITE_ERRNOS
+
+
+def _write_failed(exc: OSError, out: Path, flag: str, staging: Path) -> Exception:
+    """The one line for a write that failed in the staging: it names ``out``, never the staging path."""
+    reason = exc.strerror or str(exc).replace(str(staging), str(out))
+    if exc.errno in _FULL:
+        return RequestNotMetError(
+            f"{flag} {_shown(out)}: writing failed ({reason}); nothing was written, {_shown(out)} is as it was"
+        )
+    return SpecError(
+        f"{flag} {_shown(out)}: cannot write there ({reason}); expected a place linkwork may create and write into"
+    )
+
+
+def _stage_beside(out: Path, flag: str, *, folder: bool) -> Path:
+    """A new staging folder (or file) in ``out``'s folder (same file system: the final move is a rename)."""
+    try:
+        # beside the real folder (an --out that is a link to a folder elsewhere): the final move is a rename
+        parent = (out.resolve() if folder else out.absolute()).parent
+        parent.mkdir(parents=True, exist_ok=True)
+        if folder:
+            return Path(tempfile.mkdtemp(prefix=".linkwork-", dir=parent))
+        fd, name = tempfile.mkstemp(prefix=".linkwork-", suffix=out.suffix, dir=parent)
+        os.close(fd)
+        _usual_mode(Path(name))
+        return Path(name)
+    except OSError as exc:
+        raise SpecError(
+            f"{flag} {_shown(out)}: cannot write there ({exc.strerror or exc}); expected a place linkwork may "
+            "create and write into"
+        ) from None
+
+
+@contextlib.contextmanager
+def staged_output(out: Path, *, part: str = RUN, flag: str = "--out") -> Iterator[Path]:
+    """Write a command's files into a staging folder and move them into ``out`` only if all succeeded.
+
+    ``part`` names what is written: a whole run (the default) replaces every entry earlier runs wrote into
+    ``out`` (the stale ones are removed); a named part (``"mechanize"``) replaces only the entries of that part,
+    keeping the rest of the run it adds to. A failure part way (an error, Ctrl-C, SIGTERM) removes the staging
+    and leaves ``out`` as it was; an entry linkwork did not write, or a symbolic link, under a name to be written
+    stops the command with a :class:`SpecError` and ``out`` unchanged.
+    """
+    out = Path(out)
+    check_output_folder(out, flag=flag)
+    stage = _stage_beside(out, flag, folder=True)
+    try:
+        with _cleanup_on_signals():
+            try:
+                yield stage
+            except OSError as exc:
+                if not _is_write_error(exc, stage):
+                    raise  # not a write into the staging (a file read on the way)
+                raise _write_failed(exc, out, flag, stage) from None
+            names = sorted(item.name for item in stage.iterdir() if item.name != MANIFEST)
+            check_output_folder(out, names, flag=flag)
+            try:
+                _move_into(stage, out, names, part)
+            except OSError as exc:
+                raise _write_failed(exc, out, flag, stage) from None
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
+    """Move the staged ``names`` into ``out``, remove the stale entries of the replaced parts, record them."""
+    out.mkdir(parents=True, exist_ok=True)
+    manifest = Manifest.read(out)
+    replaced = set(manifest.parts) if part == RUN else {part}
+    stale = set().union(*(manifest.parts[p] for p in replaced if p in manifest.parts)) - set(names)
+    # first record the names about to move in (an interruption between two moves leaves only entries the
+    # manifest lists, which the next run may replace), then move
+    early = Manifest({k: set(v) for k, v in manifest.parts.items()}, set(manifest.files))
+    early.parts.setdefault(part, set()).update(names)
+    early.write(out)
+    for name in names:
+        target = out / name
+        if target.is_dir() and not target.is_symlink():
+            shutil.rmtree(target)
+        os.replace(stage / name, target)
+    for name in sorted(stale):
+        target = out / name
+        if target.is_symlink() or not _exists(target):
+            continue  # not ours any more (a link put in its place) or gone: only forgotten
+        if target.is_dir():
+            shutil.rmtree(target)
+        else:
+            target.unlink()
+    for p in replaced:
+        manifest.parts.pop(p, None)
+    for p in manifest.parts:
+        manifest.parts[p] -= set(names)
+    manifest.parts[part] = set(names)
+    manifest.files -= set(names) | stale
+    manifest.write(out)
+
+
+def check_output_file(file: Path, flag: str = "--out") -> None:
+    """Refuse, before any work, a single output ``file`` that is a folder, a symbolic link, or an existing file
+    linkwork did not write (not listed in the :data:`MANIFEST` of its folder)."""
+    file = Path(file)
+    if file.is_symlink():
+        raise SpecError(
+            f"{flag} {_shown(file)}: is a symbolic link; linkwork never writes through links, choose another file"
+        )
+    if file.is_dir():
+        raise SpecError(f"{flag} {_shown(file)}: is a folder; expected a file name to write")
+    if file.name == MANIFEST:
+        raise SpecError(f"{flag} {_shown(file)}: is linkwork's manifest; choose another file name")
+    if _exists(file) and file.name not in Manifest.read(file.absolute().parent).owned():
+        raise SpecError(
+            f"{flag} {_shown(file)}: exists and was not written by linkwork; move it away or choose another "
+            f"file (linkwork never overwrites what it did not write; what it wrote is listed in {MANIFEST} beside it)"
+        )
+
+
+def write_file(file: str | Path, write: Callable[[Path], Any], *, flag: str = "--out") -> Path:
+    """Write one output file: ``write(tmp)`` writes a temporary file beside ``file``, which is then renamed to
+    ``file`` and recorded in the folder's :data:`MANIFEST`. A failure part way (an error, Ctrl-C, SIGTERM) leaves
+    no half-written file, and any earlier ``file`` as it was; see :func:`check_output_file` for what is refused."""
+    file = Path(file)
+    check_output_file(file, flag)
+    tmp = _stage_beside(file, flag, folder=False)
+    try:
+        with _cleanup_on_signals():
+            try:
+                write(tmp)
+            except OSError as exc:
+                if not _is_write_error(exc, tmp):
+                    raise
+                raise _write_failed(exc, file, flag, tmp) from None
+            check_output_file(file, flag)
+            folder = file.absolute().parent
+            try:
+                os.replace(tmp, file)
+                manifest = Manifest.read(folder)
+                manifest.files.add(file.name)
+                for names in manifest.parts.values():
+                    names.discard(file.name)
+                manifest.write(folder)
+            except OSError as exc:
+                raise _write_failed(exc, file, flag, tmp) from None
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+    return file
+
+
+def json_text(value: Any, indent: int | None = 2) -> str:
+    """``value`` as standard JSON text (with a final newline): numpy numbers and arrays as JSON numbers and lists,
+    and a computed quantity that is not finite (undefined, such as a condition number at a singular point)
+    written as ``null``, never as the ``NaN`` or ``Infinity`` that strict JSON readers refuse."""
+
+    def plain(v: Any) -> Any:
+        if isinstance(v, dict):
+            return {str(k): plain(x) for k, x in v.items()}
+        if isinstance(v, list | tuple | np.ndarray):
+            return [plain(x) for x in v]
+        if isinstance(v, np.generic):
+            v = v.item()
+        if isinstance(v, float) and not np.isfinite(v):
+            return None
+        return v
+
+    return json.dumps(plain(value), indent=indent, allow_nan=False) + "\n"
+
+
+def require_finite(values: ArrayLike, what: str) -> np.ndarray:
+    """``values`` as a float array, or a :class:`SpecError` (exit 2) when any is not finite: the one check every
+    writer makes on the numbers it writes. ``what`` says what they are and where they came from (``"the
+    solids' coordinates (--scale 1e308 times the trace's lengths)"``)."""
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise SpecError(f"{what}: expected numbers") from None
+    if not np.all(np.isfinite(array)):
+        bad = array[~np.isfinite(array)].ravel()[0]
+        raise SpecError(f"{what}: expected finite numbers, got {bad} (nothing was written)")
+    return array
