@@ -73,12 +73,10 @@ def test_closed_naca_contours_get_fixed_pivots_inside_every_contour(tmp_path: Pa
         np.savetxt(tmp_path / f"{name}.csv", points, delimiter=",", header="x,y", comments="")
     (tmp_path / "problem.toml").write_text(
         'type = "closed"\nprofiles = ["a.csv", "b.csv", "c.csv"]\npiece_length = 0.03\nmin_pieces = 4\n'
-        'design = "CMCM"\nstarts = 4\nseed = 1\nground_region = "inside"\nmax_link = 0.8\n'
+        'design = "CMCM"\nstarts = 4\nseed = 1\nground_region = "inside"\nmax_link = 1.0\n'
     )
     result = synthesize(load_problem(tmp_path / "problem.toml"))
-    found = mechanize(
-        result
-    )  # max_link 0.8 of the largest extent (1.25): links up to the shortest chord, 1.0
+    found = mechanize(result)  # max_link 1.0: links up to the shortest chord
     pivots = [link.centre for link in found.design.links if link.anchor == "ground"]
     assert pivots
     for name, points in contours.items():

@@ -9,11 +9,13 @@ attempts run out.
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from linkwork.errors import SpecError
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
 from linkwork.mechanization.options import (
@@ -63,6 +65,8 @@ class Mechanization:
         Wall time.
     ranked
         Up to ``options.designs`` (5) passing designs, best quality factor first (``ranked[0]`` is ``design``).
+    options
+        The options the search ran with (the limits it kept are reported from them).
     """
 
     design: Design
@@ -71,6 +75,7 @@ class Mechanization:
     rejected: tuple[str, ...]
     seconds: float
     ranked: tuple[RankedDesign, ...] = ()
+    options: MechanizeOptions | None = None
 
 
 @dataclass
@@ -210,6 +215,7 @@ def mechanize(
     """
     options = _options(result, options)
     chain, label = _chain(result, name)
+    check_names(chain, options)
     # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
     # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
     modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
@@ -279,7 +285,13 @@ def _outcome(state: _Search) -> Mechanization:
         ranked = tuple(sorted(state.passed, key=lambda r: -round(r.quality.factor, 9)))
         best = ranked[0]
         return Mechanization(
-            best.design, best.verification, state.attempts, tuple(state.rejected), seconds, ranked
+            best.design,
+            best.verification,
+            state.attempts,
+            tuple(state.rejected),
+            seconds,
+            ranked,
+            state.options,
         )
     closest = state.closest[1].removeprefix("mechanize: ") if state.closest else "no design"
     timed_out = " (time limit reached)" if state.out_of_time() else ""
@@ -291,17 +303,48 @@ def _outcome(state: _Search) -> Mechanization:
     )
 
 
+#: Joints of the added links a design may have: an RR dyad's ``D<k>a`` / ``D<k>m``, a slider's ``D<k>s``, the
+#: linear actuator's ``A1a`` / ``A1s`` / ``A1m``.
+LINK_JOINT = re.compile(r"^(D[1-9][0-9]*[ams]|A1[ams])$")
+
+
+def check_names(chain: ShapeChain, options: MechanizeOptions) -> None:
+    """Refuse a ``drive`` or ``root`` that no design of this chain can have, naming the choices.
+
+    Raises
+    ------
+    SpecError
+        ``drive`` (neither a chain joint nor a link joint ``D<k>a``, ``D<k>m``, ``D<k>s``, ``A1s``) or ``root``
+        (not a body of the chain): bad input, exit code 2.
+    """
+    bodies = [b.name for b in chain.bodies]
+    if options.root is not None and options.root not in bodies:
+        raise SpecError(f"unknown body {options.root!r}; expected one of {', '.join(bodies)}", key="root")
+    joints = [j.name for j in chain.joints]
+    if options.drive is not None and options.drive not in joints and not LINK_JOINT.match(options.drive):
+        raise SpecError(
+            f"unknown joint {options.drive!r}; expected a chain joint ({', '.join(joints) or 'none'}) or a joint "
+            "of an added link: D<k>a (an RR link's fixed pivot), D<k>m (its moving pivot), D<k>s (a slider), A1s "
+            "(the linear actuator)",
+            key="drive",
+        )
+
+
 def _check(options: MechanizeOptions) -> None:
-    """Reject options no search can use (the problem reader and the flags check them too)."""
+    """Reject options no search can use (the problem reader and the flags check them too): bad input, exit 2.
+
+    Raises
+    ------
+    SpecError
+        Naming the option and what was expected.
+    """
     if options.dof < 1:
-        raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
+        raise SpecError(f"{options.dof}: expected a whole number >= 1", key="dof")
     for key, choices in (("actuator", ACTUATORS), ("binary_links", BINARY_LINKS), ("anchors", ANCHORS)):
         value = getattr(options, key)
         if value not in choices:
             quoted = [f"'{c}'" for c in choices]
-            raise MechanizationError(
-                f"mechanize: {key} {value!r}: expected {', '.join(quoted[:-1])} or {quoted[-1]}"
-            )
+            raise SpecError(f"{value!r}: expected {', '.join(quoted[:-1])} or {quoted[-1]}", key=key)
 
 
 def _with_transmissions(design: Design, check: Verification) -> Design:

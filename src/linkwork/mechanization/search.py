@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.errors import LinkworkError, MechanizationError
+from linkwork.errors import LinkworkError, MechanizationError, SpecError
 from linkwork.geometry.se2 import relative
 from linkwork.mechanization import guidance, sliders
 from linkwork.mechanization.assemble import BinaryLink
@@ -190,9 +190,11 @@ def _rr_candidates(
     for m, dyad in pivots:
         c = dyad.centre_point
         r = dyad.radius
-        if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
+        if not np.all(np.isfinite(c)) or r > options.link_limit(chain.size) or r < 1e-3 * chain.size:
             continue
         if anchor == "ground" and not bool(region.contains(c)[0]):
+            continue
+        if dyad.structural_error > options.structural_limit(chain.size):
             continue
         u = track(g_body, m) - track(g_anchor, c)
         u /= np.linalg.norm(u, axis=1, keepdims=True)
@@ -226,7 +228,7 @@ def _slider_candidates(
         for v in (np.array([1.0, 0.0]), np.array([0.0, 1.0])):
             for m in sliders.slider_points(rel, g, v * chain.size, reach=options.link_offset):
                 start, u, travel, error = sliders.fit_guide(rel, m)
-                if not sliders.monotonic(travel, chain.size) or error > 0.05 * chain.size:
+                if not sliders.monotonic(travel, chain.size) or error > options.structural_limit(chain.size):
                     continue
                 ends = start + np.outer([travel[0], travel[-1]], u)
                 if anchor == "ground" and not np.all(region.contains(ends)):
@@ -293,6 +295,16 @@ def _pivots_from_region(
     return out
 
 
+def _limits(chain: ShapeChain, options: MechanizeOptions) -> str:
+    """The link-length and structural-error limits in use, for messages: ``max_link 0.8 (0.59 x the largest
+    extent 1.36), structural error 0.068``."""
+    longest = options.link_limit(chain.size)
+    return (
+        f"max_link {longest:.4g} (a length: {longest / chain.size:.3g} x the largest extent {chain.size:.4g}) "
+        f"with a structural error at most {options.structural_limit(chain.size):.3g}"
+    )
+
+
 def _adjacent(chain: ShapeChain, body: str) -> list[tuple[str, str]]:
     """``(joint, other body)`` for every chain joint of ``body``."""
     return [(j.name, j.other(body)) for j in chain.joints if body in j.bodies]
@@ -302,9 +314,7 @@ def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
     """Bodies to try as the root: the ground-pinned body, the designer's, or every body (longest first)."""
     names = [b.name for b in chain.bodies]
     if options.root is not None and options.root not in names:
-        raise MechanizationError(
-            f"mechanize: unknown root body {options.root!r}; bodies are {', '.join(names)}"
-        )
+        raise SpecError(f"unknown body {options.root!r}; expected one of {', '.join(names)}", key="root")
     pinned = [j for j in chain.joints if "ground" in j.bodies]
     if pinned:
         return [pinned[0].other("ground")]
@@ -343,7 +353,8 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
             raise MechanizationError(
                 f"mechanize: no four-bar guides the root body {root} through the profiles with its crank turning "
                 f"one way and transmission angles above {math.degrees(options.min_transmission):.0f} deg "
-                "(try another root, a larger ground region or link offset)"
+                f"and links no longer than {_limits(chain, options)} (try another root, a larger ground region, link "
+                "offset or max_link)"
             )
     return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
 
@@ -402,7 +413,8 @@ def _steps(
                 continue
             raise MechanizationError(
                 f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it: "
-                f"every candidate pivot leaves the ground region, is too long, has a transmission angle below "
+                f"every candidate pivot leaves the ground region, is longer than {_limits(chain, options)}, has a "
+                "transmission angle below "
                 f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
                 "(try a larger ground region or link offset)"
             )
@@ -415,8 +427,9 @@ def _steps(
     if deferred:
         raise MechanizationError(
             f"mechanize: no dyad can guide body {deferred[0]} (root {root}), the last body placed from it "
-            f"(transmission angle below {math.degrees(options.min_transmission):.0f} deg or a change of "
-            "assembly mode between profiles; try a larger ground region or link offset)"
+            f"(outside the ground region, longer than {_limits(chain, options)}, a transmission angle below "
+            f"{math.degrees(options.min_transmission):.0f} deg or a change of assembly mode between profiles; try "
+            "a larger ground region, link offset or max_link)"
         )
     return steps
 
@@ -484,7 +497,7 @@ def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) 
         travel = np.diff(w, axis=0)
         for c in grid:
             length = np.linalg.norm(w - c, axis=1)
-            if length.min() < 0.05 * chain.size or length.max() > options.max_link * chain.size:
+            if length.min() < 0.05 * chain.size or length.max() > options.link_limit(chain.size):
                 continue
             dl = np.diff(length)
             if not (np.all(dl > 0) or np.all(dl < 0)):

@@ -14,22 +14,20 @@ design is rejected with the reason when
 from __future__ import annotations
 
 import math
-import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.errors import AssemblyError
 from linkwork.geometry.angles import wrap
 from linkwork.geometry.se2 import apply, pose_of
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.normalization import NearMobility, near_mobility
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.tracer import trace
-from linkwork.mechanization.assemble import Design, spec_text
+from linkwork.mechanization.assemble import Design
 from linkwork.mechanization.chain import turned
 
 Array = NDArray[np.float64]
@@ -87,13 +85,54 @@ class Verification:
 
 
 def loaded_mechanism(design: Design) -> Mechanism:
-    """The mechanism exactly as ``linkwork trace`` reads it from the written ``mechanism.toml``."""
-    from linkwork.io.spec import load_spec
+    """The mechanism of ``design``, built in memory exactly as ``linkwork trace`` reads the written
+    ``mechanism.toml`` (the spec reader builds it with the same :meth:`Mechanism.from_joints` from the same joint
+    points; tested against a written and read-back file)."""
+    return design.mechanism()
 
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "mechanism.toml"
-        path.write_text(spec_text(design), encoding="utf-8")
-        return load_spec(path).mechanism
+
+#: A design whose links leave the chain rigid but for a hair is refused as the spec reader refuses its file
+#: (``linkwork.io.spec``: a closure misfit above this per radian of the near-motion).
+NEAR_MOBILE_MISFIT = 1e-12
+
+
+def _near_rigid(mech: Mechanism) -> NearMobility | None:
+    """The near-motion of a design that the spec reader would refuse (rigid but for a hair), else ``None``."""
+    near = near_mobility(mech)
+    return near if near is not None and near.misfit > NEAR_MOBILE_MISFIT else None
+
+
+@dataclass(frozen=True)
+class PathEnd:
+    """How a traced path from one profile to the next ended, as the verification reads it.
+
+    ``kind`` is ``"target"`` (reached the drive value asked for), ``"turning"`` (the drive turned back: a dead
+    centre), ``"failed"`` (the corrector failed), ``"bifurcation"``, ``"budget"`` (step budget), ``"closed"``
+    or ``"other"``; ``text`` is the tracer's words for people.
+    """
+
+    kind: str
+    text: str
+
+
+def path_end(path: Trace) -> PathEnd:
+    """How the first branch of ``path`` ended: the ONE place mechanization reads a tracer's end reason.
+
+    The tracer reports a branch's end as text today; when its structured end reasons (a stop-reason enum with
+    kind, joint and value) land, this is the one function to change.
+    """
+    text = path.branches[0].end_reason
+    for prefix, kind in (
+        ("reached target", "target"),
+        ("drive turning point", "turning"),
+        ("corrector failed", "failed"),
+        ("bifurcation", "bifurcation"),
+        ("step budget", "budget"),
+        ("closed path", "closed"),
+    ):
+        if text.startswith(prefix):
+            return PathEnd(kind, text)
+    return PathEnd("other", text)
 
 
 def chain_displacements(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
@@ -179,12 +218,15 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
     max_steps
         Step budget of each trace (a passing design's path is the same as with the CLI's larger budget).
     """
-    try:
-        mech = loaded_mechanism(design)
-    except AssemblyError as exc:
+    mech = loaded_mechanism(design)
+    near = _near_rigid(mech)
+    if near is not None:
         # the spec reader's assembly check: the links make the chain rigid but for a hair (a near-singular design)
-        reason = str(exc).split(": ", 2)[-1].split("; ")[0]
-        return Verification(False, "branch", f"branch defect: {reason}", 0, 0, design.drive)
+        reason = (
+            f"branch defect: the joint lines are rigid by a hair, not mobile: smallest singular value "
+            f"{near.relative:.3g} of the largest, joints {', '.join(near.joints)}"
+        )
+        return Verification(False, "branch", reason, 0, 0, design.drive)
     check = _Checker.of(design, mech)
     if check.dof != design.dof:
         return check.failed(
@@ -281,7 +323,7 @@ def _path_defect(check: _Checker, trace: Trace, j: int) -> _Defect | None:
     design, d, drive = check.design, check.d, check.design.drive
     target = float(check.ideal[j, d])
     where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
-    end = trace.branches[0].end_reason
+    end = path_end(trace)
     if trace.bifurcations:
         b = trace.bifurcations[0]
         return (
@@ -303,14 +345,14 @@ def _path_defect(check: _Checker, trace: Trace, j: int) -> _Defect | None:
         return (
             "order",
             f"order defect: the drive {drive} turns back {where} at {check.show(trace.angles[k, d])} (a dead centre)"
-            + (f"; the trace then {end}" if end != "reached target" else ""),
+            + (f"; the trace then {end.text}" if end.kind != "target" else ""),
             _culprit(design, check.mech, trace),
         )
-    if end != "reached target":
-        defect = "order" if "turning" in end else "branch"
+    if end.kind != "target":
+        defect = "order" if end.kind == "turning" else "branch"
         return (
             defect,
-            f"{defect} defect: the trace {where} stopped ({end}) before the drive {drive} reached {check.show(target)}",
+            f"{defect} defect: the trace {where} stopped ({end.text}) before the drive {drive} reached {check.show(target)}",
             _culprit(design, check.mech, trace),
         )
     return None
@@ -350,6 +392,18 @@ def _circuit_culprit(design: Design, mech: Mechanism, values: Array, j: int) -> 
         ):
             return link.name
     return design.links[0].name if design.links else None
+
+
+def link_pivots(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
+    """``(2, 2)`` the world positions of every binary link's two pivots at joint displacements ``values``: the
+    anchor pivot (on the ground or on the anchor body; a slider's guide point) and the moving pivot (on the
+    body)."""
+    disp = chain_displacements(design, mech, values)
+    out: dict[str, Array] = {}
+    for link in design.links:
+        anchor = apply(disp[link.anchor], link.centre)
+        out[link.name] = np.array([anchor, apply(disp[link.body], link.circle)])
+    return out
 
 
 def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
