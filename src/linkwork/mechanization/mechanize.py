@@ -89,7 +89,7 @@ class _Search:
     attempts: int = 0
     passed: list[RankedDesign] = field(default_factory=list)
     rejected: list[str] = field(default_factory=list)
-    closest: tuple[int, str] | None = None
+    closest: list[tuple[int, str]] = field(default_factory=list)
 
     def out_of_time(self) -> bool:
         """The search's time limit has passed."""
@@ -100,10 +100,15 @@ class _Search:
         return self.out_of_time() or len(self.passed) >= self.options.designs
 
     def unusable(self, line: str) -> None:
-        """Record a plan or design that could not be traced (the closest so far when nothing was traced)."""
+        """Record a plan or design that could not be traced (among the closest while nothing was traced)."""
         self.rejected.append(line)
-        if self.closest is None:
-            self.closest = (-1, line)
+        self._closer(-1, line)
+
+    def _closer(self, reached: int, line: str) -> None:
+        """Keep the :data:`CLOSEST` designs that reached the most profiles (the first found first on a tie)."""
+        self.closest.append((reached, line))
+        self.closest.sort(key=lambda c: -c[0])  # stable: earlier designs stay ahead on a tie
+        del self.closest[CLOSEST:]
 
     def traced(self, label: str, design: Design, check: Verification) -> None:
         """Record a verified design (passed or rejected) and report progress."""
@@ -114,13 +119,12 @@ class _Search:
         else:
             self.rejected.append(f"{label}: {check.reason}")
             reached = len(check.states)
-            if self.closest is None or reached > self.closest[0]:
-                links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
-                self.closest = (
-                    reached,
-                    f"{label} (links {links}; drive {design.drive}) reached profile {reached} of {design.chain.count}, "
-                    f"then: {check.reason}",
-                )
+            links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
+            self._closer(
+                reached,
+                f"{label} (links {links}; drive {design.drive}) reached profile {reached} of {design.chain.count}, "
+                f"then: {check.reason}",
+            )
         if self.progress is not None:
             self.progress(self.attempts, self.total)
 
@@ -220,7 +224,8 @@ def mechanize(
     # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
     modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
     order = roots(chain, options)
-    state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
+    most = options.attempts * (1 + REDRIVES) * len(order) * len(modes)
+    state = _Search(options, time.perf_counter(), progress, most)
     for root in order:
         for mode in modes:
             if state.done():
@@ -293,7 +298,8 @@ def _outcome(state: _Search) -> Mechanization:
             ranked,
             state.options,
         )
-    closest = state.closest[1].removeprefix("mechanize: ") if state.closest else "no design"
+    lines = [line.removeprefix("mechanize: ") for _, line in state.closest]
+    closest = " | ".join(f"({k}) {line}" for k, line in enumerate(lines, start=1)) if lines else "no design"
     timed_out = " (time limit reached)" if state.out_of_time() else ""
     dof = state.options.dof
     raise MechanizationError(
@@ -302,6 +308,13 @@ def _outcome(state: _Search) -> Mechanization:
         + f"; closest: {closest}"
     )
 
+
+#: The closest failed designs named when none passes.
+CLOSEST = 3
+
+#: A design with an order defect (its drive turns back) is traced again driven by at most this many other joints
+#: (those moving one way through the profiles, the most evenly first), unless the designer chose the drive.
+REDRIVES = 3
 
 #: Joints of the added links a design may have: an RR dyad's ``D<k>a`` / ``D<k>m``, a slider's ``D<k>s``, the
 #: linear actuator's ``A1a`` / ``A1s`` / ``A1m``.
@@ -387,8 +400,11 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
                 f"(joints are {', '.join(design.joint_names())})"
             )
             return
+        label_k = f"root {pl.root}, anchors {options.anchors}, design {attempt}"
         check = verify(design)
-        state.traced(f"root {pl.root}, anchors {options.anchors}, design {attempt}", design, check)
+        state.traced(label_k, design, check)
+        if check.defect == "order" and options.drive is None:
+            design, check = _redrive(design, check, label_k, state)
         if check.defect == "dof":
             return
         # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
@@ -403,6 +419,36 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         if not movable:
             return
         choice[movable[attempt % len(movable)]] += 1
+
+
+def redrives(design: Design) -> list[str]:
+    """Other joints that could drive ``design``: those whose values move one way through the profiles, the
+    most evenly moving first (the smallest step between profiles over the largest), at most :data:`REDRIVES`."""
+    ideal = design.ideal_values()
+    ranked: list[tuple[float, str]] = []
+    for k, name in enumerate(design.joint_names()):
+        steps = np.diff(ideal[:, k])
+        largest = float(np.max(np.abs(steps)))
+        if name == design.drive or largest <= 1e-9 or not (np.all(steps > 0) or np.all(steps < 0)):
+            continue
+        ranked.append((float(np.min(np.abs(steps))) / largest, name))
+    ranked.sort(key=lambda r: -r[0])
+    return [name for _, name in ranked[:REDRIVES]]
+
+
+def _redrive(design: Design, check: Verification, label: str, state: _Search) -> tuple[Design, Verification]:
+    """A design whose drive turns back (a dead centre of that joint) may pass driven from another joint: the
+    mechanism is the same, only the joint that moves it one way through the profiles changes. The first that
+    passes is kept; else the original verdict stands."""
+    for other in redrives(design):
+        if state.done():
+            break
+        again = replace(design, drive=other)
+        verdict = verify(again)
+        state.traced(f"{label} re-driven from {other}", again, verdict)
+        if verdict.passed:
+            return again, verdict
+    return design, check
 
 
 def _weakest(design: Design) -> str | None:

@@ -35,6 +35,11 @@ Array = NDArray[np.float64]
 #: A traced configuration matches the profile's when every joint agrees to this (radians or length / size).
 SAME_CONFIGURATION = 1e-6
 
+#: With least-squares links, the traced mechanism is accepted on a profile when its shape error is at most the
+#: joined chain's plus this many times the largest structural error of its links (a link's error is amplified by
+#: the lever of the bodies it places; the shape error is reported beside the joined chain's either way).
+SHAPE_ALLOWANCE = 5.0
+
 #: A profile's configuration closes the loops when the closure residual's norm is below this (times the size).
 CLOSES = 1e-9
 
@@ -286,21 +291,14 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
     states: list[ProfileState] = [check.state(np.zeros(mech.n_joints), 0)]
     paths: list[Trace] = []
     max_cond = 1.0
+    structural = max((link.structural_error for link in design.links), default=0.0)
+    refine = structural > 1e-9 * design.chain.size
     for j in range(1, design.chain.count):
-        path = trace(
-            mech,
-            drive=design.drive,
-            until=(design.drive, float(v[j])),
-            max_step=max_step,
-            max_steps=max_steps,
-        )
+        path, st, found = _reach(check, j, float(v[j]), max_step, max_steps, judge=not refine)
+        if found is None and refine:
+            path, st, found = _best_setting(check, j, v, path, st, max_step, max_steps)
         paths.append(path)
         max_cond = max(max_cond, path.max_condition_raw)  # raw, like the untraced check
-        st = None
-        found = _path_defect(check, path, j)
-        if found is None:
-            st = check.state(path.angles[-1], j)
-            found = _circuit_defect(check, path, st, j)
         if found is not None:
             defect, reason, culprit = found
             return check.failed(
@@ -318,10 +316,69 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
     )
 
 
-def _path_defect(check: _Checker, trace: Trace, j: int) -> _Defect | None:
-    """A branch or order defect on the path from profile ``j`` to ``j + 1`` (0-based ``j - 1`` to ``j``)."""
+def _reach(
+    check: _Checker, j: int, value: float, max_step: float, max_steps: int, *, judge: bool = True
+) -> tuple[Trace, ProfileState | None, _Defect | None]:
+    """Trace the drive from profile 1 to ``value`` and judge the mechanism there against profile ``j``: the
+    path, the state (``None`` after a path defect) and the defect found, if any (the circuit only with
+    ``judge``)."""
+    design = check.design
+    path = trace(
+        check.mech, drive=design.drive, until=(design.drive, value), max_step=max_step, max_steps=max_steps
+    )
+    found = _path_defect(check, path, j, value)
+    if found is not None:
+        return path, None, found
+    st = check.state(path.angles[-1], j)
+    return path, st, _circuit_defect(check, path, st, j) if judge else None
+
+
+#: The drive setting of a profile is refined to this fraction of the drive's step between profiles.
+SETTING_TOLERANCE = 1e-5
+
+
+def _best_setting(
+    check: _Checker,
+    j: int,
+    v: Array,
+    path: Trace,
+    st: ProfileState | None,
+    max_step: float,
+    max_steps: int,
+) -> tuple[Trace, ProfileState | None, _Defect | None]:
+    """Least-squares links put no configuration of the mechanism exactly on a profile: the drive setting of
+    profile ``j`` is the one, between the midpoints to the neighbouring profiles' settings, where the traced
+    mechanism's shape error against profile ``j`` is smallest (a bounded scalar minimisation, each value traced
+    from profile 1). The designer sets the actuator there; the order of the profiles along the drive is kept."""
+    from scipy.optimize import minimize_scalar
+
+    assert st is not None
+    before = 0.5 * (v[j - 1] + v[j])
+    after = 0.5 * (v[j] + v[j + 1]) if j + 1 < len(v) else v[j] + 0.5 * (v[j] - v[j - 1])
+    lo, hi = sorted((float(before), float(after)))
+    tried: dict[float, tuple[Trace, ProfileState | None, _Defect | None]] = {float(v[j]): (path, st, None)}
+
+    def error(t: float) -> float:
+        if t not in tried:
+            tried[t] = _reach(check, j, t, max_step, max_steps, judge=False)
+        reached = tried[t]
+        ok = reached[1] is not None and reached[2] is None
+        return reached[1].e_max if ok else 1e3 * check.design.chain.size  # type: ignore[union-attr]
+
+    best = minimize_scalar(
+        error, bounds=(lo, hi), method="bounded", options={"xatol": SETTING_TOLERANCE * (hi - lo)}
+    )
+    t = float(best.x)
+    if error(t) < st.e_max:
+        path, st, _ = tried[t]
+    assert st is not None
+    return path, st, _circuit_defect(check, path, st, j)
+
+
+def _path_defect(check: _Checker, trace: Trace, j: int, target: float) -> _Defect | None:
+    """A branch or order defect on the path from profile 1 to the drive value ``target`` of profile ``j + 1``
+    (0-based ``j``)."""
     design, d, drive = check.design, check.d, check.design.drive
-    target = float(check.ideal[j, d])
     where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
     end = path_end(trace)
     if trace.bifurcations:
@@ -362,12 +419,28 @@ def _circuit_defect(check: _Checker, trace: Trace, st: ProfileState, j: int) -> 
     """A circuit defect at profile ``j``'s drive value: the mechanism in another assembly mode than the chain
     (least-squares links: judged by the shape, as the profile's configuration is not on the mechanism)."""
     design, chain = check.design, check.design.chain
+    start = signed_transmissions(design, check.mech, np.zeros(check.mech.n_joints))
+    now = signed_transmissions(design, check.mech, st.values)
+    flipped = [name for name, sine in now.items() if sine * start[name] < 0.0]
+    if flipped:
+        return (
+            "circuit",
+            f"circuit defect: on profile {j + 1} link {flipped[0]} is in the other assembly mode than on profile 1",
+            flipped[0],
+        )
     structural = max((link.structural_error for link in design.links), default=0.0)
-    if structural <= 1e-9 * chain.size:
-        wrong = st.deviation > SAME_CONFIGURATION
-    else:
-        wrong = st.e_max > chain.joined_errors[j] + 5.0 * structural + 1e-9 * chain.size
-    if not wrong:
+    if structural > 1e-9 * chain.size:
+        allowed = chain.joined_errors[j] + SHAPE_ALLOWANCE * structural
+        if st.e_max <= allowed + 1e-9 * chain.size:
+            return None
+        return (
+            "circuit",
+            f"shape error {st.e_max:.3g} on profile {j + 1} at its best drive setting, more than the joined "
+            f"chain's {chain.joined_errors[j]:.3g} + {SHAPE_ALLOWANCE:g} x the largest structural error "
+            f"{structural:.3g} (too far from the profile to be on it)",
+            max(design.links, key=lambda link: link.structural_error).name,
+        )
+    if st.deviation <= SAME_CONFIGURATION:
         return None
     worst = check.mech.joint_names[
         int(np.argmax(_difference(check.mech, trace.angles[-1], check.ideal[j], chain.size)))
@@ -413,6 +486,13 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     The angle at the moving pivot between the link and the line to the point that, with the link, places the
     body: the body's chain joint ``via``, or the other root link's moving pivot.
     """
+    return {name: abs(s) for name, s in signed_transmissions(design, mech, values).items()}
+
+
+def signed_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
+    """The transmission sines of :func:`link_transmissions` with their sign: the side of the line from the
+    placing point to the moving pivot the link lies on, i.e. the assembly mode of the dyad (it changes only
+    through a dead centre, sine 0)."""
     disp = chain_displacements(design, mech, values)
     joints = {jt.name: jt for jt in design.chain.joints}
     links = {link.name: link for link in design.links}
@@ -433,7 +513,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
             if jt.kind == "P":
                 assert jt.direction is not None
                 d = turned(disp[jt.other(link.body)], jt.direction)
-                out[link.name] = abs(float(u @ d))
+                out[link.name] = float(u @ d)
                 continue
             pj = apply(disp[link.body], jt.point)
         else:
@@ -441,7 +521,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
             pj = apply(disp[link.body], partner.circle)
         r = m - pj
         nr = float(np.linalg.norm(r))
-        out[link.name] = abs(float(u @ np.array([-r[1], r[0]]) / nr)) if nr > 0 else 0.0
+        out[link.name] = float(u @ np.array([-r[1], r[0]]) / nr) if nr > 0 else 0.0
     return out
 
 
