@@ -100,9 +100,10 @@ class _Search:
         return self.out_of_time() or len(self.passed) >= self.options.designs
 
     def unusable(self, line: str) -> None:
-        """Record a plan or design that could not be traced (among the closest while nothing was traced)."""
+        """Record a plan or design that could not be traced (among the closest while nothing was traced; one
+        that says how a link leaves the shape ahead of one that does not)."""
         self.rejected.append(line)
-        self._closer(-1, line)
+        self._closer(-1 if "leaves profile" in line else -2, line)
 
     def _closer(self, reached: int, line: str) -> None:
         """Keep the :data:`CLOSEST` designs that reached the most profiles (the first found first on a tie)."""

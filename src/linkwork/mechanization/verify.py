@@ -334,7 +334,10 @@ def _reach(
 
 
 #: The drive setting of a profile is refined to this fraction of the drive's step between profiles.
-SETTING_TOLERANCE = 1e-5
+SETTING_TOLERANCE = 1e-3
+
+#: At most this many traces refine one profile's drive setting.
+SETTING_TRACES = 14
 
 
 def _best_setting(
@@ -366,7 +369,10 @@ def _best_setting(
         return reached[1].e_max if ok else 1e3 * check.design.chain.size  # type: ignore[union-attr]
 
     best = minimize_scalar(
-        error, bounds=(lo, hi), method="bounded", options={"xatol": SETTING_TOLERANCE * (hi - lo)}
+        error,
+        bounds=(lo, hi),
+        method="bounded",
+        options={"xatol": SETTING_TOLERANCE * (hi - lo), "maxiter": SETTING_TRACES},
     )
     t = float(best.x)
     if error(t) < st.e_max:
