@@ -70,8 +70,8 @@ class ProfileState:
 class Verification:
     """The outcome of :func:`verify`.
 
-    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"``, ``"circuit"`` or
-    ``"closure"`` with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
+    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"``, ``"circuit"``,
+    ``"closure"`` or (set by the search with ``ground_region = "inside"``) ``"inside"``, with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
     when the motion was not traced (more than one DOF: the tracer follows one-parameter paths); a design that
     passes untraced says so in ``reason`` (``"not traced: dof 2 ..."``).
     """
