@@ -103,3 +103,15 @@ def test_path_end_reads_every_stop_of_the_tracer() -> None:
     }
     # every stop the tracer can report is told apart (the rest, joint limit and no progress, are "other")
     assert {"target", "turning", "failed", "bifurcation", "budget", "closed"} <= kinds
+
+
+def test_path_end_prefers_the_structured_end_when_the_tracer_gives_one() -> None:
+    from types import SimpleNamespace
+
+    from linkwork.mechanization.verify import path_end
+
+    # a structured end (``Branch.end_kind``, a StopReason) decides, whatever the words say
+    branch = SimpleNamespace(end_reason="reached target", end_kind=SimpleNamespace(name="TURNING"))
+    assert path_end(SimpleNamespace(branches=[branch])).kind == "turning"  # type: ignore[arg-type]
+    plain = SimpleNamespace(end_reason="drive turning point", end_kind=None)
+    assert path_end(SimpleNamespace(branches=[plain])).kind == "turning"  # type: ignore[arg-type]

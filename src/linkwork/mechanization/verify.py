@@ -120,22 +120,28 @@ class PathEnd:
     text: str
 
 
+#: The tracer's stop reasons (``StopReason`` names, and the words of each) as the verification reads them.
+_END_KINDS = (
+    ("TARGET", "reached target", "target"),
+    ("TURNING", "drive turning point", "turning"),
+    ("FAILED", "corrector failed", "failed"),
+    ("SIGN_CHANGE", "bifurcation", "bifurcation"),
+    ("BUDGET", "step budget", "budget"),
+    ("CLOSED", "closed path", "closed"),
+)
+
+
 def path_end(path: Trace) -> PathEnd:
     """How the first branch of ``path`` ended: the ONE place mechanization reads a tracer's end reason.
 
-    The tracer reports a branch's end as text today; when its structured end reasons (a stop-reason enum with
-    kind, joint and value) land, this is the one function to change.
+    The structured end (``Branch.end_kind``, a ``StopReason``) when the tracer gives one, else the words of
+    ``Branch.end_reason``.
     """
-    text = path.branches[0].end_reason
-    for prefix, kind in (
-        ("reached target", "target"),
-        ("drive turning point", "turning"),
-        ("corrector failed", "failed"),
-        ("bifurcation", "bifurcation"),
-        ("step budget", "budget"),
-        ("closed path", "closed"),
-    ):
-        if text.startswith(prefix):
+    branch = path.branches[0]
+    text = branch.end_reason
+    structured = getattr(branch, "end_kind", None)
+    for name, words, kind in _END_KINDS:
+        if (getattr(structured, "name", None) == name) if structured is not None else text.startswith(words):
             return PathEnd(kind, text)
     return PathEnd("other", text)
 
