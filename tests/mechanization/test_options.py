@@ -31,15 +31,17 @@ def test_every_option_is_a_problem_key_in_file_units(tmp_path: Path) -> None:
         tmp_path,
         'dof = 2\ndrive = "J1"\nactuator = "prismatic"\nground_region = "inside"\nlink_offset = 0.5\n'
         'max_link = 0.8\nmin_transmission = 20.0\nanchors = "any"\nattempts = 3\ntime_limit = 12.5\n'
-        'root = "s1"\nbinary_links = "both"\ndesigns = 2\n',
+        'root = "s1"\nbinary_links = "both"\ndesigns = 2\nmax_structural_error = 0.002\n',
     )
     problem = load_problem(file)
-    assert set(problem.mechanize_options) == set(OPTION_KEYS)
+    # max_link_fraction is the other way of giving max_link (not both)
+    assert set(problem.mechanize_options) == set(OPTION_KEYS) - {"max_link_fraction"}
     options = resolve_options(problem)
     assert options.dof == 2 and options.drive == "J1" and options.actuator == "prismatic"
     assert options.ground_region == "inside" and options.anchors == "any" and options.root == "s1"
     assert options.link_offset == 0.5 and options.max_link == 0.8 and options.attempts == 3
     assert options.time_limit == 12.5 and options.binary_links == "both" and options.designs == 2
+    assert options.max_structural_error == 0.002 and options.link_limit(5.0) == 0.8  # a length, any size
     assert abs(options.min_transmission - math.radians(20.0)) <= 1e-15  # degrees in the file, radians here
 
 
@@ -69,8 +71,21 @@ def test_a_bad_key_names_the_file_and_the_key(tmp_path: Path, line: str, key: st
     assert "\n" not in str(info.value)
 
 
+def test_max_link_is_a_length_and_max_link_fraction_a_multiple_of_the_largest_extent(tmp_path: Path) -> None:
+    assert MechanizeOptions(max_link=0.8).link_limit(2.0) == 0.8
+    assert MechanizeOptions(max_link_fraction=0.8).link_limit(2.0) == 1.6
+    assert MechanizeOptions().link_limit(2.0) == 3.0  # the default: 1.5 times the largest extent
+    with pytest.raises(SpecError, match=r"problem\.toml: max_link_fraction: give max_link"):
+        load_problem(_problem(tmp_path, "max_link = 0.8\nmax_link_fraction = 0.5\n"))
+    # a flag replaces the file's limit whichever way either is given
+    problem = load_problem(_problem(tmp_path, "max_link = 0.8\n"))
+    assert resolve_options(problem, {"max_link_fraction": 0.5}).link_limit(2.0) == 1.0
+    problem = load_problem(_problem(tmp_path, "max_link_fraction = 0.5\n"))
+    assert resolve_options(problem, {"max_link": 0.7}).link_limit(2.0) == 0.7
+
+
 def test_a_bad_flag_names_the_flag() -> None:
-    with pytest.raises(SpecError, match="--max-link: expected a positive number"):
+    with pytest.raises(SpecError, match="--max-link: expected a positive length"):
         options_from_values({"max_link": -1.0}, flags=True)
     with pytest.raises(SpecError, match="--ground-region"):
         parse_region_flag("1,a")

@@ -72,3 +72,46 @@ def test_a_drive_that_is_not_monotonic_over_the_profiles_is_an_order_defect() ->
     check = verify(_four_bar_design(poses, GROUND_D, COUPLER))
     assert not check.passed
     assert check.defect == "order"
+
+
+def test_the_mechanism_verified_in_memory_is_the_one_linkwork_trace_reads_from_the_file(tmp_path) -> None:
+    from linkwork.io.spec import load_spec
+    from linkwork.mechanization.assemble import spec_text
+    from linkwork.mechanization.verify import loaded_mechanism
+
+    poses = np.array([coupler_pose(p) for p in np.radians([40.0, 70.0, 110.0])])
+    design = _four_bar_design(poses, GROUND_D, COUPLER)
+    file = tmp_path / "mechanism.toml"
+    file.write_text(spec_text(design), encoding="utf-8")
+    read, memory = load_spec(file).mechanism, loaded_mechanism(design)
+    assert read.joint_names == memory.joint_names and read.joint_types == memory.joint_types
+    assert read.loops == memory.loops and read.bodies == memory.bodies
+    # the spec file writes every coordinate to full precision: the same twists and offsets to rounding
+    np.testing.assert_allclose(read.twists, memory.twists, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(read.offsets, memory.offsets, rtol=0, atol=1e-15)
+
+
+def test_path_end_reads_every_stop_of_the_tracer() -> None:
+    from types import SimpleNamespace
+
+    from linkwork.kinematics.march import STOP_REASONS
+    from linkwork.mechanization.verify import path_end
+
+    kinds = {
+        path_end(SimpleNamespace(branches=[SimpleNamespace(end_reason=text)])).kind  # type: ignore[arg-type]
+        for text in STOP_REASONS.values()
+    }
+    # every stop the tracer can report is told apart (the rest, joint limit and no progress, are "other")
+    assert {"target", "turning", "failed", "bifurcation", "budget", "closed"} <= kinds
+
+
+def test_path_end_prefers_the_structured_end_when_the_tracer_gives_one() -> None:
+    from types import SimpleNamespace
+
+    from linkwork.mechanization.verify import path_end
+
+    # a structured end (``Branch.end_kind``, a StopReason) decides, whatever the words say
+    branch = SimpleNamespace(end_reason="reached target", end_kind=SimpleNamespace(name="TURNING"))
+    assert path_end(SimpleNamespace(branches=[branch])).kind == "turning"  # type: ignore[arg-type]
+    plain = SimpleNamespace(end_reason="drive turning point", end_kind=None)
+    assert path_end(SimpleNamespace(branches=[plain])).kind == "turning"  # type: ignore[arg-type]

@@ -1,6 +1,8 @@
-"""The bundled wing mechanized with ``ground_region = "inside"``: every fixed pivot inside every airfoil outline
-(checked with matplotlib's point-in-polygon on the Selig files as written), every binary link no longer than the
-cruise chord (1.0), and the written mechanism, traced, passes through every profile."""
+"""A wing morphing NACA 2412 -> 3412 -> 4412 (chords 1.0, 1.05, 1.1, open outlines) mechanized with
+``ground_region = "inside"``: every pivot of every link, fixed and moving, inside every airfoil outline in that
+profile's pose, and every link inside (checked with matplotlib's point-in-polygon on the outlines as written, from
+``mechanization.json``'s ``profiles[k].pivots``), no link longer than the cruise chord (1.0), and the written
+mechanism, traced, passes through every profile."""
 
 from __future__ import annotations
 
@@ -11,43 +13,57 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linkwork.data import example
 from linkwork.io.problem import load_problem
 from linkwork.io.spec import load_spec
 from linkwork.kinematics.tracer import trace
-from linkwork.mechanization import MechanizeOptions, build_chain, mechanize, write_mechanization
+from linkwork.mechanization import MechanizeOptions, mechanize, write_mechanization
+from linkwork.mechanization.verify import SHAPE_ALLOWANCE
 from linkwork.synthesis import synthesize
 
 from .geometry_checks import joint_positions, triangle_angle
+from .test_many_profiles import naca4
 
-WING = example("wing").parent
 CHORD = 1.0  # the cruise profile's chord, the shortest of the three
+SECTIONS = {"cruise": ("2412", 1.0), "climb": ("3412", 1.05), "landing": ("4412", 1.1)}
 
 
 @pytest.fixture(scope="module")
 def inside(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object, tuple]:
-    result = synthesize(load_problem(WING / "mechanize.toml"))
-    size = build_chain(result).size
-    options = MechanizeOptions(ground_region="inside", max_link=CHORD / size, designs=1, time_limit=60.0)
+    profiles = tmp_path_factory.mktemp("wing-inside")
+    for name, (code, chord) in SECTIONS.items():
+        np.savetxt(
+            profiles / f"{name}.csv", naca4(code, chord)[:-1], delimiter=",", header="x,y", comments=""
+        )
+    (profiles / "problem.toml").write_text(
+        'type = "open"\nprofiles = ["cruise.csv", "climb.csv", "landing.csv"]\npiece_length = 0.02\n'
+        'design = "MCMC"\nmechanize = true\n'
+    )
+    result = synthesize(load_problem(profiles / "problem.toml"))
+    options = MechanizeOptions(ground_region="inside", max_link=CHORD, designs=1, time_limit=120.0)
     calls: list[tuple[int, int | None]] = []
     found = mechanize(result, options, progress=lambda done, total: calls.append((done, total)))
-    folder = tmp_path_factory.mktemp("wing-inside")
-    write_mechanization(found, folder)
-    return folder, result, (calls, found.attempts)
+    write_mechanization(found, profiles)
+    return profiles, result, (calls, found.attempts)
 
 
-def _outline(name: str) -> np.ndarray:
-    return np.loadtxt(WING / name, skiprows=1)
+def _outline(folder: Path, name: str) -> np.ndarray:
+    return np.loadtxt(folder / name, delimiter=",", skiprows=1)
 
 
-def test_every_ground_pivot_is_inside_every_airfoil(inside: tuple) -> None:
+def test_every_pivot_and_link_is_inside_every_airfoil_in_its_pose(inside: tuple) -> None:
     mpath = pytest.importorskip("matplotlib.path")
     folder, _, _ = inside
     report = json.loads((folder / "mechanization.json").read_text())
     pivots = [d["ground_pivot"] for d in report["dyads"] if d["ground_pivot"] is not None]
     assert pivots, "at least the root's links are pivoted on the ground"
-    for name in ("cruise.dat", "climb.dat", "landing.dat"):
-        assert np.all(mpath.Path(_outline(name)).contains_points(pivots)), name
+    for name in SECTIONS:
+        assert np.all(mpath.Path(_outline(folder, f"{name}.csv")).contains_points(pivots)), name
+    for profile, name in zip(report["profiles"], SECTIONS, strict=True):
+        shape = mpath.Path(_outline(folder, f"{name}.csv"))  # closed from its last point to its first
+        for link, (anchor, moving) in profile["pivots"].items():
+            along = np.linspace(0.0, 1.0, 201)[:, None]
+            points = np.array(anchor) + along * (np.array(moving) - np.array(anchor))
+            assert np.all(shape.contains_points(points)), (link, name)
     for dyad in report["dyads"]:
         assert (dyad["ground_pivot"] is None) == (dyad["anchor"] != "ground")
         if dyad["type"] == "RR":
@@ -62,8 +78,11 @@ def test_the_written_mechanism_traces_through_every_profile(inside: tuple) -> No
     mech = load_spec(folder / "mechanism.toml").mechanism
     drive = report["drive"]
     for j, profile in enumerate(report["profiles"]):
-        # exact three-position guidance: the shape error on every profile is the joined chain's
-        assert abs(profile["e_max"] - float(np.max(result.joined[j].errors))) <= 1e-9
+        # links inside a slender shape need not be exact: the shape error is within the joined chain's plus the
+        # documented allowance of five times the largest structural error
+        joined = float(np.max(result.joined[j].errors))
+        assert profile["joined_e_max"] == joined
+        assert profile["e_max"] <= joined + SHAPE_ALLOWANCE * report["max_structural_error"] + 1e-9
         if j == 0:
             continue
         value = (

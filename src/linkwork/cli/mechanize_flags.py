@@ -61,7 +61,25 @@ LinkOffset = Annotated[
 MaxLink = Annotated[
     float | None,
     typer.Option(
-        rich_help_panel=PANEL, help="Longest link, times the profiles' largest extent; key max_link."
+        rich_help_panel=PANEL,
+        help="Longest link, a length in the profiles' units (default 1.5 times their largest extent); key "
+        "max_link.",
+    ),
+]
+MaxLinkFraction = Annotated[
+    float | None,
+    typer.Option(
+        rich_help_panel=PANEL,
+        help="Longest link as a multiple of the profiles' largest extent (instead of --max-link); key "
+        "max_link_fraction.",
+    ),
+]
+MaxStructuralError = Annotated[
+    float | None,
+    typer.Option(
+        rich_help_panel=PANEL,
+        help="Largest structural error of a least-squares link (more than five profiles): the spread of the "
+        "length it would need across the profiles, profile units; key max_structural_error.",
     ),
 ]
 MinTransmission = Annotated[
@@ -94,6 +112,8 @@ FLAGS: dict[str, Any] = {
     "ground_region": GroundRegion,
     "link_offset": LinkOffset,
     "max_link": MaxLink,
+    "max_link_fraction": MaxLinkFraction,
+    "max_structural_error": MaxStructuralError,
     "min_transmission": MinTransmission,
     "attempts": Attempts,
     "designs": Designs,
@@ -105,7 +125,7 @@ FLAGS: dict[str, Any] = {
 def with_mechanize_flags(after: str) -> Callable[[Callable[..., None]], Callable[..., None]]:
     """Add the mechanization flags of :data:`FLAGS` to a command, after its parameter ``after``.
 
-    The decorated command declares a keyword parameter ``flags`` instead of the thirteen flags; it receives the
+    The decorated command declares a keyword parameter ``flags`` instead of the flags; it receives the
     flags given on the command line as problem-file values (see :func:`flag_values`).
     """
 

@@ -8,7 +8,8 @@ lies on the circle about ``c``:
 * 3 positions: any circle point; its centre point is the centre of the circle through its three positions.
 * 4 positions: the circle points lie on a cubic, the circle-point curve, their centres on the centre-point curve.
 * 5 positions: at most four circle points (Burmester points), where two such cubics meet.
-* more positions: least-squares circles, with a structural error.
+* more positions: least-squares circles, with a structural error (the spread of the length the link would
+  need across the positions).
 
 Equal distances ``|W_j - c| = |W_1 - c|`` are linear in ``c``: ``2 (W_j - W_1) . c = |W_j|^2 - |W_1|^2``
 (McCarthy, *Geometric Design of Linkages*, ch. 4-5); the ``|m|^2`` terms cancel, so each row is linear in ``m``
@@ -87,7 +88,9 @@ class Dyad:
     radius
         The link length ``|W_1 - c|`` (the dyad is exact in position 1).
     structural_error
-        ``max_j | |W_j - c| - radius |``: 0 (to rounding) for an exact dyad.
+        The spread of the length the link would need across the positions, ``max_j |W_j - c| - min_j |W_j -
+        c|``: 0 (to rounding) for an exact dyad. A link of length ``radius`` misses the other positions by up to
+        this much.
     """
 
     circle_point: Array
@@ -101,7 +104,7 @@ def centre_point(poses: ArrayLike, circle_point: ArrayLike) -> Dyad:
 
     For ``p = 3`` the centre of the circle through the three positions; for ``p > 3`` the least-squares
     solution of the equal-distance equations, refined to minimise the geometric distances, with the link length
-    fixed by position 1 and the structural error reported.
+    fixed by position 1 and the structural error (the spread of the distances) reported.
     """
     g = np.asarray(poses, dtype=float)
     m = np.asarray(circle_point, dtype=float)
@@ -115,7 +118,7 @@ def centre_point(poses: ArrayLike, circle_point: ArrayLike) -> Dyad:
         c = np.asarray(np.linalg.lstsq(a, b, rcond=None)[0], dtype=float)
         c = _refine_centre(w, c)
     radius = float(np.linalg.norm(w[0] - c))
-    err = float(np.max(np.abs(np.linalg.norm(w - c, axis=1) - radius)))
+    err = float(np.ptp(np.linalg.norm(w - c, axis=1)))
     return Dyad(m, c, radius, err)
 
 
@@ -326,7 +329,7 @@ def burmester_points(poses: ArrayLike, *, tol: float = 1e-8) -> list[Dyad]:
         a, b = _rows(g, z)
         c = np.linalg.lstsq(a, b, rcond=None)[0]
         radius = float(np.linalg.norm(w[0] - c))
-        err = float(np.max(np.abs(np.linalg.norm(w - c, axis=1) - radius)))
+        err = float(np.ptp(np.linalg.norm(w - c, axis=1)))
         if err > tol * scale or radius > 1e6 * scale:
             continue
         if any(np.linalg.norm(d.circle_point - z) <= 1e-7 * scale for d in found):

@@ -9,11 +9,13 @@ attempts run out.
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from linkwork.errors import SpecError
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
 from linkwork.mechanization.options import (
@@ -63,6 +65,8 @@ class Mechanization:
         Wall time.
     ranked
         Up to ``options.designs`` (5) passing designs, best quality factor first (``ranked[0]`` is ``design``).
+    options
+        The options the search ran with (the limits it kept are reported from them).
     """
 
     design: Design
@@ -71,6 +75,7 @@ class Mechanization:
     rejected: tuple[str, ...]
     seconds: float
     ranked: tuple[RankedDesign, ...] = ()
+    options: MechanizeOptions | None = None
 
 
 @dataclass
@@ -84,7 +89,7 @@ class _Search:
     attempts: int = 0
     passed: list[RankedDesign] = field(default_factory=list)
     rejected: list[str] = field(default_factory=list)
-    closest: tuple[int, str] | None = None
+    closest: list[tuple[int, str]] = field(default_factory=list)
 
     def out_of_time(self) -> bool:
         """The search's time limit has passed."""
@@ -95,10 +100,16 @@ class _Search:
         return self.out_of_time() or len(self.passed) >= self.options.designs
 
     def unusable(self, line: str) -> None:
-        """Record a plan or design that could not be traced (the closest so far when nothing was traced)."""
+        """Record a plan or design that could not be traced (among the closest while nothing was traced; one
+        that says how a link leaves the shape ahead of one that does not)."""
         self.rejected.append(line)
-        if self.closest is None:
-            self.closest = (-1, line)
+        self._closer(-1 if "leaves profile" in line else -2, line)
+
+    def _closer(self, reached: int, line: str) -> None:
+        """Keep the :data:`CLOSEST` designs that reached the most profiles (the first found first on a tie)."""
+        self.closest.append((reached, line))
+        self.closest.sort(key=lambda c: -c[0])  # stable: earlier designs stay ahead on a tie
+        del self.closest[CLOSEST:]
 
     def traced(self, label: str, design: Design, check: Verification) -> None:
         """Record a verified design (passed or rejected) and report progress."""
@@ -109,13 +120,12 @@ class _Search:
         else:
             self.rejected.append(f"{label}: {check.reason}")
             reached = len(check.states)
-            if self.closest is None or reached > self.closest[0]:
-                links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
-                self.closest = (
-                    reached,
-                    f"{label} (links {links}; drive {design.drive}) reached profile {reached} of {design.chain.count}, "
-                    f"then: {check.reason}",
-                )
+            links = ", ".join(f"{link.name} {link.anchor}-{link.body}" for link in design.links)
+            self._closer(
+                reached,
+                f"{label} (links {links}; drive {design.drive}) reached profile {reached} of {design.chain.count}, "
+                f"then: {check.reason}",
+            )
         if self.progress is not None:
             self.progress(self.attempts, self.total)
 
@@ -210,11 +220,13 @@ def mechanize(
     """
     options = _options(result, options)
     chain, label = _chain(result, name)
+    check_names(chain, options)
     # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
     # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
     modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
     order = roots(chain, options)
-    state = _Search(options, time.perf_counter(), progress, options.attempts * len(order) * len(modes))
+    most = options.attempts * (1 + REDRIVES) * len(order) * len(modes)
+    state = _Search(options, time.perf_counter(), progress, most)
     for root in order:
         for mode in modes:
             if state.done():
@@ -279,9 +291,16 @@ def _outcome(state: _Search) -> Mechanization:
         ranked = tuple(sorted(state.passed, key=lambda r: -round(r.quality.factor, 9)))
         best = ranked[0]
         return Mechanization(
-            best.design, best.verification, state.attempts, tuple(state.rejected), seconds, ranked
+            best.design,
+            best.verification,
+            state.attempts,
+            tuple(state.rejected),
+            seconds,
+            ranked,
+            state.options,
         )
-    closest = state.closest[1].removeprefix("mechanize: ") if state.closest else "no design"
+    lines = [line.removeprefix("mechanize: ") for _, line in state.closest]
+    closest = " | ".join(f"({k}) {line}" for k, line in enumerate(lines, start=1)) if lines else "no design"
     timed_out = " (time limit reached)" if state.out_of_time() else ""
     dof = state.options.dof
     raise MechanizationError(
@@ -291,17 +310,55 @@ def _outcome(state: _Search) -> Mechanization:
     )
 
 
+#: The closest failed designs named when none passes.
+CLOSEST = 3
+
+#: A design with an order defect (its drive turns back) is traced again driven by at most this many other joints
+#: (those moving one way through the profiles, the most evenly first), unless the designer chose the drive.
+REDRIVES = 3
+
+#: Joints of the added links a design may have: an RR dyad's ``D<k>a`` / ``D<k>m``, a slider's ``D<k>s``, the
+#: linear actuator's ``A1a`` / ``A1s`` / ``A1m``.
+LINK_JOINT = re.compile(r"^(D[1-9][0-9]*[ams]|A1[ams])$")
+
+
+def check_names(chain: ShapeChain, options: MechanizeOptions) -> None:
+    """Refuse a ``drive`` or ``root`` that no design of this chain can have, naming the choices.
+
+    Raises
+    ------
+    SpecError
+        ``drive`` (neither a chain joint nor a link joint ``D<k>a``, ``D<k>m``, ``D<k>s``, ``A1s``) or ``root``
+        (not a body of the chain): bad input, exit code 2.
+    """
+    bodies = [b.name for b in chain.bodies]
+    if options.root is not None and options.root not in bodies:
+        raise SpecError(f"unknown body {options.root!r}; expected one of {', '.join(bodies)}", key="root")
+    joints = [j.name for j in chain.joints]
+    if options.drive is not None and options.drive not in joints and not LINK_JOINT.match(options.drive):
+        raise SpecError(
+            f"unknown joint {options.drive!r}; expected a chain joint ({', '.join(joints) or 'none'}) or a joint "
+            "of an added link: D<k>a (an RR link's fixed pivot), D<k>m (its moving pivot), D<k>s (a slider), A1s "
+            "(the linear actuator)",
+            key="drive",
+        )
+
+
 def _check(options: MechanizeOptions) -> None:
-    """Reject options no search can use (the problem reader and the flags check them too)."""
+    """Reject options no search can use (the problem reader and the flags check them too): bad input, exit 2.
+
+    Raises
+    ------
+    SpecError
+        Naming the option and what was expected.
+    """
     if options.dof < 1:
-        raise MechanizationError(f"mechanize: dof {options.dof}: expected at least 1")
+        raise SpecError(f"{options.dof}: expected a whole number >= 1", key="dof")
     for key, choices in (("actuator", ACTUATORS), ("binary_links", BINARY_LINKS), ("anchors", ANCHORS)):
         value = getattr(options, key)
         if value not in choices:
             quoted = [f"'{c}'" for c in choices]
-            raise MechanizationError(
-                f"mechanize: {key} {value!r}: expected {', '.join(quoted[:-1])} or {quoted[-1]}"
-            )
+            raise SpecError(f"{value!r}: expected {', '.join(quoted[:-1])} or {quoted[-1]}", key=key)
 
 
 def _with_transmissions(design: Design, check: Verification) -> Design:
@@ -344,8 +401,11 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
                 f"(joints are {', '.join(design.joint_names())})"
             )
             return
+        label_k = f"root {pl.root}, anchors {options.anchors}, design {attempt}"
         check = verify(design)
-        state.traced(f"root {pl.root}, anchors {options.anchors}, design {attempt}", design, check)
+        state.traced(label_k, design, check)
+        if check.defect == "order" and options.drive is None:
+            design, check = _redrive(design, check, label_k, state)
         if check.defect == "dof":
             return
         # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
@@ -360,6 +420,36 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         if not movable:
             return
         choice[movable[attempt % len(movable)]] += 1
+
+
+def redrives(design: Design) -> list[str]:
+    """Other joints that could drive ``design``: those whose values move one way through the profiles, the
+    most evenly moving first (the smallest step between profiles over the largest), at most :data:`REDRIVES`."""
+    ideal = design.ideal_values()
+    ranked: list[tuple[float, str]] = []
+    for k, name in enumerate(design.joint_names()):
+        steps = np.diff(ideal[:, k])
+        largest = float(np.max(np.abs(steps)))
+        if name == design.drive or largest <= 1e-9 or not (np.all(steps > 0) or np.all(steps < 0)):
+            continue
+        ranked.append((float(np.min(np.abs(steps))) / largest, name))
+    ranked.sort(key=lambda r: -r[0])
+    return [name for _, name in ranked[:REDRIVES]]
+
+
+def _redrive(design: Design, check: Verification, label: str, state: _Search) -> tuple[Design, Verification]:
+    """A design whose drive turns back (a dead centre of that joint) may pass driven from another joint: the
+    mechanism is the same, only the joint that moves it one way through the profiles changes. The first that
+    passes is kept; else the original verdict stands."""
+    for other in redrives(design):
+        if state.done():
+            break
+        again = replace(design, drive=other)
+        verdict = verify(again)
+        state.traced(f"{label} re-driven from {other}", again, verdict)
+        if verdict.passed:
+            return again, verdict
+    return design, check
 
 
 def _weakest(design: Design) -> str | None:

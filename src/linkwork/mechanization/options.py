@@ -31,6 +31,8 @@ OPTION_KEYS = (
     "ground_region",
     "link_offset",
     "max_link",
+    "max_link_fraction",
+    "max_structural_error",
     "min_transmission",
     "anchors",
     "attempts",
@@ -44,6 +46,13 @@ OPTION_KEYS = (
 ACTUATORS = ("revolute", "prismatic")
 ANCHORS = ("ground", "any", "auto")
 BINARY_LINKS = ("revolute", "prismatic", "both")
+
+#: Longest link, times the profiles' largest extent, when neither ``max_link`` nor ``max_link_fraction`` is given.
+DEFAULT_LINK_FRACTION = 1.5
+
+#: Least-squares links whose structural error exceeds this fraction of the profiles' size are never kept
+#: (without ``max_structural_error``).
+DEFAULT_STRUCTURAL_FRACTION = 0.05
 
 ProgressCallback = Progress
 """The one progress protocol (:class:`linkwork.progress.Progress`): ``progress(done, total)``, designs traced so far
@@ -144,7 +153,15 @@ class MechanizeOptions:
     min_transmission
         Radians: dyads whose transmission angle drops below this on a profile are dropped.
     max_link
-        Longest link, as a multiple of the profiles' size (their largest extent: the chord of a wing).
+        Longest link, a length in the profiles' units (``None``: see ``max_link_fraction``). Before 0.3 this was
+        a multiple of the profiles' largest extent; that is now ``max_link_fraction``.
+    max_link_fraction
+        Longest link as a multiple of the profiles' largest extent (the largest chord of a wing), used when
+        ``max_link`` is ``None``; ``None`` means :data:`DEFAULT_LINK_FRACTION`.
+    max_structural_error
+        Largest structural error of a least-squares link (more than five profiles): the spread ``max_j |
+        |W_j - c| - r|`` of the length it would need across the profiles, a length in the profiles' units;
+        ``None``: no bound (the error is reported).
     root
         The body guided first (default: the body with the longest outline).
     drive
@@ -172,7 +189,9 @@ class MechanizeOptions:
     link_offset: float = 1.5
     anchors: str = "auto"
     min_transmission: float = math.radians(15.0)
-    max_link: float = 1.5
+    max_link: float | None = None
+    max_link_fraction: float | None = None
+    max_structural_error: float | None = None
     root: str | None = None
     drive: str | None = None
     actuator: str = "revolute"
@@ -181,6 +200,20 @@ class MechanizeOptions:
     attempts: int = 6
     designs: int = 5
     time_limit: float = 60.0
+
+    def link_limit(self, size: float) -> float:
+        """The longest link allowed, a length, for profiles of largest extent ``size``."""
+        if self.max_link is not None:
+            return self.max_link
+        fraction = self.max_link_fraction if self.max_link_fraction is not None else DEFAULT_LINK_FRACTION
+        return fraction * size
+
+    def structural_limit(self, size: float) -> float:
+        """The largest structural error allowed, a length: ``max_structural_error``, else
+        :data:`DEFAULT_STRUCTURAL_FRACTION` of ``size`` (the search's own cut-off)."""
+        if self.max_structural_error is not None:
+            return self.max_structural_error
+        return DEFAULT_STRUCTURAL_FRACTION * size
 
     def region_of(self, targets: tuple[Array, ...], size: float) -> GroundRegion:
         """The ground region in use for profiles ``targets`` of largest extent ``size``."""
@@ -259,7 +292,18 @@ _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
     "anchors": _one_of(ANCHORS),
     "binary_links": _one_of(BINARY_LINKS),
     "link_offset": (lambda v: n if (n := _number(v)) is not None and n >= 0 else None, "a number >= 0"),
-    "max_link": (lambda v: n if (n := _number(v)) is not None and n > 0 else None, "a positive number"),
+    "max_link": (
+        lambda v: n if (n := _number(v)) is not None and n > 0 else None,
+        "a positive length (profile units)",
+    ),
+    "max_link_fraction": (
+        lambda v: n if (n := _number(v)) is not None and n > 0 else None,
+        "a positive multiple of the profiles' largest extent",
+    ),
+    "max_structural_error": (
+        lambda v: n if (n := _number(v)) is not None and n >= 0 else None,
+        "a length >= 0 (profile units)",
+    ),
     "min_transmission": (
         lambda v: math.radians(n) if (n := _number(v)) is not None and 0 <= n < 90 else None,
         "an angle in degrees, 0 <= min_transmission < 90",
@@ -299,6 +343,18 @@ def options_from_values(
         except _Bad as bad:
             shown = "--" + key.replace("_", "-") if flags else key
             raise SpecError(str(bad), source=source, key=shown) from None
+    # the longest link is one limit: a length or a fraction, and the one given here replaces the base's
+    if "max_link" in out and "max_link_fraction" in out:
+        shown = "--max-link-fraction" if flags else "max_link_fraction"
+        raise SpecError(
+            "give max_link (a length) or max_link_fraction (a multiple of the largest extent), not both",
+            source=source,
+            key=shown,
+        )
+    if "max_link" in out:
+        out["max_link_fraction"] = None
+    elif "max_link_fraction" in out:
+        out["max_link"] = None
     names = {f.name for f in fields(MechanizeOptions)}
     assert set(out) <= names
     base = base or MechanizeOptions()

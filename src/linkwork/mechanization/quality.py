@@ -11,8 +11,8 @@ The quality factor of a design is the product of three numbers between 0 and 1 (
   shortest and longest length; a slider has no length and does not count);
 * ``f_stroke``: the actuator stroke. For a linear actuator ``min(1, L_retracted / stroke)`` (a single-stage
   actuator cannot extend by more than its retracted length); for a revolute drive ``min(1, 180 deg / sweep)``
-  (a crank that turns more than half a revolution between the first and last profile needs a gear); 1 for a
-  slider's drive.
+  (a crank, or any revolute joint driving, that turns more than half a revolution between the first and last
+  profile needs a gear); 1 for a slider's drive.
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ def quality(design: Design, check: Verification) -> Quality:
         slide = names.index(design.drive)
         retracted = actuator.length + min(s.values[slide] for s in check.states)
         f_stroke = min(1.0, retracted / stroke) if stroke > 0 else 1.0
-    elif design.drive.endswith("a") or design.drive.startswith("J"):
+    elif next(str(j["type"]) for j in design.joint_specs() if j["name"] == design.drive) == "R":
         f_stroke = min(1.0, math.pi / stroke) if stroke > 0 else 1.0
     else:  # a slider or the chain's own prismatic joint: its guide is as long as it must be
         f_stroke = 1.0

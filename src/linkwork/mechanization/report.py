@@ -9,6 +9,7 @@ from typing import Any
 
 from linkwork.mechanization.assemble import spec_text
 from linkwork.mechanization.mechanize import Mechanization, RankedDesign
+from linkwork.mechanization.verify import link_pivots
 
 
 def _value(kind: str, value: float) -> float:
@@ -17,9 +18,12 @@ def _value(kind: str, value: float) -> float:
 
 def mechanization_dict(result: Mechanization) -> dict[str, Any]:
     """The ``mechanization.json`` contract: ``dof``, ``drive``, ``dyads`` and per profile ``drive_value``,
-    ``angles`` {joint: degrees (lengths for prismatic joints)} and ``e_max``; angles in degrees."""
+    ``angles`` {joint: degrees (lengths for prismatic joints)}, ``e_max`` beside ``joined_e_max``, and ``pivots``
+    {link: [[x, y] anchor pivot, [x, y] moving pivot]} in that profile's pose; ``limits`` the link-length and
+    structural-error bounds used; angles in degrees."""
     design, check = result.design, result.verification
     mech = design.mechanism()
+    size = design.chain.size
     kinds = dict(zip(mech.joint_names, mech.joint_types, strict=True))
     d_kind = kinds[design.drive]
     profiles = []
@@ -35,6 +39,10 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
                 "e_max": state.e_max,
                 "joined_e_max": float(design.chain.joined_errors[j]),
                 "deviation": state.deviation,
+                "pivots": {
+                    name: [[float(v) for v in point] for point in pair]
+                    for name, pair in link_pivots(design, mech, state.values).items()
+                },
             }
         )
     return {
@@ -49,6 +57,9 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
         "dyads": [link.to_dict() for link in design.links],
         "profiles": profiles,
         "e_max": max(s.e_max for s in check.states),
+        "joined_e_max": float(max(design.chain.joined_errors)),
+        "max_structural_error": max((link.structural_error for link in design.links), default=0.0),
+        "limits": _limits(result, size),
         "max_condition": check.max_condition,
         "verification": {
             "passed": check.passed,
@@ -74,6 +85,23 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
         "notes": list(design.notes),
         "seconds": result.seconds,
         "trace_command": f"linkwork trace mechanism.toml --drive {design.drive} --until {design.drive}=<drive_value>",
+    }
+
+
+def _limits(result: Mechanization, size: float) -> dict[str, Any]:
+    """The bounds the search kept: ``max_link`` (a length, profile units) and the same as a multiple of the
+    profiles' largest extent ``size``, and ``max_structural_error`` (a length; ``None`` when not bounded by the
+    designer)."""
+    options = result.options
+    if options is None:
+        return {}
+    longest = options.link_limit(size)
+    return {
+        "max_link": longest,
+        "max_link_fraction": longest / size,
+        "largest_extent": size,
+        "max_structural_error": options.max_structural_error,
+        "structural_error_cut": options.structural_limit(size),
     }
 
 

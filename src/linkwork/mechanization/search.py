@@ -24,11 +24,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.errors import LinkworkError, MechanizationError
+from linkwork.errors import LinkworkError, MechanizationError, SpecError
 from linkwork.geometry.se2 import relative
 from linkwork.mechanization import guidance, sliders
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, track, track_direction
+from linkwork.mechanization.inside import Leaving, leaving
 from linkwork.mechanization.options import GroundRegion, MechanizeOptions
 
 Array = NDArray[np.float64]
@@ -39,6 +40,11 @@ REGION_SAMPLES = 81
 #: With more than five profiles, this many moving pivots per body are moved to fit a circle best.
 POLISHED = 12
 
+#: Score lost per unit of structural error relative to the profiles' size: a structural error of 1 % of the
+#: size costs as much as 50 degrees of transmission angle (the shape error is what the designer asked for; any
+#: transmission above ``min_transmission`` works).
+STRUCTURAL_WEIGHT = 5e3
+
 
 @dataclass(frozen=True)
 class Candidate:
@@ -47,6 +53,7 @@ class Candidate:
     link: BinaryLink
     score: float
     quality: Array = field(default_factory=lambda: np.zeros(0))
+    leaves: Leaving | None = None
 
 
 @dataclass(frozen=True)
@@ -83,6 +90,23 @@ def _moving_pivots(chain: ShapeChain, body: str, count: int, offset: float) -> A
     normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
     out = [pts[idx] + h * offset * length * normal for h in (0.0, 1 / 3, -1 / 3, 2 / 3, -2 / 3, 1.0, -1.0)]
     return np.vstack(out)
+
+
+#: Points inside the first profile tried as moving pivots of a body (``ground_region = "inside"``).
+INTERIOR_SAMPLES = 40
+
+
+def _interior(chain: ShapeChain, body: str) -> Array:
+    """Points inside the first profile near ``body`` (within its length of its outline), profile-1 coordinates."""
+    pts = chain.body(body).outline
+    length = float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) if len(pts) > 1 else chain.size
+    first = GroundRegion.inside(chain.targets[:1]).samples(4 * INTERIOR_SAMPLES)
+    if len(first) == 0:
+        return first.reshape(0, 2)
+    near = np.min(np.linalg.norm(first[:, None, :] - pts[None, :, :], axis=2), axis=1)
+    close = first[near <= max(length, 0.05 * chain.size)]
+    step = max(1, len(close) // INTERIOR_SAMPLES)
+    return close[::step]
 
 
 def _guide(rel: Array, m: Array) -> guidance.Dyad | None:
@@ -144,23 +168,52 @@ def body_candidates(
     anchors: Sequence[str],
     options: MechanizeOptions,
     name: str = "D",
+    *,
+    keep_outside: bool = False,
 ) -> list[Candidate]:
     """Ranked binary links guiding ``body`` relative to each anchor (best first): RR dyads and, as
-    ``options.binary_links`` allows, PR sliders."""
+    ``options.binary_links`` allows, PR sliders.
+
+    With ``ground_region = "inside"`` a link is kept only when its pivots and the link lie inside every profile
+    in its pose (:mod:`linkwork.mechanization.inside`); ``keep_outside`` keeps the others too, each with how it
+    leaves (``Candidate.leaves``), to say how close the search came."""
     region = options.region_of(chain.targets, chain.size)
     out: list[Candidate] = []
     g_body = chain.body(body).displacements
     for anchor in anchors:
         rel = relative(chain.motion(anchor), g_body)
         if options.binary_links in ("revolute", "both"):
-            pivots = _pivot_candidates(chain, body, rel, options)
+            pivots = _pivot_candidates(chain, body, rel, options, region)
             if anchor == "ground":
                 pivots += _pivots_from_region(chain, rel, region)
-            out += _rr_candidates(chain, body, via, anchor, pivots, options, region, name)
+            if region.kind == "inside" and chain.kind == "open":
+                # a closed or fixed-end chain closes its own loop only where every link is exact: an inexact
+                # link there makes the mechanism rigid
+                pivots += _inside_pairs(chain, body, anchor, rel, region, options)
+            out += _rr_candidates(chain, body, via, anchor, pivots, options, region, name, keep_outside)
         if options.binary_links in ("prismatic", "both"):
-            out += _slider_candidates(chain, body, via, anchor, rel, options, region, name)
+            out += _slider_candidates(chain, body, via, anchor, rel, options, region, name, keep_outside)
     out.sort(key=lambda cand: -cand.score)
     return out
+
+
+def least_leaving(
+    chain: ShapeChain, body: str, via: str | None, anchors: Sequence[str], options: MechanizeOptions
+) -> str:
+    """With ``ground_region = "inside"``: how the link of ``body`` that comes closest to staying inside leaves
+    (for the message when no link stays inside); empty otherwise."""
+    if options.region_of(chain.targets, chain.size).kind != "inside":
+        return ""
+    cands = [c for c in body_candidates(chain, body, via, anchors, options, keep_outside=True) if c.leaves]
+    if not cands:
+        return ""
+    best = min(cands, key=lambda c: c.leaves.by if c.leaves is not None else math.inf)
+    assert best.leaves is not None
+    link = best.link
+    return (
+        f"; the link of {body} closest to staying inside ({link.anchor} to {body}, moving pivot "
+        f"({link.circle[0]:.4g}, {link.circle[1]:.4g})): {best.leaves.describe('it')}"
+    )
 
 
 def _accepts(s: Array, options: MechanizeOptions) -> bool:
@@ -183,16 +236,26 @@ def _rr_candidates(
     options: MechanizeOptions,
     region: GroundRegion,
     name: str,
+    keep_outside: bool = False,
 ) -> list[Candidate]:
-    """RR dyads from their pivots: long, short, outside the region or badly transmitting ones dropped."""
+    """RR dyads from their pivots: long, short, outside the region or badly transmitting ones dropped (with
+    ``ground_region = "inside"``: any pivot or link leaving a profile, unless ``keep_outside``)."""
     g_body, g_anchor = chain.body(body).displacements, chain.motion(anchor)
+    inside = region.kind == "inside"
     out = []
     for m, dyad in pivots:
         c = dyad.centre_point
         r = dyad.radius
-        if not np.all(np.isfinite(c)) or r > options.max_link * chain.size or r < 1e-3 * chain.size:
+        if not np.all(np.isfinite(c)) or r > options.link_limit(chain.size) or r < 1e-3 * chain.size:
             continue
-        if anchor == "ground" and not bool(region.contains(c)[0]):
+        leaves = None
+        if inside:
+            leaves = leaving(chain.targets, track(g_anchor, c), track(g_body, m))
+            if leaves.by > 0.0 and not keep_outside:
+                continue
+        elif anchor == "ground" and not bool(region.contains(c)[0]):
+            continue
+        if dyad.structural_error > options.structural_limit(chain.size) + 1e-9 * chain.size:
             continue
         u = track(g_body, m) - track(g_anchor, c)
         u /= np.linalg.norm(u, axis=1, keepdims=True)
@@ -201,9 +264,9 @@ def _rr_candidates(
             continue
         mu = _smallest_angle(s)
         ratio = abs(math.log(r / (0.5 * chain.size)))
-        score = math.degrees(mu) - 15.0 * ratio - 1e3 * dyad.structural_error / chain.size
+        score = math.degrees(mu) - 15.0 * ratio - STRUCTURAL_WEIGHT * dyad.structural_error / chain.size
         link = BinaryLink(name, "RR", anchor, body, c, np.asarray(m, float), dyad.structural_error, mu, via)
-        out.append(Candidate(link, score, s))
+        out.append(Candidate(link, score, s, leaves))
     return out
 
 
@@ -216,37 +279,55 @@ def _slider_candidates(
     options: MechanizeOptions,
     region: GroundRegion,
     name: str,
+    keep_outside: bool = False,
 ) -> list[Candidate]:
     """PR sliders: slider points of the body (exact for three profiles), guides fitted through their positions,
-    kept when the slider moves one way, its guide lies in the region (on the ground) and it transmits well."""
+    kept when the slider moves one way, its guide lies in the region (on the ground) and it transmits well
+    (with ``ground_region = "inside"``: its guide and its moving pivot inside every profile in its pose)."""
     g_anchor = chain.motion(anchor)
+    g_body = chain.body(body).displacements
+    inside = region.kind == "inside"
     grid = _moving_pivots(chain, body, max(3, options.candidates // 2), options.link_offset)
     out = []
     for g in grid:
         for v in (np.array([1.0, 0.0]), np.array([0.0, 1.0])):
             for m in sliders.slider_points(rel, g, v * chain.size, reach=options.link_offset):
                 start, u, travel, error = sliders.fit_guide(rel, m)
-                if not sliders.monotonic(travel, chain.size) or error > 0.05 * chain.size:
+                if (
+                    not sliders.monotonic(travel, chain.size)
+                    or error > options.structural_limit(chain.size) + 1e-9 * chain.size
+                ):
                     continue
                 ends = start + np.outer([travel[0], travel[-1]], u)
-                if anchor == "ground" and not np.all(region.contains(ends)):
+                leaves = None
+                if inside:
+                    # the guide, on the anchor, and the moving pivot: inside every profile in its pose
+                    leaves = leaving(chain.targets, track(g_anchor, ends[0]), track(g_anchor, ends[1]))
+                    pivot = leaving(chain.targets, track(g_body, m), track(g_body, m))
+                    leaves = pivot if pivot.by > leaves.by else leaves
+                    if leaves.by > 0.0 and not keep_outside:
+                        continue
+                elif anchor == "ground" and not np.all(region.contains(ends)):
                     continue
                 s = _transmitting(chain, body, via, m, "PR", track_direction(g_anchor, u), options)
                 if s is None:
                     continue
                 mu = _smallest_angle(s)
-                score = math.degrees(mu) - 1e3 * error / chain.size
+                score = math.degrees(mu) - STRUCTURAL_WEIGHT * error / chain.size
                 link = BinaryLink(name, "PR", anchor, body, start, np.asarray(m, float), error, mu, via, u)
-                out.append(Candidate(link, score, s))
+                out.append(Candidate(link, score, s, leaves))
     return out
 
 
 def _pivot_candidates(
-    chain: ShapeChain, body: str, rel: Array, options: MechanizeOptions
+    chain: ShapeChain, body: str, rel: Array, options: MechanizeOptions, region: GroundRegion
 ) -> list[tuple[Array, guidance.Dyad]]:
-    """Moving pivots and their dyads: any point (p <= 3), the circle-point curve (4), Burmester points (5)."""
+    """Moving pivots and their dyads: any point (p <= 3), the circle-point curve (4), Burmester points (5);
+    with ``ground_region = "inside"`` also points inside the first profile (where a moving pivot must be)."""
     p = len(rel)
     grid = _moving_pivots(chain, body, options.candidates, options.link_offset)
+    if region.kind == "inside":
+        grid = np.vstack([grid, _interior(chain, body)])
     out: list[tuple[Array, guidance.Dyad]] = []
     if p <= 3:
         for m in grid:
@@ -271,6 +352,39 @@ def _pivot_candidates(
     return out
 
 
+#: Pivot pairs inside the shape kept per body and anchor (the smallest structural errors).
+INSIDE_PAIRS = 60
+
+
+def _inside_pairs(
+    chain: ShapeChain, body: str, anchor: str, rel: Array, region: GroundRegion, options: MechanizeOptions
+) -> list[tuple[Array, guidance.Dyad]]:
+    """With ``ground_region = "inside"``: links whose both pivots are sampled inside the shape, a moving pivot
+    inside the first profile near ``body`` and an anchor pivot in the ground region (or inside the first profile
+    near the anchor body), kept when the length they would need varies across the profiles by at most the
+    structural-error limit (least squares: a link of the length on profile 1, its spread reported).
+
+    Exact guidance puts the centre of a body point's circle where the body's motion says, which for a slender
+    shape morphing by small motions is far outside it; a short link inside accepts a small structural error."""
+    movings = _interior(chain, body)
+    anchors = region.samples(REGION_SAMPLES) if anchor == "ground" else _interior(chain, anchor)
+    if len(movings) == 0 or len(anchors) == 0:
+        return []
+    w = np.array([guidance.positions(rel, m) for m in movings])  # (k, p, 2) in the anchor's profile-1 frame
+    dist = np.linalg.norm(w[:, None, :, :] - anchors[None, :, None, :], axis=3)  # (k, n, p)
+    spread = np.ptp(dist, axis=2)
+    limit = options.structural_limit(chain.size)
+    ok = np.argwhere(spread <= limit + 1e-9 * chain.size)
+    ok = ok[np.argsort(spread[ok[:, 0], ok[:, 1]])][:INSIDE_PAIRS]
+    return [
+        (
+            movings[i],
+            guidance.Dyad(movings[i], anchors[n].copy(), float(dist[i, n, 0]), float(spread[i, n])),
+        )
+        for i, n in ok
+    ]
+
+
 def _pivots_from_region(
     chain: ShapeChain, rel: Array, region: GroundRegion
 ) -> list[tuple[Array, guidance.Dyad]]:
@@ -293,6 +407,16 @@ def _pivots_from_region(
     return out
 
 
+def _limits(chain: ShapeChain, options: MechanizeOptions) -> str:
+    """The link-length and structural-error limits in use, for messages: ``max_link 0.8 (0.59 x the largest
+    extent 1.36), structural error 0.068``."""
+    longest = options.link_limit(chain.size)
+    return (
+        f"max_link {longest:.4g} (a length: {longest / chain.size:.3g} x the largest extent {chain.size:.4g}) "
+        f"with a structural error at most {options.structural_limit(chain.size):.3g}"
+    )
+
+
 def _adjacent(chain: ShapeChain, body: str) -> list[tuple[str, str]]:
     """``(joint, other body)`` for every chain joint of ``body``."""
     return [(j.name, j.other(body)) for j in chain.joints if body in j.bodies]
@@ -302,9 +426,7 @@ def roots(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
     """Bodies to try as the root: the ground-pinned body, the designer's, or every body (longest first)."""
     names = [b.name for b in chain.bodies]
     if options.root is not None and options.root not in names:
-        raise MechanizationError(
-            f"mechanize: unknown root body {options.root!r}; bodies are {', '.join(names)}"
-        )
+        raise SpecError(f"unknown body {options.root!r}; expected one of {', '.join(names)}", key="root")
     pinned = [j for j in chain.joints if "ground" in j.bodies]
     if pinned:
         return [pinned[0].other("ground")]
@@ -341,9 +463,12 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
         pairs = _root_pairs(chain, root, options)
         if not pairs:
             raise MechanizationError(
-                f"mechanize: no four-bar guides the root body {root} through the profiles with its crank turning "
+                f"mechanize: no four-bar guides the root body {root}"
+                + least_leaving(chain, root, None, ["ground"], options)
+                + "; none through the profiles with its crank turning "
                 f"one way and transmission angles above {math.degrees(options.min_transmission):.0f} deg "
-                "(try another root, a larger ground region or link offset)"
+                f"and links no longer than {_limits(chain, options)} (try another root, a larger ground region, link "
+                "offset or max_link)"
             )
     return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
 
@@ -401,8 +526,11 @@ def _steps(
                 deferred.remove(parent)
                 continue
             raise MechanizationError(
-                f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it: "
-                f"every candidate pivot leaves the ground region, is too long, has a transmission angle below "
+                f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it"
+                + least_leaving(chain, body, None, anchors, options)
+                + ": "
+                f"every candidate pivot leaves the ground region, is longer than {_limits(chain, options)}, has a "
+                "transmission angle below "
                 f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
                 "(try a larger ground region or link offset)"
             )
@@ -414,9 +542,12 @@ def _steps(
             deferred.append(body)
     if deferred:
         raise MechanizationError(
-            f"mechanize: no dyad can guide body {deferred[0]} (root {root}), the last body placed from it "
-            f"(transmission angle below {math.degrees(options.min_transmission):.0f} deg or a change of "
-            "assembly mode between profiles; try a larger ground region or link offset)"
+            f"mechanize: no dyad can guide body {deferred[0]} (root {root})"
+            + least_leaving(chain, deferred[0], None, ["ground"], options)
+            + "; it is the last body placed from it "
+            f"(outside the ground region, longer than {_limits(chain, options)}, a transmission angle below "
+            f"{math.degrees(options.min_transmission):.0f} deg or a change of assembly mode between profiles; try "
+            "a larger ground region, link offset or max_link)"
         )
     return steps
 
@@ -476,15 +607,21 @@ def prismatic_actuator(chain: ShapeChain, body: str, options: MechanizeOptions) 
     MechanizationError
         When no pivot pair on the ground and the body has a monotonic length.
     """
-    grid = options.region_of(chain.targets, chain.size).samples(REGION_SAMPLES)
+    region = options.region_of(chain.targets, chain.size)
+    grid = region.samples(REGION_SAMPLES)
     g = chain.body(body).displacements
     best, best_score = None, -math.inf
-    for m in _moving_pivots(chain, body, options.candidates, options.link_offset):
+    movings = _moving_pivots(chain, body, options.candidates, options.link_offset)
+    if region.kind == "inside":
+        movings = np.vstack([movings, _interior(chain, body)])
+    for m in movings:
         w = track(g, m)
         travel = np.diff(w, axis=0)
         for c in grid:
             length = np.linalg.norm(w - c, axis=1)
-            if length.min() < 0.05 * chain.size or length.max() > options.max_link * chain.size:
+            if length.min() < 0.05 * chain.size or length.max() > options.link_limit(chain.size):
+                continue
+            if region.kind == "inside" and leaving(chain.targets, np.tile(c, (len(w), 1)), w).by > 0.0:
                 continue
             dl = np.diff(length)
             if not (np.all(dl > 0) or np.all(dl < 0)):

@@ -14,28 +14,31 @@ design is rejected with the reason when
 from __future__ import annotations
 
 import math
-import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.errors import AssemblyError
 from linkwork.geometry.angles import wrap
 from linkwork.geometry.se2 import apply, pose_of
 from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.normalization import NearMobility, near_mobility
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.tracer import trace
-from linkwork.mechanization.assemble import Design, spec_text
+from linkwork.mechanization.assemble import Design
 from linkwork.mechanization.chain import turned
 
 Array = NDArray[np.float64]
 
 #: A traced configuration matches the profile's when every joint agrees to this (radians or length / size).
 SAME_CONFIGURATION = 1e-6
+
+#: With least-squares links, the traced mechanism is accepted on a profile when its shape error is at most the
+#: joined chain's plus this many times the largest structural error of its links (a link's error is amplified by
+#: the lever of the bodies it places; the shape error is reported beside the joined chain's either way).
+SHAPE_ALLOWANCE = 5.0
 
 #: A profile's configuration closes the loops when the closure residual's norm is below this (times the size).
 CLOSES = 1e-9
@@ -67,8 +70,8 @@ class ProfileState:
 class Verification:
     """The outcome of :func:`verify`.
 
-    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"``, ``"circuit"`` or
-    ``"closure"`` with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
+    ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"``, ``"circuit"``,
+    ``"closure"`` or (set by the search with ``ground_region = "inside"``) ``"inside"``, with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
     when the motion was not traced (more than one DOF: the tracer follows one-parameter paths); a design that
     passes untraced says so in ``reason`` (``"not traced: dof 2 ..."``).
     """
@@ -87,13 +90,60 @@ class Verification:
 
 
 def loaded_mechanism(design: Design) -> Mechanism:
-    """The mechanism exactly as ``linkwork trace`` reads it from the written ``mechanism.toml``."""
-    from linkwork.io.spec import load_spec
+    """The mechanism of ``design``, built in memory exactly as ``linkwork trace`` reads the written
+    ``mechanism.toml`` (the spec reader builds it with the same :meth:`Mechanism.from_joints` from the same joint
+    points; tested against a written and read-back file)."""
+    return design.mechanism()
 
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "mechanism.toml"
-        path.write_text(spec_text(design), encoding="utf-8")
-        return load_spec(path).mechanism
+
+#: A design whose links leave the chain rigid but for a hair is refused as the spec reader refuses its file
+#: (``linkwork.io.spec``: a closure misfit above this per radian of the near-motion).
+NEAR_MOBILE_MISFIT = 1e-12
+
+
+def _near_rigid(mech: Mechanism) -> NearMobility | None:
+    """The near-motion of a design that the spec reader would refuse (rigid but for a hair), else ``None``."""
+    near = near_mobility(mech)
+    return near if near is not None and near.misfit > NEAR_MOBILE_MISFIT else None
+
+
+@dataclass(frozen=True)
+class PathEnd:
+    """How a traced path from one profile to the next ended, as the verification reads it.
+
+    ``kind`` is ``"target"`` (reached the drive value asked for), ``"turning"`` (the drive turned back: a dead
+    centre), ``"failed"`` (the corrector failed), ``"bifurcation"``, ``"budget"`` (step budget), ``"closed"``
+    or ``"other"``; ``text`` is the tracer's words for people.
+    """
+
+    kind: str
+    text: str
+
+
+#: The tracer's stop reasons (``StopReason`` names, and the words of each) as the verification reads them.
+_END_KINDS = (
+    ("TARGET", "reached target", "target"),
+    ("TURNING", "drive turning point", "turning"),
+    ("FAILED", "corrector failed", "failed"),
+    ("SIGN_CHANGE", "bifurcation", "bifurcation"),
+    ("BUDGET", "step budget", "budget"),
+    ("CLOSED", "closed path", "closed"),
+)
+
+
+def path_end(path: Trace) -> PathEnd:
+    """How the first branch of ``path`` ended: the ONE place mechanization reads a tracer's end reason.
+
+    The structured end (``Branch.end_kind``, a ``StopReason``) when the tracer gives one, else the words of
+    ``Branch.end_reason``.
+    """
+    branch = path.branches[0]
+    text = branch.end_reason
+    structured = getattr(branch, "end_kind", None)
+    for name, words, kind in _END_KINDS:
+        if (getattr(structured, "name", None) == name) if structured is not None else text.startswith(words):
+            return PathEnd(kind, text)
+    return PathEnd("other", text)
 
 
 def chain_displacements(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
@@ -179,12 +229,15 @@ def verify(design: Design, *, max_step: float = math.radians(2.0), max_steps: in
     max_steps
         Step budget of each trace (a passing design's path is the same as with the CLI's larger budget).
     """
-    try:
-        mech = loaded_mechanism(design)
-    except AssemblyError as exc:
+    mech = loaded_mechanism(design)
+    near = _near_rigid(mech)
+    if near is not None:
         # the spec reader's assembly check: the links make the chain rigid but for a hair (a near-singular design)
-        reason = str(exc).split(": ", 2)[-1].split("; ")[0]
-        return Verification(False, "branch", f"branch defect: {reason}", 0, 0, design.drive)
+        reason = (
+            f"branch defect: the joint lines are rigid by a hair, not mobile: smallest singular value "
+            f"{near.relative:.3g} of the largest, joints {', '.join(near.joints)}"
+        )
+        return Verification(False, "branch", reason, 0, 0, design.drive)
     check = _Checker.of(design, mech)
     if check.dof != design.dof:
         return check.failed(
@@ -244,21 +297,14 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
     states: list[ProfileState] = [check.state(np.zeros(mech.n_joints), 0)]
     paths: list[Trace] = []
     max_cond = 1.0
+    structural = max((link.structural_error for link in design.links), default=0.0)
+    refine = structural > 1e-9 * design.chain.size
     for j in range(1, design.chain.count):
-        path = trace(
-            mech,
-            drive=design.drive,
-            until=(design.drive, float(v[j])),
-            max_step=max_step,
-            max_steps=max_steps,
-        )
+        path, st, found = _reach(check, j, float(v[j]), max_step, max_steps, judge=not refine)
+        if found is None and refine:
+            path, st, found = _best_setting(check, j, v, path, st, max_step, max_steps)
         paths.append(path)
         max_cond = max(max_cond, path.max_condition_raw)  # raw, like the untraced check
-        st = None
-        found = _path_defect(check, path, j)
-        if found is None:
-            st = check.state(path.angles[-1], j)
-            found = _circuit_defect(check, path, st, j)
         if found is not None:
             defect, reason, culprit = found
             return check.failed(
@@ -276,12 +322,77 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
     )
 
 
-def _path_defect(check: _Checker, trace: Trace, j: int) -> _Defect | None:
-    """A branch or order defect on the path from profile ``j`` to ``j + 1`` (0-based ``j - 1`` to ``j``)."""
+def _reach(
+    check: _Checker, j: int, value: float, max_step: float, max_steps: int, *, judge: bool = True
+) -> tuple[Trace, ProfileState | None, _Defect | None]:
+    """Trace the drive from profile 1 to ``value`` and judge the mechanism there against profile ``j``: the
+    path, the state (``None`` after a path defect) and the defect found, if any (the circuit only with
+    ``judge``)."""
+    design = check.design
+    path = trace(
+        check.mech, drive=design.drive, until=(design.drive, value), max_step=max_step, max_steps=max_steps
+    )
+    found = _path_defect(check, path, j, value)
+    if found is not None:
+        return path, None, found
+    st = check.state(path.angles[-1], j)
+    return path, st, _circuit_defect(check, path, st, j) if judge else None
+
+
+#: The drive setting of a profile is refined to this fraction of the drive's step between profiles.
+SETTING_TOLERANCE = 1e-3
+
+#: At most this many traces refine one profile's drive setting.
+SETTING_TRACES = 14
+
+
+def _best_setting(
+    check: _Checker,
+    j: int,
+    v: Array,
+    path: Trace,
+    st: ProfileState | None,
+    max_step: float,
+    max_steps: int,
+) -> tuple[Trace, ProfileState | None, _Defect | None]:
+    """Least-squares links put no configuration of the mechanism exactly on a profile: the drive setting of
+    profile ``j`` is the one, between the midpoints to the neighbouring profiles' settings, where the traced
+    mechanism's shape error against profile ``j`` is smallest (a bounded scalar minimisation, each value traced
+    from profile 1). The designer sets the actuator there; the order of the profiles along the drive is kept."""
+    from scipy.optimize import minimize_scalar
+
+    assert st is not None
+    before = 0.5 * (v[j - 1] + v[j])
+    after = 0.5 * (v[j] + v[j + 1]) if j + 1 < len(v) else v[j] + 0.5 * (v[j] - v[j - 1])
+    lo, hi = sorted((float(before), float(after)))
+    tried: dict[float, tuple[Trace, ProfileState | None, _Defect | None]] = {float(v[j]): (path, st, None)}
+
+    def error(t: float) -> float:
+        if t not in tried:
+            tried[t] = _reach(check, j, t, max_step, max_steps, judge=False)
+        reached = tried[t]
+        ok = reached[1] is not None and reached[2] is None
+        return reached[1].e_max if ok else 1e3 * check.design.chain.size  # type: ignore[union-attr]
+
+    best = minimize_scalar(
+        error,
+        bounds=(lo, hi),
+        method="bounded",
+        options={"xatol": SETTING_TOLERANCE * (hi - lo), "maxiter": SETTING_TRACES},
+    )
+    t = float(best.x)
+    if error(t) < st.e_max:
+        path, st, _ = tried[t]
+    assert st is not None
+    return path, st, _circuit_defect(check, path, st, j)
+
+
+def _path_defect(check: _Checker, trace: Trace, j: int, target: float) -> _Defect | None:
+    """A branch or order defect on the path from profile 1 to the drive value ``target`` of profile ``j + 1``
+    (0-based ``j``)."""
     design, d, drive = check.design, check.d, check.design.drive
-    target = float(check.ideal[j, d])
     where = f"between profiles {j} and {j + 1}" if j == 1 else f"before profile {j + 1}"
-    end = trace.branches[0].end_reason
+    end = path_end(trace)
     if trace.bifurcations:
         b = trace.bifurcations[0]
         return (
@@ -303,14 +414,14 @@ def _path_defect(check: _Checker, trace: Trace, j: int) -> _Defect | None:
         return (
             "order",
             f"order defect: the drive {drive} turns back {where} at {check.show(trace.angles[k, d])} (a dead centre)"
-            + (f"; the trace then {end}" if end != "reached target" else ""),
+            + (f"; the trace then {end.text}" if end.kind != "target" else ""),
             _culprit(design, check.mech, trace),
         )
-    if end != "reached target":
-        defect = "order" if "turning" in end else "branch"
+    if end.kind != "target":
+        defect = "order" if end.kind == "turning" else "branch"
         return (
             defect,
-            f"{defect} defect: the trace {where} stopped ({end}) before the drive {drive} reached {check.show(target)}",
+            f"{defect} defect: the trace {where} stopped ({end.text}) before the drive {drive} reached {check.show(target)}",
             _culprit(design, check.mech, trace),
         )
     return None
@@ -320,12 +431,28 @@ def _circuit_defect(check: _Checker, trace: Trace, st: ProfileState, j: int) -> 
     """A circuit defect at profile ``j``'s drive value: the mechanism in another assembly mode than the chain
     (least-squares links: judged by the shape, as the profile's configuration is not on the mechanism)."""
     design, chain = check.design, check.design.chain
+    start = signed_transmissions(design, check.mech, np.zeros(check.mech.n_joints))
+    now = signed_transmissions(design, check.mech, st.values)
+    flipped = [name for name, sine in now.items() if sine * start[name] < 0.0]
+    if flipped:
+        return (
+            "circuit",
+            f"circuit defect: on profile {j + 1} link {flipped[0]} is in the other assembly mode than on profile 1",
+            flipped[0],
+        )
     structural = max((link.structural_error for link in design.links), default=0.0)
-    if structural <= 1e-9 * chain.size:
-        wrong = st.deviation > SAME_CONFIGURATION
-    else:
-        wrong = st.e_max > chain.joined_errors[j] + 5.0 * structural + 1e-9 * chain.size
-    if not wrong:
+    if structural > 1e-9 * chain.size:
+        allowed = chain.joined_errors[j] + SHAPE_ALLOWANCE * structural
+        if st.e_max <= allowed + 1e-9 * chain.size:
+            return None
+        return (
+            "circuit",
+            f"shape error {st.e_max:.3g} on profile {j + 1} at its best drive setting, more than the joined "
+            f"chain's {chain.joined_errors[j]:.3g} + {SHAPE_ALLOWANCE:g} x the largest structural error "
+            f"{structural:.3g} (too far from the profile to be on it)",
+            max(design.links, key=lambda link: link.structural_error).name,
+        )
+    if st.deviation <= SAME_CONFIGURATION:
         return None
     worst = check.mech.joint_names[
         int(np.argmax(_difference(check.mech, trace.angles[-1], check.ideal[j], chain.size)))
@@ -352,6 +479,18 @@ def _circuit_culprit(design: Design, mech: Mechanism, values: Array, j: int) -> 
     return design.links[0].name if design.links else None
 
 
+def link_pivots(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
+    """``(2, 2)`` the world positions of every binary link's two pivots at joint displacements ``values``: the
+    anchor pivot (on the ground or on the anchor body; a slider's guide point) and the moving pivot (on the
+    body)."""
+    disp = chain_displacements(design, mech, values)
+    out: dict[str, Array] = {}
+    for link in design.links:
+        anchor = apply(disp[link.anchor], link.centre)
+        out[link.name] = np.array([anchor, apply(disp[link.body], link.circle)])
+    return out
+
+
 def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
     """Sine of every RR link's (and PR slider's) transmission angle at joint displacements ``values`` (0: a dead
     centre).
@@ -359,6 +498,13 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
     The angle at the moving pivot between the link and the line to the point that, with the link, places the
     body: the body's chain joint ``via``, or the other root link's moving pivot.
     """
+    return {name: abs(s) for name, s in signed_transmissions(design, mech, values).items()}
+
+
+def signed_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[str, float]:
+    """The transmission sines of :func:`link_transmissions` with their sign: the side of the line from the
+    placing point to the moving pivot the link lies on, i.e. the assembly mode of the dyad (it changes only
+    through a dead centre, sine 0)."""
     disp = chain_displacements(design, mech, values)
     joints = {jt.name: jt for jt in design.chain.joints}
     links = {link.name: link for link in design.links}
@@ -379,7 +525,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
             if jt.kind == "P":
                 assert jt.direction is not None
                 d = turned(disp[jt.other(link.body)], jt.direction)
-                out[link.name] = abs(float(u @ d))
+                out[link.name] = float(u @ d)
                 continue
             pj = apply(disp[link.body], jt.point)
         else:
@@ -387,7 +533,7 @@ def link_transmissions(design: Design, mech: Mechanism, values: Array) -> dict[s
             pj = apply(disp[link.body], partner.circle)
         r = m - pj
         nr = float(np.linalg.norm(r))
-        out[link.name] = abs(float(u @ np.array([-r[1], r[0]]) / nr)) if nr > 0 else 0.0
+        out[link.name] = float(u @ np.array([-r[1], r[0]]) / nr) if nr > 0 else 0.0
     return out
 
 

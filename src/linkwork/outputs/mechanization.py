@@ -81,6 +81,7 @@ def print_mechanization(found: Mechanization) -> None:
         "fixed pivot",
         "moving pivot",
         "length",
+        "structural error",
         "transmission (deg)",
     ):
         links.add_column(column)
@@ -93,13 +94,19 @@ def print_mechanization(found: Mechanization) -> None:
             f"({link.centre[0]:.4g}, {link.centre[1]:.4g})",
             f"({link.circle[0]:.4g}, {link.circle[1]:.4g})",
             f"{link.length:.4g}",
+            f"{link.structural_error:.3g}",
             f"{math.degrees(link.transmission):.1f}",
         )
     console.print(links)
     mech = design.mechanism()
     revolute = mech.joint_types[mech.index(design.drive)] == "R"
     states = Table(title=f"DOF {check.dof}, drive {design.drive}", title_justify="left", title_style="bold")
-    for column in ("profile", "drive value" + (" (deg)" if revolute else ""), "E_max", "E_max joined"):
+    for column in (
+        "profile",
+        "drive value" + (" (deg)" if revolute else ""),
+        "E_max mechanism",
+        "E_max joined chain",
+    ):
         states.add_column(column, justify="right")
     for j, state in enumerate(check.states):
         value = math.degrees(state.drive_value) if revolute else state.drive_value
@@ -107,6 +114,16 @@ def print_mechanization(found: Mechanization) -> None:
             str(j + 1), f"{value:.6f}", f"{state.e_max:.4f}", f"{design.chain.joined_errors[j]:.4f}"
         )
     console.print(states)
+    if found.options is not None:
+        size = design.chain.size
+        longest = found.options.link_limit(size)
+        structural = max((link.structural_error for link in design.links), default=0.0)
+        bound = found.options.max_structural_error
+        console.print(
+            f"longest link allowed {longest:.4g} ({longest / size:.3g} x the largest extent {size:.4g}); "
+            f"largest structural error {structural:.3g}"
+            + (f" (max_structural_error {bound:.4g})" if bound is not None else " (not bounded)")
+        )
     if len(found.ranked) > 1:
         ranking = Table(title="Designs found, by quality factor", title_justify="left", title_style="bold")
         for column in ("rank", "quality", "min transmission (deg)", "link ratio", "stroke", "drive"):

@@ -38,8 +38,9 @@ def chain_bounds(points: np.ndarray, pad: float = 0.08) -> dict[str, Any]:
 
 
 def mechanism_viewer_data(found: Mechanization, *, title: str | None = None) -> dict[str, Any]:
-    """The trace viewer's data for a mechanized chain, with ``overlays`` (the target profiles), the bounds of
-    the fixed view framed on the profiles and the fixed pivots, and ``view = "fixed"``.
+    """The trace viewer's data for a mechanized chain, with ``overlays`` (the target profiles, and every link's
+    moving pivot on the profiles), the bounds of the fixed view framed on the profiles and every link's pivots on
+    every profile, and ``view = "fixed"``.
 
     Raises
     ------
@@ -63,8 +64,23 @@ def mechanism_viewer_data(found: Mechanization, *, title: str | None = None) -> 
         }
         for j, (name, t) in enumerate(zip(names, chain.targets, strict=True))
     ]
-    pivots = [link.centre for link in found.design.links if link.anchor == "ground"]
-    frame = np.vstack([*chain.targets, *(np.reshape(p, (1, 2)) for p in pivots)])
+    # every binary link's pivots on every profile (mechanization.json's profiles[k].pivots): the moving pivot's
+    # positions on the profiles, joined in profile order
+    from linkwork.mechanization.verify import link_pivots
+
+    mech = found.design.mechanism()
+    at = [link_pivots(found.design, mech, state.values) for state in check.states]
+    for link in found.design.links:
+        moving = np.array([pivots[link.name][1] for pivots in at])
+        data["overlays"].append(
+            {
+                "name": f"{link.name} moving pivot on profiles 1-{chain.count}",
+                "color": "#d62728",
+                "points": np.column_stack([moving, np.zeros(len(moving))]).tolist(),
+            }
+        )
+    every = np.array([point for pivots in at for pair in pivots.values() for point in pair]).reshape(-1, 2)
+    frame = np.vstack([*chain.targets, every])
     data["bounds"]["fixed"] = chain_bounds(frame)
     data["view"] = "fixed"
     return data
