@@ -94,6 +94,22 @@ class Rows:
         self.step.append(np.zeros(1, dtype=np.int64))
 
 
+@dataclass(frozen=True)
+class Home:
+    """What was measured at the point a branch's march began: a closed path's last row is that point again."""
+
+    sigma: Array
+    res: float
+    tau: float
+
+    def copy_to(self, chunk: Chunk, row: int) -> None:
+        """Make ``chunk``'s row ``row`` (the start again, in continuous angles) carry the start's values: the
+        compiled march copies its own row 0, which is the start only in a branch's first call."""
+        chunk.sigma[row] = self.sigma
+        chunk.res[row] = self.res
+        chunk.tau[row] = self.tau
+
+
 @dataclass
 class QueuedBranch:
     """A branch to trace from a bifurcation point: its parent branch, the point and the direction to leave in."""
@@ -179,12 +195,17 @@ class BranchMarcher:
         stop_at_known: bool,
         step_offset: int = 0,
         check_closed: bool = True,
+        opened_at: tuple[Array, Home] | None = None,
     ) -> tuple[int, str]:
         """March one branch to its end, locating bifurcations and folds on the way; returns (steps, end reason).
 
         ``step_offset``: step number of ``u0`` in its branch (1 when the branch opens at a bifurcation point).
+        ``opened_at``: the point the branch's first row is, when it is not ``u0`` (the bifurcation point a queued
+        branch leaves), with its values: the branch is closed when it comes back round to it.
         """
-        u, t, u_home = u0.copy(), t0.copy(), u0.copy()
+        u, t = u0.copy(), t0.copy()
+        u_home = u0.copy() if opened_at is None else opened_at[0].copy()
+        home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
         while True:
             n = max(min(self.budget, 100 if self.progress else self.budget), 0)
@@ -192,6 +213,9 @@ class BranchMarcher:
                 return n_steps, STOP_REASONS[0]
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
+            home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
+            if chunk.code == CLOSED:
+                home.copy_to(chunk, chunk.count - 1)
             limit_reason = self._land_on_limit(chunk) if chunk.code == LIMIT else None
             component = self._component_entry(chunk)
             if component is not None:
@@ -483,7 +507,10 @@ class BranchMarcher:
             s_off = float(np.linalg.norm(u1 - job.u))
             start_len = len(self.rows.u)
             basis = np.ascontiguousarray(U1[:, : cfg.r_path])
-            nb, rb = self.run_branch(bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1)
+            opened_at = (job.u, Home(sigma_star, float(r_star), 0.0))
+            nb, rb = self.run_branch(
+                bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1, opened_at=opened_at
+            )
             for i in range(start_len, len(self.rows.u)):
                 self.rows.s[i] = self.rows.s[i] + s_off
                 self.rows.step[i] = self.rows.step[i] + 1

