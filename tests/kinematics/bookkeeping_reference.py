@@ -131,3 +131,33 @@ def spherical_four_bar(ground: float, crank: float, coupler: float, rocker: floa
         {"name": "D", "bodies": ["rocker", "ground"], "direction": d},
     ]
     return Mechanism.from_joints("spherical 4R", joints)
+
+
+def stephenson_six_bar(theta: float, spread: float = 0.0) -> Mechanism:
+    """A Stephenson six-bar: a crank-rocker four-bar (ground 2, crank 0.6, coupler 2.2, rocker 2) whose coupler
+    carries a third pivot E, joined to a second ground pivot G by the dyad E-F-G with equal links longer than
+    half the largest distance from E to G (so it assembles all the way round); the crank A starts at ``theta``
+    and reads ``theta`` there. ``spread`` (-1..1) moves G along a line below the ground."""
+    four = planar_four_bar(2.0, 0.6, 2.2, 2.0, theta)
+    pts = {four.joint_names[j]: np.cross(four.twists[j, :3], four.twists[j, 3:]) for j in range(4)}
+    B, C = pts["B"][:2], pts["C"][:2]
+    along = (C - B) / np.linalg.norm(C - B)
+    E = B + 0.5 * (C - B) + 0.8 * np.array([-along[1], along[0]])
+    G = np.array([1.0 + 1.5 * spread, -2.5])
+    half = 0.5 * float(np.linalg.norm(E - G))
+    link = 4.0  # > half of the largest |E - G| over the crank's turn (below 4 here)
+    mid = 0.5 * (E + G)
+    normal = np.array([-(E - G)[1], (E - G)[0]]) / (2.0 * half)
+    F = mid + np.sqrt(link**2 - half**2) * normal
+    joints = [
+        {"name": "A", "bodies": ["ground", "crank"], "point": pts["A"][:2], "value": theta},
+        {"name": "B", "bodies": ["crank", "coupler"], "point": B},
+        {"name": "C", "bodies": ["coupler", "rocker"], "point": C},
+        {"name": "D", "bodies": ["rocker", "ground"], "point": pts["D"][:2]},
+        {"name": "E", "bodies": ["coupler", "link5"], "point": E},
+        {"name": "F", "bodies": ["link5", "link6"], "point": F},
+        {"name": "G", "bodies": ["link6", "ground"], "point": G},
+    ]
+    for j in joints:
+        j["direction"] = [0.0, 0.0, 1.0]
+    return Mechanism.from_joints("Stephenson six-bar", joints, planar=True)

@@ -23,6 +23,7 @@ from bookkeeping_reference import (
     planar_four_bar,
     singular_values,
     spherical_four_bar,
+    stephenson_six_bar,
     wrapped,
 )
 from bookkeeping_reference import residual as reference_residual
@@ -189,3 +190,86 @@ def test_generated_spherical_4r_closed_path_and_singular_values(params: tuple[fl
     assert tr.branches[0].end_reason == "closed path"
     assert assert_closed_rows_match(tr) == 1
     assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
+
+
+# ------------------------------------------------------------------------------------ targets
+#: A reached target: the drive's last value equals it (radians).
+TARGET_TOL = 1e-12
+
+
+def reported_range(tr: Trace) -> tuple[float, float]:
+    """The drive's range on the first branch, as the tracer reports it (its points and folds)."""
+    d = tr.mechanism.index(tr.drive)
+    values = [tr.angles[tr.branch == 0, d], [f.angles[d] for f in tr.folds if f.branch == 0]]
+    joined = np.concatenate([np.asarray(v, dtype=float) for v in values])
+    return float(joined.min()), float(joined.max())
+
+
+def targets_inside(tr: Trace) -> list[float]:
+    """Targets strictly inside the reported range of the drive, and for a drive that turns round, exactly one
+    turn from the start and just below it (both ways round)."""
+    lo, hi = reported_range(tr)
+    start = float(tr.angles[0, tr.mechanism.index(tr.drive)])
+    span = hi - lo
+    out = [lo + 0.03 * span, lo + 0.41 * span, lo + 0.97 * span]
+    if span >= 2.0 * np.pi - 1e-9:
+        turn = np.sign(hi + lo - 2.0 * start) or 1.0
+        out += [
+            start + turn * 2.0 * np.pi,
+            start + turn * (2.0 * np.pi - 1e-6),
+            start + turn * (2 * np.pi - 0.01),
+        ]
+    return out
+
+
+def assert_reaches_every_target(mech: Mechanism, free: Trace, **options: object) -> None:
+    d = mech.index(free.drive)
+    for target in targets_inside(free):
+        tr = lw.trace(mech, drive=free.drive, until=(free.drive, target), **options)  # type: ignore[arg-type]
+        assert "unmet" not in tr.stats, f"{mech.name}: {tr.stats.get('unmet')}"
+        assert tr.branches[0].end_reason == "reached target"
+        assert abs(tr.angles[tr.branch == 0, d][-1] - target) <= TARGET_TOL * max(1.0, abs(target))
+
+
+@pytest.mark.parametrize("name", BUILT_INS)
+def test_every_built_in_reaches_every_target_inside_its_range(name: str) -> None:
+    mech = lw.load(name)
+    assert_reaches_every_target(mech, built_in_trace(name, False))
+
+
+@pytest.mark.parametrize(
+    "mech",
+    [
+        stephenson_six_bar(0.0),
+        spherical_four_bar(70 * DEG, 20 * DEG, 70 * DEG, 70 * DEG, 40 * DEG),
+        planar_four_bar(2.0, 1.0, 2.5, 2.0, 60 * DEG),
+    ],
+    ids=["stephenson", "spherical-4r", "four-bar"],
+)
+def test_exactly_one_turn_and_just_below_are_reached(mech: Mechanism) -> None:
+    free = lw.trace(mech)
+    assert_reaches_every_target(mech, free)
+    assert_reaches_every_target(mech, free, progress=lambda done, total: None)
+
+
+def test_one_turn_of_a_four_bar_in_equal_steps_lands_on_it() -> None:
+    mech = lw.load("four-bar")
+    start = float(mech.offsets[0])
+    for target, steps in ((start + 2 * np.pi, 360), (start + 2 * np.pi - 0.5 * DEG, 359)):
+        tr = lw.trace(mech, until=("A", target), steps=steps)
+        assert tr.branches[0].end_reason == "reached target"
+        assert abs(tr.angles[-1, 0] - target) <= TARGET_TOL * abs(target)
+
+
+@PROPERTY
+@given(spherical_crank)
+def test_generated_spherical_4r_reaches_every_target(params: tuple[float, ...]) -> None:
+    mech = generated_spherical(params)
+    assert_reaches_every_target(mech, lw.trace(mech))
+
+
+@PROPERTY
+@given(st.floats(0.0, 360.0), st.floats(-1.0, 1.0))
+def test_generated_stephenson_reaches_one_turn(theta: float, spread: float) -> None:
+    mech = stephenson_six_bar(theta * DEG, spread)
+    assert_reaches_every_target(mech, lw.trace(mech))

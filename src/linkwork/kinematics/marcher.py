@@ -25,6 +25,7 @@ from linkwork.kinematics.march import (
     NO_PROGRESS,
     SIGN_CHANGE,
     STOP_REASONS,
+    TARGET,
 )
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
@@ -216,6 +217,8 @@ class BranchMarcher:
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
             if chunk.code == CLOSED:
                 home.copy_to(chunk, chunk.count - 1)
+                if self._target_on_last_step(chunk) and self._land(chunk, self.cfg.drive, self.cfg.target):
+                    chunk.code = TARGET  # the closing step passed over the target (or ends on it): land there
             limit_reason = self._land_on_limit(chunk) if chunk.code == LIMIT else None
             component = self._component_entry(chunk)
             if component is not None:
@@ -255,28 +258,50 @@ class BranchMarcher:
         the end reason, ``limit <joint>``.
         """
         cfg, c = self.cfg, chunk.count
-        u_a, t_a, u_b = chunk.u[c - 2], chunk.t[c - 2], chunk.u[c - 1]
+        u_b = chunk.u[c - 1]
         over = np.flatnonzero((u_b < cfg.lo) | (u_b > cfg.hi))
         reason = "limit " + ", ".join(self.mech.joint_names[self.mech.group_members()[g][0]] for g in over)
         g = int(over[0])
-        bound = cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g]
+        self._land(chunk, g, cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g])
+        return reason
+
+    def _target_on_last_step(self, chunk: Chunk) -> bool:
+        """Whether the drive's target lies on the chunk's last step (between its last two rows' drive values).
+
+        A path closes by snapping onto its start once it is within one and a half steps of it; a target on that
+        stretch (just below a full turn of the drive, or exactly on it) is reached there, not refused."""
+        cfg, c = self.cfg, chunk.count
+        if cfg.target is None or c < 2:
+            return False
+        a, b = chunk.u[c - 2, cfg.drive], chunk.u[c - 1, cfg.drive]
+        slack = 1e-12 * max(1.0, abs(cfg.target))
+        return min(a, b) - slack <= cfg.target <= max(a, b) + slack
+
+    def _land(self, chunk: Chunk, g: int, value: float) -> bool:
+        """Replace the chunk's last row by the point of its last step where unknown ``g`` is at ``value``.
+
+        From the row before it, the predictor goes along the tangent to that value and the corrector holds the
+        unknown there (as when landing on a target). Returns whether it converged (the row is kept otherwise).
+        """
+        cfg, c = self.cfg, chunk.count
+        u_a, t_a = chunk.u[c - 2], chunk.t[c - 2]
         if abs(t_a[g]) < 1e-12:
-            return reason
-        guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
-        guess[g] = bound
+            return False
+        guess = u_a + (value - u_a[g]) / t_a[g] * t_a
+        guess[g] = value
         tol, ws = cfg.tol, self.ws
         ok, _, r = ws.kernels.correct(
             *ws.kernel_arrays(), guess, g, tol.closure, tol.exact, tol.roundoff, tol.truncate, tol.max_iter,
             ws.q, ws.res, ws.jac,
         )  # fmt: skip
         if not ok:
-            return reason
+            return False
         _, _, jac = ws.evaluate(guess)
         chunk.u[c - 1] = guess
         chunk.sigma[c - 1] = np.linalg.svd(jac, compute_uv=False)[: cfg.n_sigma]
         chunk.res[c - 1] = r
         chunk.s[c - 1] = chunk.s[c - 2] + float(np.linalg.norm(guess - u_a))
-        return reason
+        return True
 
     def _turns_towards_target(self, chunk: Chunk, u_home: Array) -> bool:
         """Whether a closed path turned the (revolute) drive by whole turns towards a target still ahead."""
