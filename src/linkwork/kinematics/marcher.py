@@ -217,7 +217,12 @@ class BranchMarcher:
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
             if chunk.code == CLOSED:
                 home.copy_to(chunk, chunk.count - 1)
-                if self._target_on_last_step(chunk) and self._land(chunk, self.cfg.drive, self.cfg.target):
+                target = self.cfg.target
+                if (
+                    target is not None
+                    and self._target_on_last_step(chunk)
+                    and self._land(chunk, self.cfg.drive, target)
+                ):
                     chunk.code = TARGET  # the closing step passed over the target (or ends on it): land there
             limit_reason = self._land_on_limit(chunk) if chunk.code == LIMIT else None
             component = self._component_entry(chunk)
