@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 from bookkeeping_reference import (
     bennett,
+    jacobian,
     planar_four_bar,
     singular_values,
     spherical_four_bar,
@@ -273,3 +274,67 @@ def test_generated_spherical_4r_reaches_every_target(params: tuple[float, ...]) 
 def test_generated_stephenson_reaches_one_turn(theta: float, spread: float) -> None:
     mech = stephenson_six_bar(theta * DEG, spread)
     assert_reaches_every_target(mech, lw.trace(mech))
+
+
+# ------------------------------------------------------------------------------------ folds
+#: At a located fold the drive's component of the (independent) null vector is below this.
+FOLD_TANGENT_TOL = 1e-5
+
+
+def assert_folds_turn_back(tr: Trace) -> None:
+    """Every reported fold is a turning point of the drive: the independent Jacobian's null vector has no drive
+    component there, the drive's value is an extreme of its neighbouring rows, and no fold sits on a branch along
+    which the drive stays put."""
+    mech = tr.mechanism
+    d = mech.index(tr.drive)
+    g = int(mech.groups[d])
+    for f in tr.folds:
+        drive = tr.angles[tr.branch == f.branch, d]
+        assert np.ptp(drive) > 1e-6, f"fold on branch {f.branch}, where {tr.drive} stays at {drive[0]:.12g}"
+        assert f.value == f.angles[d]
+        null = np.linalg.svd(jacobian(mech, f.angles))[2][-1]
+        assert abs(null[g]) < FOLD_TANGENT_TOL
+        steps = tr.step[tr.branch == f.branch]
+        k = int(np.flatnonzero(steps == f.step)[0])
+        around = drive[max(k - 1, 0) : k + 3] - f.value
+        assert np.all(around <= 1e-12) or np.all(around >= -1e-12), "the drive does not turn back at the fold"
+
+
+@pytest.mark.parametrize("name", BUILT_INS)
+def test_folds_are_only_where_the_drive_turns_back(name: str) -> None:
+    for branches in (False, True):
+        assert_folds_turn_back(built_in_trace(name, branches))
+
+
+def test_guest_frame_branches_along_which_the_drive_stays_put_have_no_folds() -> None:
+    tr = built_in_trace("guest-frame", True)
+    d = tr.mechanism.index("A")
+    still = [br.id for br in tr.branches if np.ptp(tr.angles[tr.branch == br.id, d]) < 1e-9]
+    assert still, "Guest's frame has branches along which A stays at the bifurcation point's value"
+    assert not [f for f in tr.folds if f.branch in still]
+    assert {f.branch for f in tr.folds} >= {0}
+
+
+def test_a_fold_value_is_the_joint_value_in_python_and_report_json() -> None:
+    """Slider-crank (crank 1, rod 3, offset 0.1) driven by the slider: it turns back where crank and rod are in
+    line, at sqrt((rod +- crank)^2 - offset^2) (closed form)."""
+    from linkwork.io.results import report_dict
+
+    tr = lw.trace(lw.load("slider-crank", crank=1.0, rod=3.0, offset=0.1, theta=0.0), drive="D")
+    extremes = sorted(f.value for f in tr.folds)
+    np.testing.assert_allclose(
+        extremes, [np.sqrt(2.0**2 - 0.01), np.sqrt(4.0**2 - 0.01)], rtol=0.0, atol=1e-9
+    )
+    report = report_dict(tr)
+    np.testing.assert_allclose(sorted(f["value"] for f in report["folds"]), extremes, rtol=0.0, atol=1e-12)
+
+
+@PROPERTY
+@given(st.floats(1.6, 2.6), st.floats(30.0, 150.0))
+def test_generated_four_bar_driven_by_its_rocker_folds_at_its_extremes(coupler: float, theta: float) -> None:
+    """A crank-rocker (ground 2, crank 0.6, rocker 2) driven by the rocker D folds twice per turn of the crank."""
+    mech = planar_four_bar(2.0, 0.6, coupler, 2.0, theta * DEG)
+    tr = lw.trace(mech, drive="D")
+    assert tr.branches[0].end_reason == "closed path"
+    assert len(tr.folds) == 2
+    assert_folds_turn_back(tr)

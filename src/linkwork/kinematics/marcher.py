@@ -41,7 +41,9 @@ class MarchSettings:
     """What every march of one trace shares: the drive, the step control, the path's rank, limits, tolerances.
 
     ``target`` is the drive's target in the unknowns (``None``: none); ``lo``/``hi`` are the limits in the
-    unknowns (``-inf``/``inf`` where none); ``periodic`` marks the revolute unknowns (compared modulo a turn).
+    unknowns (``-inf``/``inf`` where none); ``periodic`` marks the revolute unknowns (compared modulo a turn);
+    ``drive_joint`` is the joint the user drives (``-1``: the first joint of the drive's unknown), whose value a
+    fold reports.
     """
 
     drive: int
@@ -55,6 +57,12 @@ class MarchSettings:
     lo: Array
     hi: Array
     tol: Tolerances
+    drive_joint: int = -1
+
+
+#: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
+#: branch along which the drive stays put (to round-off) that component only changes sign by noise.
+FOLD_MOVING = 1e-8
 
 
 @dataclass
@@ -396,15 +404,26 @@ class BranchMarcher:
                 self._add_point(bif, branch_id, chunk.t[k])
 
     def _scan_folds(self, chunk: Chunk, branch_id: int, base: int) -> None:
-        """Locate every fold of the drive in the chunk: the tangent's drive component changes sign."""
+        """Locate every fold of the drive in the chunk: where the drive turns back.
+
+        A candidate is a step over which the tangent's drive component changes sign while moving by more than
+        :data:`FOLD_MOVING` on at least one side; the located point is kept when the drive's value there is an
+        extreme of the step (beyond both ends, by more than round-off), so a branch along which the drive is
+        constant (its tangent component only noise) has no folds.
+        """
         d = self.cfg.drive
         td = chunk.t[: chunk.count, d]
-        for k in np.flatnonzero(td[:-1] * td[1:] < 0.0):
-            u_f = locate_fold(
-                self.ws, chunk.u[k], chunk.t[k], chunk.u[k + 1], chunk.t[k + 1], d, self.cfg.tol
-            )
+        moving = np.maximum(np.abs(td[:-1]), np.abs(td[1:])) > FOLD_MOVING
+        joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.mech.group_members()[d][0]
+        for k in np.flatnonzero((td[:-1] * td[1:] < 0.0) & moving):
+            u_a, u_b = chunk.u[k], chunk.u[k + 1]
+            u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol)
+            beyond = np.sign(td[k]) * (u_f[d] - np.array([u_a[d], u_b[d]]))
+            noise = 1e-13 * max(1.0, abs(float(u_f[d])))
+            if beyond.min() < -noise or beyond.max() <= noise:
+                continue  # the drive does not turn back here
             angles = self.mech.angles_from_q(self.mech.q_from_u(u_f))
-            self.folds.append(Fold(branch_id, base + int(k), float(u_f[d]), angles))
+            self.folds.append(Fold(branch_id, base + int(k), float(angles[joint]), angles))
 
     def _on_sign_change(self, chunk: Chunk, basis_prev: Array, branch_id: int, step: int) -> int | None:
         """Locate the zero of the test function in the chunk's last step; returns the id if already known."""
