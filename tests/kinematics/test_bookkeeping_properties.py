@@ -338,3 +338,42 @@ def test_generated_four_bar_driven_by_its_rocker_folds_at_its_extremes(coupler: 
     assert tr.branches[0].end_reason == "closed path"
     assert len(tr.folds) == 2
     assert_folds_turn_back(tr)
+
+
+# ------------------------------------------------------------------------------------ landing on a bifurcation
+#: The parallelogram relation on every row, and the crossing's crank angle (radians).
+PARALLELOGRAM_TOL = 1e-9
+
+
+@PROPERTY
+@given(st.sampled_from([0.5, 1.0, 2.0, 2.5, 3.0, 5.0]), st.integers(3, 60), st.integers(3, 30))
+def test_equal_steps_landing_on_a_bifurcation_recognise_it_and_stay_on_their_branch(
+    delta: float, before: int, after: int
+) -> None:
+    """A parallelogram four-bar (ground 2, crank 1, coupler 2, rocker 1) crosses its other branch where every
+    pivot is on one line (crank at 180 deg). Equal drive steps of ``delta`` deg with one landing exactly there:
+    the point is a bifurcation point with two branch tangents, and every row keeps the parallelogram relation
+    (coupler parallel to the ground: q_B = -q_A, q_C = q_A, q_D = -q_A modulo a turn)."""
+    theta = 180.0 - before * delta
+    mech = planar_four_bar(2.0, 1.0, 2.0, 1.0, theta * DEG)
+    tr = lw.trace(mech, until=("A", (before + after) * delta * DEG), steps=before + after)
+    assert tr.branches[0].end_reason == "reached target"
+    q = tr.angles - mech.offsets
+    for j, sign in ((1, -1.0), (2, 1.0), (3, -1.0)):
+        np.testing.assert_allclose(wrapped(q[:, j] - sign * q[:, 0]), 0.0, atol=PARALLELOGRAM_TOL)
+    crossings = [b for b in tr.bifurcations if b.kind == "bifurcation"]
+    assert len(crossings) == 1
+    assert abs(wrapped(theta * DEG + crossings[0].angles[0] - np.pi)) < PARALLELOGRAM_TOL
+    assert len(crossings[0].tangents) == 2
+
+
+def test_the_reported_four_bar_landing_on_its_crossing_reaches_its_target() -> None:
+    """`trace four-bar --set ground=2 --set crank=1 --set coupler=2 --set rocker=1 --set theta=60 --until A=419
+    --steps 359`: 1-degree steps, one on each crossing (A = 180 and 360 deg)."""
+    mech = lw.load("four-bar", ground=2.0, crank=1.0, coupler=2.0, rocker=1.0, theta=60 * DEG)
+    for branches in (False, True):
+        tr = lw.trace(mech, until=("A", 419 * DEG), steps=359, branches=branches)
+        assert tr.branches[0].end_reason == "reached target"
+        found = sorted(float(np.degrees(b.angles[0])) for b in tr.bifurcations)
+        np.testing.assert_allclose(found, [180.0, 360.0], atol=1e-7)
+        assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 12))

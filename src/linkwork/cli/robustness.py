@@ -79,7 +79,7 @@ def robustness(
         position_tol=hinge_position_tol,
         direction_tol=float(np.radians(hinge_direction_tol)),
         distribution=distribution,
-        spatial=spatial_errors or not mech.planar,
+        spatial=spatial_errors or not mech.moves_in_plane,
     )
     nominal = _nominal_path(mech, until_in_api_units(mech, target), steps, max_steps)
     setup = prepare(mech, nominal, model, seed)

@@ -19,6 +19,7 @@ from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
 from linkwork.kinematics.march import (
+    BUDGET,
     CLOSED,
     FAILED,
     LIMIT,
@@ -236,10 +237,21 @@ class BranchMarcher:
             component = self._component_entry(chunk)
             if component is not None:
                 chunk.count = component + 1
+            landed = self._landed_row(chunk, component)
+            if (
+                landed is not None
+            ):  # a step landed on a singular point: the rows after it may be on another branch
+                if landed < chunk.count - 1 or chunk.code not in (TARGET, CLOSED, LIMIT):
+                    chunk.count, chunk.code = landed + 1, BUDGET
             self._record(chunk, branch_id, first, n_steps)
             base = n_steps + step_offset
             n_steps += chunk.count - 1
             self.budget -= chunk.count - 1
+            through: Array | None = None
+            if landed is not None:
+                ended, through = self._on_landed(chunk, branch_id, base + landed, stop_at_known)
+                if ended is not None:
+                    return n_steps, ended
             self._scan_rank_minima(chunk, branch_id, base)
             self._scan_folds(chunk, branch_id, base)
             first = False
@@ -247,6 +259,20 @@ class BranchMarcher:
                 self.progress(self.max_steps - self.budget, self.max_steps)
             if component is not None:
                 return n_steps, self._enter_component(chunk, branch_id, base + component)
+            if through is not None and chunk.code == BUDGET and self.budget > 0:
+                # Step off the singular point along the branch it was reached on, then march on from there.
+                across = self._step_across(chunk, through, paper, basis_prev, basis)
+                if across is None:
+                    reason = "corrector failed at a fixed drive step" if paper else "corrector failed"
+                    return n_steps, f"{reason} (leaving the bifurcation point the path landed on)"
+                self._record(across, branch_id, False, n_steps)
+                self._scan_folds(across, branch_id, n_steps + step_offset)
+                n_steps += 1
+                self.budget -= 1
+                if across.code == TARGET:
+                    return n_steps, STOP_REASONS[TARGET]
+                u, t, h0 = across.u[1].copy(), across.t[1].copy(), across.h
+                continue
             if chunk.code == SIGN_CHANGE:
                 known = self._on_sign_change(chunk, basis_prev, branch_id, n_steps + step_offset)
                 if known is not None and stop_at_known:
@@ -277,6 +303,107 @@ class BranchMarcher:
         g = int(over[0])
         self._land(chunk, g, cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g])
         return reason
+
+    def _landed_row(self, chunk: Chunk, component: int | None) -> int | None:
+        """The first row after the chunk's start where the Jacobian's rank has dropped below the path's, unless
+        it is where the branch enters a higher-dimensional component: a step that landed on a singular point
+        (equal drive steps landing on a bifurcation point), where the march's tangent is any vector of a null
+        space of dimension two and the sign of the test function means nothing."""
+        if chunk.count < 2:
+            return None
+        ranks = numerical_ranks(chunk.sigma[1 : chunk.count], self.cfg.tol)
+        low = np.flatnonzero(ranks < self.cfg.r_path)
+        if len(low) == 0:
+            return None
+        row = int(low[0]) + 1
+        return None if component is not None and row >= component else row
+
+    def _on_landed(
+        self, chunk: Chunk, branch_id: int, step: int, stop_at_known: bool
+    ) -> tuple[str | None, Array | None]:
+        """Recognise the chunk's last row, a singular point the path landed on, as a located point.
+
+        A new point is classified and kept (its other branches queued); a known one ends a branch that stops at
+        known points. Returns ``(end reason or None, tangent to go on along)``: the branch tangent there nearest
+        the incoming one (or the incoming tangent projected on the null space when there are fewer than two),
+        oriented the same way; it replaces the row's tangent."""
+        c = chunk.count
+        u_k, t_in = chunk.u[c - 1].copy(), chunk.t[c - 2].copy()
+        known = self._match(u_k)
+        if known is None:
+            point = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u_k, 0.0, self.cfg)
+            self._add_point(point, branch_id, t_in)
+        else:
+            point = self.found[known]
+            if stop_at_known:
+                self._arrived(known, u_k - chunk.u[c - 2])
+                return f"reached bifurcation {known}", None
+            self._passed(known, chunk)
+        if point.kind == "component":
+            dim = point.dimension
+            return f"entered a {dim}-dimensional component (mobility {dim}) at point {point.id}", None
+        if len(point.tangents_u) >= 2:
+            tangent = point.tangents_u[int(np.argmax(np.abs(point.tangents_u @ t_in)))].copy()
+        else:
+            _, _, jac = self.ws.evaluate(u_k)
+            _, s, Vt = np.linalg.svd(jac)
+            null = Vt[numerical_rank(s, self.cfg.tol) :]
+            tangent = null.T @ (null @ t_in)
+        tangent /= np.linalg.norm(tangent)
+        tangent *= 1.0 if tangent @ t_in >= 0.0 else -1.0
+        chunk.t[c - 1] = tangent
+        return None, tangent
+
+    def _step_across(
+        self, chunk: Chunk, tangent: Array, paper: bool, basis_prev: Array, basis: Array
+    ) -> Chunk | None:
+        """One step from the chunk's last row (a singular point) along ``tangent``: a two-row chunk (that row,
+        then the new point with its tangent, singular values, residual and test value), ``basis`` updated in place
+        for the march that goes on; None when the corrector does not converge.
+
+        Paper mode moves the drive by the fixed step with the drive held, as the march does; adaptive mode takes
+        the march's step length along the tangent and corrects in the hyperplane normal to it, halving the step
+        on failure. A target on the step is landed on (code ``TARGET``)."""
+        cfg, ws, tol = self.cfg, self.ws, self.cfg.tol
+        c, d = chunk.count, cfg.drive
+        u_k = chunk.u[c - 1]
+        h = chunk.h
+        u_next: Array | None = None
+        while u_next is None and abs(h) >= cfg.min_step:
+            if paper:
+                if abs(tangent[d]) < 1e-12:
+                    return None
+                guess = u_k + (h / tangent[d]) * tangent
+                guess[d] = u_k[d] + h
+                ok, _, _ = ws.kernels.correct(
+                    *ws.kernel_arrays(), guess, d, tol.closure, tol.exact, tol.roundoff, tol.truncate,
+                    tol.max_iter, ws.q, ws.res, ws.jac,
+                )  # fmt: skip
+                if not ok:
+                    return None
+                u_next = guess
+            else:
+                guess, _, ok = correct_on_plane(ws, u_k + h * tangent, tangent, tol)
+                if ok and float(tangent @ (guess - u_k)) > tol.advance * h:
+                    u_next = guess
+                else:
+                    h *= 0.5
+        if u_next is None:
+            return None
+        r, _, jac = ws.evaluate(u_next)
+        t_next, sigma = np.empty_like(tangent), np.empty(cfg.n_sigma)
+        new_basis = basis_prev.copy()
+        tau = ws.kernels.tangent_and_test(jac, tangent.copy(), new_basis, cfg.r_path, t_next, sigma)
+        basis[:, :] = new_basis
+        across = Chunk(
+            u=np.array([u_k, u_next]), t=np.array([tangent, t_next]),
+            sigma=np.array([chunk.sigma[c - 1], sigma]), res=np.array([chunk.res[c - 1], r]),
+            tau=np.array([chunk.tau[c - 1], tau]), s=np.array([0.0, float(np.linalg.norm(u_next - u_k))]),
+            count=2, code=BUDGET, h=h,
+        )  # fmt: skip
+        if cfg.target is not None and self._target_on_last_step(across) and self._land(across, d, cfg.target):
+            across.code = TARGET
+        return across
 
     def _target_on_last_step(self, chunk: Chunk) -> bool:
         """Whether the drive's target lies on the chunk's last step (between its last two rows' drive values).

@@ -117,6 +117,34 @@ class Mechanism:
         """Number of scalar closure equations (loops x rows)."""
         return len(self.loops) * len(self.rows)
 
+    def plane_normal(self, tol: float = 1e-9) -> Array | None:
+        """The unit normal of the plane the mechanism moves in, however it is written; None for a spatial one.
+
+        A mechanism is planar when every revolute axis is parallel to one direction ``n`` (to ``tol`` in the sine
+        of the angle between them) and every prismatic direction is normal to it: then every link moves parallel
+        to the plane normal to ``n``, whether it was written as a ``planar`` mechanism (``n`` is z), as a ``dh``
+        loop with zero twists, or as hinge lines that happen to be parallel. Rotation about parallel axes keeps
+        them parallel, so the reference configuration decides for the whole motion.
+        """
+        if self.planar:
+            return np.array([0.0, 0.0, 1.0])
+        w, v = self.twists[:, :3], self.twists[:, 3:]
+        revolute = np.einsum("ij,ij->i", w, w) > 0.5
+        if not np.any(revolute):
+            return None
+        normal = w[np.flatnonzero(revolute)[0]]
+        normal = normal / np.linalg.norm(normal)
+        if np.any(np.linalg.norm(np.cross(w[revolute], normal), axis=1) > tol):
+            return None
+        if np.any(np.abs(v[~revolute] @ normal) > tol):
+            return None
+        return normal
+
+    @property
+    def moves_in_plane(self) -> bool:
+        """Whether the mechanism is planar however it is written (:meth:`plane_normal`)."""
+        return self.plane_normal() is not None
+
     def index(self, joint: str | int) -> int:
         """Index of a joint given by name or index; a clear :class:`SpecError` for an unknown one."""
         if isinstance(joint, int | np.integer):

@@ -148,13 +148,14 @@ def unit_noise(seeds: np.ndarray, n_joints: int, uniform: bool) -> np.ndarray:
 
 def component_scale(mech: Mechanism, model: ImperfectionModel, lines: HingeLines) -> Array:
     """``(n, 4)`` tolerance per noise component: tilts ``direction_tol``, shifts ``position_tol``; for in-plane
-    errors of a planar mechanism no tilt out of the plane (a revolute axis stays normal to it; a prismatic
-    direction turns only about the plane's normal), and zero shift for a prismatic joint."""
+    errors of a planar mechanism (however it is written: :meth:`Mechanism.plane_normal`) no tilt out of the plane
+    (a revolute axis stays normal to it; a prismatic direction turns only about the plane's normal), and zero
+    shift for a prismatic joint."""
     scale = np.empty((mech.n_joints, 4))
-    in_plane = mech.planar and not model.spatial
+    normal = mech.plane_normal()
     scale[:, :2] = model.direction_tol
-    if in_plane:
-        about_normal = np.abs(np.stack([lines.e1[:, 2], lines.e2[:, 2]], axis=1)) > 0.999
+    if normal is not None and not model.spatial:
+        about_normal = np.abs(np.stack([lines.e1 @ normal, lines.e2 @ normal], axis=1)) > 0.999
         scale[:, :2] = np.where(about_normal & ~lines.revolute[:, None], model.direction_tol, 0.0)
     scale[:, 2:] = np.where(lines.revolute, model.position_tol, 0.0)[:, None]
     return scale
