@@ -14,12 +14,14 @@ their closed forms):
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import cache
 
 import numpy as np
 import pytest
 from bookkeeping_reference import (
     bennett,
+    hat,
     jacobian,
     planar_four_bar,
     singular_values,
@@ -28,8 +30,9 @@ from bookkeeping_reference import (
     wrapped,
 )
 from bookkeeping_reference import residual as reference_residual
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from scipy.linalg import expm
 
 import linkwork as lw
 from linkwork.kinematics.mechanism import Mechanism
@@ -94,8 +97,14 @@ def assert_sigma_is_fresh_svd(tr: Trace, rows: np.ndarray) -> None:
 # ------------------------------------------------------------------------------------ closed paths
 @pytest.mark.parametrize("name", BUILT_INS)
 def test_every_built_in_closed_path_ends_on_its_first_row(name: str) -> None:
+    """And report.json's ``condition_at_end`` (the normalised ratio at the last point) is the start's again."""
+    from linkwork.io.results import report_dict
+
     tr = built_in_trace(name, False)
     assert assert_closed_rows_match(tr) >= (1 if tr.branches[0].end_reason == "closed path" else 0)
+    if tr.branches[-1].end_reason == "closed path":
+        assert report_dict(tr)["condition_at_end"] == pytest.approx(tr.condition()[0], rel=1e-9)
+        assert tr.rank[-1] == tr.rank[0]
 
 
 @pytest.mark.parametrize("name", ["guest-frame", "bricard-threefold", "four-bar"])
@@ -354,6 +363,7 @@ def test_equal_steps_landing_on_a_bifurcation_recognise_it_and_stay_on_their_bra
     pivot is on one line (crank at 180 deg). Equal drive steps of ``delta`` deg with one landing exactly there:
     the point is a bifurcation point with two branch tangents, and every row keeps the parallelogram relation
     (coupler parallel to the ground: q_B = -q_A, q_C = q_A, q_D = -q_A modulo a turn)."""
+    assume(10.0 <= before * delta <= 170.0)  # the start between the crossings, on the parallelogram branch
     theta = 180.0 - before * delta
     mech = planar_four_bar(2.0, 1.0, 2.0, 1.0, theta * DEG)
     tr = lw.trace(mech, until=("A", (before + after) * delta * DEG), steps=before + after)
@@ -377,3 +387,58 @@ def test_the_reported_four_bar_landing_on_its_crossing_reaches_its_target() -> N
         found = sorted(float(np.degrees(b.angles[0])) for b in tr.bifurcations)
         np.testing.assert_allclose(found, [180.0, 360.0], atol=1e-7)
         assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 12))
+
+
+# ------------------------------------------------------------------------------------ scale-free steps
+#: The same linkage in another unit or place: every row's angles agree (radians).
+SAME_STEPS_TOL = 1e-9
+
+
+def rigid(seed: int) -> np.ndarray:
+    """A random rigid motion (rotation up to pi about a random axis, translation up to 5), by scipy's expm."""
+    rng = np.random.default_rng(seed)
+    axis = rng.normal(size=3)
+    w = axis / np.linalg.norm(axis) * rng.uniform(0.1, np.pi - 0.1)
+    return expm(hat(np.concatenate([w, rng.uniform(-5.0, 5.0, size=3)])))
+
+
+def moved(mech: Mechanism, T: np.ndarray, scale: float = 1.0) -> Mechanism:
+    """Every hinge line scaled by ``scale`` about the origin, then moved by the rigid motion ``T``: a line
+    through ``p`` along ``w`` goes through ``R s p + d`` along ``R w``."""
+    R, d = T[:3, :3], T[:3, 3]
+    w, v = mech.twists[:, :3], scale * mech.twists[:, 3:]
+    twists = np.concatenate([w @ R.T, v @ R.T + np.cross(d, w @ R.T)], axis=1)
+    return replace(mech, twists=twists, hinge_points=np.zeros((0, 3)))
+
+
+def assert_same_steps(a: Trace, b: Trace) -> None:
+    assert a.angles.shape == b.angles.shape, f"{len(a.angles)} points against {len(b.angles)}"
+    np.testing.assert_allclose(b.angles, a.angles, rtol=0.0, atol=SAME_STEPS_TOL)
+    assert [br.end_reason for br in a.branches] == [br.end_reason for br in b.branches]
+
+
+@PROPERTY
+@given(bennett_params, st.integers(0, 1000))
+def test_the_step_sequence_of_a_bennett_linkage_does_not_depend_on_unit_or_place(
+    params: tuple[float, float, float], seed: int
+) -> None:
+    """Metres against millimetres (every length times 1000, the closed form built in each unit) and the linkage
+    moved and turned: the adaptive steps land on the same points (it differed by up to 0.106 deg)."""
+    a1, da, t1 = params
+    metres = bennett(a1 * DEG, (a1 + da) * DEG, t1 * DEG)
+    millimetres = bennett(a1 * DEG, (a1 + da) * DEG, t1 * DEG, scale=1000.0)
+    reference = lw.trace(metres)
+    assert_same_steps(reference, lw.trace(millimetres))
+    assert_same_steps(reference, lw.trace(moved(metres, rigid(seed))))
+
+
+@pytest.mark.parametrize("name", ["bricard-line", "goldberg", "hedgepeth-rods", "guest-frame", "four-bar"])
+def test_the_step_sequence_of_a_built_in_does_not_depend_on_unit_or_place(name: str) -> None:
+    mech = lw.load(name)
+    reference = built_in_trace(name, False)
+    T = rigid(7)
+    if mech.planar:  # turned about z and moved in the plane: a planar mechanism stays in z = 0
+        c, s = np.cos(2.1), np.sin(2.1)
+        T = np.array([[c, -s, 0.0, 3.0], [s, c, 0.0, -4.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    for variant in (moved(mech, np.eye(4), 1000.0), moved(mech, T, 0.001)):
+        assert_same_steps(reference, lw.trace(variant))
