@@ -41,7 +41,7 @@ from linkwork.linkages.registry import REGISTRY
 
 DEG = np.pi / 180.0
 #: Seeded, no deadline, few examples: the generated cases run in seconds.
-PROPERTY = settings(deadline=None, max_examples=8, derandomize=True)
+PROPERTY = settings(deadline=None, max_examples=6, derandomize=True)
 #: A closed path's last row against its first: angles (rad, modulo a turn), singular values, residual.
 CLOSED_TOL = 1e-9
 #: Singular values against numpy's SVD of the finite-difference Jacobian, relative to sigma_1 (the central
@@ -57,7 +57,7 @@ def built_in_trace(name: str, branches: bool) -> Trace:
     return lw.trace(lw.load(name), branches=branches)
 
 
-def rows_to_check(tr: Trace, most: int = 24) -> np.ndarray:
+def rows_to_check(tr: Trace, most: int = 12) -> np.ndarray:
     """Every branch's first and last rows and up to ``most`` rows spread along the path."""
     starts = np.flatnonzero(np.diff(tr.branch, prepend=-1) != 0)
     ends = np.append(starts[1:] - 1, len(tr.branch) - 1)
@@ -147,7 +147,7 @@ def test_generated_bennett_closed_path_and_singular_values(params: tuple[float, 
     tr = lw.trace(generated_bennett(params), progress=lambda done, total: None)
     assert tr.branches[0].end_reason == "closed path"
     assert assert_closed_rows_match(tr) == 1
-    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
+    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 6))
 
 
 grashof_crank = st.tuples(
@@ -176,7 +176,7 @@ def test_generated_four_bar_closed_path_and_singular_values(
     tr = lw.trace(generated_four_bar(params), progress=lambda done, total: None)
     assert tr.branches[0].end_reason == "closed path"
     assert assert_closed_rows_match(tr) == 1
-    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
+    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 6))
 
 
 spherical_crank = st.tuples(
@@ -199,7 +199,7 @@ def test_generated_spherical_4r_closed_path_and_singular_values(params: tuple[fl
     tr = lw.trace(generated_spherical(params), progress=lambda done, total: None)
     assert tr.branches[0].end_reason == "closed path"
     assert assert_closed_rows_match(tr) == 1
-    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 8))
+    assert_sigma_is_fresh_svd(tr, rows_to_check(tr, 6))
 
 
 # ------------------------------------------------------------------------------------ targets
