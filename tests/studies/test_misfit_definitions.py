@@ -175,3 +175,37 @@ def test_what_a_tolerance_means_is_stated_and_true(distribution: str) -> None:
     assert tolerances["distribution"] == distribution
     assert tolerances["fraction_beyond"] == pytest.approx(expected, abs=1e-15)
     assert ("standard deviation" if distribution == "normal" else "hard bound") in tolerances["meaning"]
+
+
+def test_robustness_command_gives_a_dh_four_bar_in_plane_errors(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """`linkwork robustness` on a spec file of a four-bar written as a `dh` loop with zero twists: in-plane errors
+    by default (robustness.json says so), every sample keeps its mobility."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from linkwork.cli import app
+
+    mech = dh_four_bar()
+    lines = ['name = "four-bar as dh"', 'angles = "deg"', "", "[loop]", 'convention = "dh"']
+    for p in mech.meta["params"]:
+        lines += [
+            "",
+            "[[loop.joints]]",
+            f"theta = {float(np.degrees(p['theta']))!r}",
+            f"a = {float(p['a'])!r}",
+            "alpha = 0.0",
+        ]
+    spec = tmp_path / "four-bar-dh.toml"
+    spec.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "rb"
+    result = CliRunner().invoke(
+        app,
+        ["robustness", str(spec), "--samples", "30", "--hinge-position-tol", "1e-2", "--hinge-direction-tol",
+         "0.5", "--until", f"A={float(np.degrees(mech.offsets[0])) + 30.0!r}", "--steps", "10", "--workers", "0",
+         "--no-plots", "-o", str(out)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stdout + result.stderr
+    summary = json.loads((out / "robustness.json").read_text())
+    assert summary["tolerances"]["errors"] == "in-plane"
+    assert summary["mobility_kept"] == 1.0
