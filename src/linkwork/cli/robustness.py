@@ -32,10 +32,20 @@ def robustness(
     spec: opt.SpecName,
     samples: Annotated[int, typer.Option(help="Number of imperfect samples.")],
     hinge_position_tol: Annotated[
-        float, typer.Option(help="Hinge position tolerance, normal to the line (length units).")
+        float,
+        typer.Option(
+            help="Hinge position tolerance normal to the line (length units): with --distribution normal the "
+            "standard deviation of each of the two shift components (61 % of hinges shift by more); with uniform "
+            "a hard bound (the shift is uniform in a disc of this radius)."
+        ),
     ],
     hinge_direction_tol: Annotated[
-        float, typer.Option(help="Hinge direction tolerance: cone half-angle (deg).")
+        float,
+        typer.Option(
+            help="Hinge direction tolerance (deg), a tilt about the hinge itself: with --distribution normal the "
+            "standard deviation of each of the two tilt components (61 % of hinges tilt by more); with uniform a "
+            "hard bound (the tilt is uniform in a cone of this half-angle)."
+        ),
     ],
     set_: opt.SetParams = None,
     until: Annotated[
@@ -51,7 +61,11 @@ def robustness(
     ] = None,
     fixed: opt.Fixed = None,
     distribution: Annotated[
-        str, typer.Option(help="normal (tolerance = standard deviation) or uniform (within the tolerance).")
+        str,
+        typer.Option(
+            help="normal: each tolerance is the standard deviation of each error component (the default; 61 % of "
+            "hinges exceed it); uniform: each tolerance is a hard bound (errors uniform in a disc or cone)."
+        ),
     ] = "normal",
     seed: Annotated[int, typer.Option(help="Seed of the study; sample i gets its own seed from it.")] = 0,
     scheduler: opt.Scheduler = None,
@@ -86,7 +100,7 @@ def robustness(
         position_tol=hinge_position_tol,
         direction_tol=float(np.radians(hinge_direction_tol)),
         distribution=distribution,
-        spatial=spatial_errors or not mech.planar,
+        spatial=spatial_errors or not mech.moves_in_plane,
     )
     nominal = _nominal_path(mech, until_in_api_units(mech, target), steps, max_steps)
     setup = prepare(mech, nominal, model, seed)

@@ -136,7 +136,10 @@ def _rank_entries(trace: Trace) -> dict[str, Any]:
     start_rank = int(trace.stats.start_rank)
     regular = np.ones(len(trace.rank), dtype=bool)
     for b in trace.bifurcations:
-        regular &= np.linalg.norm(trace.angles - b.angles, axis=1) > 1e-6
+        diff = trace.angles - b.angles
+        revolute = np.array([kind == "R" for kind in mech.joint_types])
+        diff[:, revolute] = (diff[:, revolute] + np.pi) % (2.0 * np.pi) - np.pi  # the point, a turn away
+        regular &= np.linalg.norm(diff, axis=1) > 1e-6
     ranks = trace.rank[regular] if np.any(regular) else trace.rank
     return {
         "rank": start_rank,

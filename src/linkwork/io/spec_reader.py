@@ -210,14 +210,17 @@ def read_loop_table(
             thetas.append(reader.number(joint, "theta", here, default=0.0, angle=True))
         mech, assembly = from_rods(name, rods, thetas, joint_names=names, meta=info, closure_tol=closure_tol)
     else:
-        twists, offsets = [], []
+        twists, offsets, points = [], [], []
         for i, joint in enumerate(joints):
             here = _key(path, i)
             point = reader.vector(joint, "point", here)
             direction = reader.vector(joint, "direction", here, nonzero=True)
             twists.append(line_twist(point, direction, "R"))
+            points.append(point)
             offsets.append(reader.number(joint, "theta", here, default=0.0, angle=True))
-        mech = Mechanism.single_loop(name, names, np.array(twists), offsets=np.array(offsets), meta=info)
+        mech = Mechanism.single_loop(
+            name, names, np.array(twists), offsets=np.array(offsets), meta=info, hinge_points=np.array(points)
+        )
     return mech, assembly, couplings
 
 

@@ -110,6 +110,58 @@ def correct(mech, u, held, corrector, q, res, jac):
 
 
 @kernel()
+def correct_across(mech, u, t, corrector, q, res, jac):
+    """Gauss-Newton for the closure in the hyperplane through the predicted ``u`` normal to the tangent ``t``
+    (pseudo-arclength), in place on ``u``; returns ``(converged, iterations, residual)`` as :func:`correct`.
+
+    Each step is the truncated-SVD least-squares solution (Eq. (28)) of the closure's Jacobian bordered by
+    ``t``: the point it converges to, where the path crosses that hyperplane, does not depend on how the closure
+    equations are weighted, so the steps are the same whatever the length unit and wherever the linkage stands
+    (a minimum-norm correction over all unknowns lands elsewhere on the path for each weighting).
+    """
+    tol, exact, roundoff, truncate, max_iter = corrector
+    m = u.shape[0]
+    E = res.shape[0]
+    u0 = u.copy()
+    A = np.empty((E + 1, m))
+    b = np.empty(E + 1)
+    prev = np.inf
+    accept = max(tol, roundoff * exact)
+    for it in range(max_iter + 1):
+        r = evaluate(mech, u, q, res, jac)
+        if not np.isfinite(r):
+            return False, it, r
+        if r < exact:
+            return True, it, r
+        if r < accept and r > 0.5 * prev:
+            return True, it, r
+        if it == max_iter or (it >= 2 and r > prev):
+            return False, it, r
+        prev = r
+        gap = 0.0
+        for a in range(m):
+            for e in range(E):
+                A[e, a] = jac[e, a]
+            A[E, a] = t[a]
+            gap += t[a] * (u[a] - u0[a])
+        for e in range(E):
+            b[e] = res[e]
+        b[E] = gap
+        U, s, Vt = np.linalg.svd(A)
+        cut = truncate * s[0]
+        for i in range(min(s.shape[0], m)):
+            if s[i] <= cut:
+                break
+            c = 0.0
+            for e in range(E + 1):
+                c += U[e, i] * b[e]
+            c /= s[i]
+            for a in range(m):
+                u[a] -= Vt[i, a] * c
+    return False, max_iter, prev
+
+
+@kernel()
 def least_squares_step(jac, res, held, u):
     """``u -= argmin |J du + r|`` over the unknowns other than ``held``, by Cholesky of ``J^T J``.
 
@@ -210,6 +262,16 @@ def step_geometry(u, t, u_try, t_new):
         dist += du * du
         ahead += t[a] * du
     return turn, np.sqrt(dist), ahead
+
+
+@kernel()
+def correction(u, t, step, u_try):
+    """How far the corrector moved the predicted point ``u + step t`` to ``u_try``."""
+    acc = 0.0
+    for a in range(u.shape[0]):
+        d = u_try[a] - u[a] - step * t[a]
+        acc += d * d
+    return np.sqrt(acc)
 
 
 @kernel()
@@ -322,8 +384,12 @@ def march(mech, start, steps, corrector, bounds, out):
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
-        ok, iters, r = correct(mech, u_try, held, corrector, q, res, jac)
+        if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
+            ok, _, r = correct_across(mech, u_try, t, corrector, q, res, jac)
+        else:
+            ok, _, r = correct(mech, u_try, held, corrector, q, res, jac)
         turn, dist, tau_new = 1.0, 0.0, 0.0
+        easy = ok and correction(u, t, step, u_try) <= 0.1 * abs(step)
         if ok:
             basis_try[:, :] = basis
             tau_new = tangent_and_test(jac, t, basis_try, r_path, t_new, sig)
@@ -358,8 +424,9 @@ def march(mech, start, steps, corrector, bounds, out):
             if far > 4.0 * hmax and d < 1.5 * abs(h):
                 close_path(u, u_home, periodic, count - 1, out_u, out_sigma, out_res, out_tau)
                 return count, CLOSED, h
-        # ---- step control: grow an easy adaptive step
-        if not paper and iters <= 3 and turn > np.sqrt(cos_turn):
+        # ---- step control: grow an easy adaptive step (judged in the unknowns, so that it does not depend on the
+        # length unit or where the linkage stands: the corrector moved the point by under a tenth of the step)
+        if not paper and easy and turn > np.sqrt(cos_turn):
             h = min(h * 1.5, hmax)
     return count, BUDGET, h
 

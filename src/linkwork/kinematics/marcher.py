@@ -34,7 +34,9 @@ class MarchSettings:
     """What every march of one trace shares: the drive, the step control, the path's rank, limits, tolerances.
 
     ``target`` is the drive's target in the unknowns (``None``: none); ``lo``/``hi`` are the limits in the
-    unknowns (``-inf``/``inf`` where none); ``periodic`` marks the revolute unknowns (compared modulo a turn).
+    unknowns (``-inf``/``inf`` where none); ``periodic`` marks the revolute unknowns (compared modulo a turn);
+    ``drive_joint`` is the joint the user drives (``-1``: the first joint of the drive's unknown), whose value a
+    fold reports.
     """
 
     drive: int
@@ -48,6 +50,12 @@ class MarchSettings:
     lo: Array
     hi: Array
     tol: Tolerances
+    drive_joint: int = -1
+
+
+#: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
+#: branch along which the drive stays put (to round-off) that component only changes sign by noise.
+FOLD_MOVING = 1e-8
 
 
 @dataclass
@@ -87,6 +95,22 @@ class Rows:
         self.s.append(np.zeros(1))
         self.branch.append(np.array([branch], dtype=np.int64))
         self.step.append(np.zeros(1, dtype=np.int64))
+
+
+@dataclass(frozen=True)
+class Home:
+    """What was measured at the point a branch's march began: a closed path's last row is that point again."""
+
+    sigma: Array
+    res: float
+    tau: float
+
+    def copy_to(self, chunk: Chunk, row: int) -> None:
+        """Make ``chunk``'s row ``row`` (the start again, in continuous angles) carry the start's values: the
+        compiled march copies its own row 0, which is the start only in a branch's first call."""
+        chunk.sigma[row] = self.sigma
+        chunk.res[row] = self.res
+        chunk.tau[row] = self.tau
 
 
 @dataclass
@@ -185,14 +209,17 @@ class BranchMarcher:
         stop_at_known: bool,
         step_offset: int = 0,
         check_closed: bool = True,
+        opened_at: tuple[Array, Home] | None = None,
     ) -> tuple[int, End]:
         """March one branch to its end, locating bifurcations and folds on the way; returns (steps, how it ended).
 
         ``step_offset``: step number of ``u0`` in its branch (1 when the branch opens at a bifurcation point).
+        ``opened_at``: the point the branch's first row is, when it is not ``u0`` (the bifurcation point a queued
+        branch leaves), with its values: the branch is closed when it comes back round to it.
         """
         n_steps, kind, text, about, point = self._march_branch(
             branch_id, u0, t0, basis, paper=paper, h0=h0, stop_at_known=stop_at_known,
-            step_offset=step_offset, check_closed=check_closed,
+            step_offset=step_offset, check_closed=check_closed, opened_at=opened_at,
         )  # fmt: skip
         return n_steps, self.end(kind, text, self.rows.u[-1][-1], about, point)
 
@@ -218,10 +245,13 @@ class BranchMarcher:
         stop_at_known: bool,
         step_offset: int,
         check_closed: bool,
+        opened_at: tuple[Array, Home] | None,
     ) -> tuple[int, StopReason, str, int | None, int | None]:
         """:meth:`run_branch`'s march: returns (steps, kind, text, the unknown the reason is about or ``None``
         for the drive, the located point it ended on or ``None``)."""
-        u, t, u_home = u0.copy(), t0.copy(), u0.copy()
+        u, t = u0.copy(), t0.copy()
+        u_home = u0.copy() if opened_at is None else opened_at[0].copy()
+        home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
         while True:
             n = max(min(self.budget, 100 if self.progress else self.budget), 0)
@@ -229,14 +259,42 @@ class BranchMarcher:
                 return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
+            home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
+            if chunk.code == StopReason.CLOSED:
+                home.copy_to(chunk, chunk.count - 1)
+                target = self.cfg.target
+                if (
+                    target is not None
+                    and self._target_on_last_step(chunk)
+                    and self._land(chunk, self.cfg.drive, target)
+                ):
+                    chunk.code = (
+                        StopReason.TARGET
+                    )  # the closing step passed over the target (or ends on it): land there
             limit = self._land_on_limit(chunk) if chunk.code == StopReason.LIMIT else None
             component = self._component_entry(chunk)
             if component is not None:
                 chunk.count = component + 1
+            landed = self._landed_row(chunk, component)
+            if (
+                landed is not None
+            ):  # a step landed on a singular point: the rows after it may be on another branch
+                if landed < chunk.count - 1 or chunk.code not in (
+                    StopReason.TARGET,
+                    StopReason.CLOSED,
+                    StopReason.LIMIT,
+                ):
+                    chunk.count, chunk.code = landed + 1, StopReason.BUDGET
             self._record(chunk, branch_id, first, n_steps)
             base = n_steps + step_offset
             n_steps += chunk.count - 1
             self.budget -= chunk.count - 1
+            through: Array | None = None
+            if landed is not None:
+                ended, through = self._on_landed(chunk, branch_id, base + landed, stop_at_known)
+                if ended is not None:
+                    kind, text, point = ended
+                    return n_steps, kind, text, None, point
             self._scan_rank_minima(chunk, branch_id, base)
             self._scan_folds(chunk, branch_id, base)
             first = False
@@ -245,6 +303,21 @@ class BranchMarcher:
             if component is not None:
                 point, text = self._enter_component(chunk, branch_id, base + component)
                 return n_steps, StopReason.COMPONENT, text, None, point
+            if through is not None and chunk.code == StopReason.BUDGET and self.budget > 0:
+                # Step off the singular point along the branch it was reached on, then march on from there.
+                across = self._step_across(chunk, through, paper, basis_prev, basis)
+                if across is None:
+                    reason = "corrector failed at a fixed drive step" if paper else "corrector failed"
+                    text = f"{reason} (leaving the bifurcation point the path landed on)"
+                    return n_steps, StopReason.FAILED, text, None, None
+                self._record(across, branch_id, False, n_steps)
+                self._scan_folds(across, branch_id, n_steps + step_offset)
+                n_steps += 1
+                self.budget -= 1
+                if across.code == StopReason.TARGET:
+                    return n_steps, StopReason.TARGET, StopReason.TARGET.text, None, None
+                u, t, h0 = across.u[1].copy(), across.t[1].copy(), across.h
+                continue
             if chunk.code == StopReason.SIGN_CHANGE:
                 known = self._on_sign_change(chunk, basis_prev, branch_id, n_steps + step_offset)
                 if known is not None and stop_at_known:
@@ -271,25 +344,148 @@ class BranchMarcher:
         the unknown that passed its limit first and the end reason, ``limit <joint>``.
         """
         cfg, c = self.cfg, chunk.count
-        u_a, t_a, u_b = chunk.u[c - 2], chunk.t[c - 2], chunk.u[c - 1]
+        u_b = chunk.u[c - 1]
         over = np.flatnonzero((u_b < cfg.lo) | (u_b > cfg.hi))
         reason = "limit " + ", ".join(self.mech.joint_names[self.mech.group_members()[g][0]] for g in over)
         g = int(over[0])
-        bound = cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g]
+        self._land(chunk, g, cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g])
+        return g, reason
+
+    def _landed_row(self, chunk: Chunk, component: int | None) -> int | None:
+        """The first row after the chunk's start where the Jacobian's rank has dropped below the path's, unless
+        it is where the branch enters a higher-dimensional component: a step that landed on a singular point
+        (equal drive steps landing on a bifurcation point), where the march's tangent is any vector of a null
+        space of dimension two and the sign of the test function means nothing."""
+        if chunk.count < 2:
+            return None
+        ranks = numerical_ranks(chunk.sigma[1 : chunk.count], self.cfg.tol)
+        low = np.flatnonzero(ranks < self.cfg.r_path)
+        if len(low) == 0:
+            return None
+        row = int(low[0]) + 1
+        return None if component is not None and row >= component else row
+
+    def _on_landed(
+        self, chunk: Chunk, branch_id: int, step: int, stop_at_known: bool
+    ) -> tuple[tuple[StopReason, str, int] | None, Array | None]:
+        """Recognise the chunk's last row, a singular point the path landed on, as a located point.
+
+        A new point is classified and kept (its other branches queued); a known one ends a branch that stops at
+        known points. Returns ``((kind, text, point) of the branch's end, or None; tangent to go on along)``: the branch tangent there nearest
+        the incoming one (or the incoming tangent projected on the null space when there are fewer than two),
+        oriented the same way; it replaces the row's tangent."""
+        c = chunk.count
+        u_k, t_in = chunk.u[c - 1].copy(), chunk.t[c - 2].copy()
+        known = self._match(u_k)
+        if known is None:
+            point = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u_k, 0.0, self.cfg)
+            self._add_point(point, branch_id, t_in)
+        else:
+            point = self.found[known]
+            if stop_at_known:
+                self._arrived(known, u_k - chunk.u[c - 2])
+                return (StopReason.KNOWN_POINT, f"reached bifurcation {known}", known), None
+            self._passed(known, chunk)
+        if point.kind == "component":
+            dim = point.dimension
+            text = f"entered a {dim}-dimensional component (mobility {dim}) at point {point.id}"
+            return (StopReason.COMPONENT, text, point.id), None
+        if len(point.tangents_u) >= 2:
+            tangent = point.tangents_u[int(np.argmax(np.abs(point.tangents_u @ t_in)))].copy()
+        else:
+            _, _, jac = self.ws.evaluate(u_k)
+            _, s, Vt = np.linalg.svd(jac)
+            null = Vt[numerical_rank(s, self.cfg.tol) :]
+            tangent = null.T @ (null @ t_in)
+        tangent /= np.linalg.norm(tangent)
+        tangent *= 1.0 if tangent @ t_in >= 0.0 else -1.0
+        chunk.t[c - 1] = tangent
+        return None, tangent
+
+    def _step_across(
+        self, chunk: Chunk, tangent: Array, paper: bool, basis_prev: Array, basis: Array
+    ) -> Chunk | None:
+        """One step from the chunk's last row (a singular point) along ``tangent``: a two-row chunk (that row,
+        then the new point with its tangent, singular values, residual and test value), ``basis`` updated in place
+        for the march that goes on; None when the corrector does not converge.
+
+        Paper mode moves the drive by the fixed step with the drive held, as the march does; adaptive mode takes
+        the march's step length along the tangent and corrects in the hyperplane normal to it, halving the step
+        on failure. A target on the step is landed on (code ``TARGET``)."""
+        cfg, ws, tol = self.cfg, self.ws, self.cfg.tol
+        c, d = chunk.count, cfg.drive
+        u_k = chunk.u[c - 1]
+        h = chunk.h
+        u_next: Array | None = None
+        while u_next is None and abs(h) >= cfg.min_step:
+            if paper:
+                if abs(tangent[d]) < 1e-12:
+                    return None
+                guess = u_k + (h / tangent[d]) * tangent
+                guess[d] = u_k[d] + h
+                ok, _, _ = ws.kernels.correct(
+                    ws.kernel_arrays(), guess, d, ws.corrector(tol), ws.q, ws.res, ws.jac
+                )
+                if not ok:
+                    return None
+                u_next = guess
+            else:
+                guess, _, ok = correct_on_plane(ws, u_k + h * tangent, tangent, tol)
+                if ok and float(tangent @ (guess - u_k)) > tol.advance * h:
+                    u_next = guess
+                else:
+                    h *= 0.5
+        if u_next is None:
+            return None
+        r, _, jac = ws.evaluate(u_next)
+        t_next, sigma = np.empty_like(tangent), np.empty(cfg.n_sigma)
+        new_basis = basis_prev.copy()
+        tau = ws.kernels.tangent_and_test(jac, tangent.copy(), new_basis, cfg.r_path, t_next, sigma)
+        basis[:, :] = new_basis
+        across = Chunk(
+            u=np.array([u_k, u_next]), t=np.array([tangent, t_next]),
+            sigma=np.array([chunk.sigma[c - 1], sigma]), res=np.array([chunk.res[c - 1], r]),
+            tau=np.array([chunk.tau[c - 1], tau]), s=np.array([0.0, float(np.linalg.norm(u_next - u_k))]),
+            count=2, code=StopReason.BUDGET, h=h,
+        )  # fmt: skip
+        if cfg.target is not None and self._target_on_last_step(across) and self._land(across, d, cfg.target):
+            across.code = StopReason.TARGET
+        return across
+
+    def _target_on_last_step(self, chunk: Chunk) -> bool:
+        """Whether the drive's target lies on the chunk's last step (between its last two rows' drive values).
+
+        A path closes by snapping onto its start once it is within one and a half steps of it; a target on that
+        stretch (just below a full turn of the drive, or exactly on it) is reached there, not refused."""
+        cfg, c = self.cfg, chunk.count
+        if cfg.target is None or c < 2:
+            return False
+        a, b = chunk.u[c - 2, cfg.drive], chunk.u[c - 1, cfg.drive]
+        slack = 1e-12 * max(1.0, abs(cfg.target))
+        return min(a, b) - slack <= cfg.target <= max(a, b) + slack
+
+    def _land(self, chunk: Chunk, g: int, value: float) -> bool:
+        """Replace the chunk's last row by the point of its last step where unknown ``g`` is at ``value``.
+
+        From the row before it, the predictor goes along the tangent to that value and the corrector holds the
+        unknown there (as when landing on a target). Returns whether it converged (the row is kept otherwise).
+        """
+        cfg, c = self.cfg, chunk.count
+        u_a, t_a = chunk.u[c - 2], chunk.t[c - 2]
         if abs(t_a[g]) < 1e-12:
-            return g, reason
-        guess = u_a + (bound - u_a[g]) / t_a[g] * t_a
-        guess[g] = bound
+            return False
+        guess = u_a + (value - u_a[g]) / t_a[g] * t_a
+        guess[g] = value
         tol, ws = cfg.tol, self.ws
         ok, _, r = ws.kernels.correct(ws.kernel_arrays(), guess, g, ws.corrector(tol), ws.q, ws.res, ws.jac)
         if not ok:
-            return g, reason
+            return False
         _, _, jac = ws.evaluate(guess)
         chunk.u[c - 1] = guess
         chunk.sigma[c - 1] = np.linalg.svd(jac, compute_uv=False)[: cfg.n_sigma]
         chunk.res[c - 1] = r
         chunk.s[c - 1] = chunk.s[c - 2] + float(np.linalg.norm(guess - u_a))
-        return g, reason
+        return True
 
     def _turns_towards_target(self, chunk: Chunk, u_home: Array) -> bool:
         """Whether a closed path turned the (revolute) drive by whole turns towards a target still ahead."""
@@ -380,15 +576,26 @@ class BranchMarcher:
                 self._add_point(bif, branch_id, chunk.t[k])
 
     def _scan_folds(self, chunk: Chunk, branch_id: int, base: int) -> None:
-        """Locate every fold of the drive in the chunk: the tangent's drive component changes sign."""
+        """Locate every fold of the drive in the chunk: where the drive turns back.
+
+        A candidate is a step over which the tangent's drive component changes sign while moving by more than
+        :data:`FOLD_MOVING` on at least one side; the located point is kept when the drive's value there is an
+        extreme of the step (beyond both ends, by more than round-off), so a branch along which the drive is
+        constant (its tangent component only noise) has no folds.
+        """
         d = self.cfg.drive
         td = chunk.t[: chunk.count, d]
-        for k in np.flatnonzero(td[:-1] * td[1:] < 0.0):
-            u_f = locate_fold(
-                self.ws, chunk.u[k], chunk.t[k], chunk.u[k + 1], chunk.t[k + 1], d, self.cfg.tol
-            )
+        moving = np.maximum(np.abs(td[:-1]), np.abs(td[1:])) > FOLD_MOVING
+        joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.mech.group_members()[d][0]
+        for k in np.flatnonzero((td[:-1] * td[1:] < 0.0) & moving):
+            u_a, u_b = chunk.u[k], chunk.u[k + 1]
+            u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol)
+            beyond = np.sign(td[k]) * (u_f[d] - np.array([u_a[d], u_b[d]]))
+            noise = 1e-13 * max(1.0, abs(float(u_f[d])))
+            if beyond.min() < -noise or beyond.max() <= noise:
+                continue  # the drive does not turn back here
             angles = self.mech.angles_from_q(self.mech.q_from_u(u_f))
-            self.folds.append(Fold(branch_id, base + int(k), float(u_f[d]), angles))
+            self.folds.append(Fold(branch_id, base + int(k), float(angles[joint]), angles))
 
     def _on_sign_change(self, chunk: Chunk, basis_prev: Array, branch_id: int, step: int) -> int | None:
         """Locate the zero of the test function in the chunk's last step; returns the id if already known."""
@@ -518,8 +725,9 @@ class BranchMarcher:
             s_off = float(np.linalg.norm(u1 - job.u))
             start_len = len(self.rows.u)
             basis = np.ascontiguousarray(U1[:, : cfg.r_path])
+            opened_at = (job.u, Home(sigma_star, float(r_star), 0.0))
             nb, end = self.run_branch(
-                bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1
+                bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1, opened_at=opened_at
             )
             for i in range(start_len, len(self.rows.u)):
                 self.rows.s[i] = self.rows.s[i] + s_off

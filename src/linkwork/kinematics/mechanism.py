@@ -64,6 +64,12 @@ class Mechanism:
         fixed joint, which stays at its reference value.
     meta
         Free-form provenance (constructor name and parameters, drawing hints); never used by the numerics.
+    hinge_points
+        ``(n, 3)`` the point written for each joint (a point on its line in the reference configuration: where
+        the physical hinge is), or ``(0, 3)`` when the description gave none (a ``dh`` or ``rods`` loop). A line
+        carries no position along itself; manufacturing errors tilt a hinge about this point
+        (:mod:`linkwork.studies.imperfections`). A point that no longer lies on its line (the twists replaced,
+        moved or re-referenced) is not used.
     """
 
     name: str
@@ -77,6 +83,7 @@ class Mechanism:
     planar: bool = False
     groups: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     meta: Mapping[str, Any] = field(default_factory=dict)
+    hinge_points: Array = field(default_factory=lambda: np.zeros((0, 3)))
 
     def __post_init__(self) -> None:
         """Check the shapes and keep private, read-only copies of the arrays (a frozen value in full)."""
@@ -92,6 +99,10 @@ class Mechanism:
         if groups.shape != (n,):
             raise ValueError(f"Expected groups of shape ({n},), got {groups.shape}")
         object.__setattr__(self, "groups", _frozen(groups, np.int64))
+        points = np.asarray(self.hinge_points, dtype=float).reshape(-1, 3)
+        if len(points) not in (0, n):
+            raise ValueError(f"Expected hinge_points of shape ({n}, 3) or (0, 3), got {points.shape}")
+        object.__setattr__(self, "hinge_points", _frozen(points, float))
         if len(set(self.joint_names)) != n:
             raise SpecError(f"joint names must be unique, got {list(self.joint_names)}")
 
@@ -128,6 +139,34 @@ class Mechanism:
     def n_equations(self) -> int:
         """Number of scalar closure equations (loops x rows)."""
         return len(self.loops) * len(self.rows)
+
+    def plane_normal(self, tol: float = 1e-9) -> Array | None:
+        """The unit normal of the plane the mechanism moves in, however it is written; None for a spatial one.
+
+        A mechanism is planar when every revolute axis is parallel to one direction ``n`` (to ``tol`` in the sine
+        of the angle between them) and every prismatic direction is normal to it: then every link moves parallel
+        to the plane normal to ``n``, whether it was written as a ``planar`` mechanism (``n`` is z), as a ``dh``
+        loop with zero twists, or as hinge lines that happen to be parallel. Rotation about parallel axes keeps
+        them parallel, so the reference configuration decides for the whole motion.
+        """
+        if self.planar:
+            return np.array([0.0, 0.0, 1.0])
+        w, v = self.twists[:, :3], self.twists[:, 3:]
+        revolute = np.einsum("ij,ij->i", w, w) > 0.5
+        if not np.any(revolute):
+            return None
+        normal = w[np.flatnonzero(revolute)[0]]
+        normal = normal / np.linalg.norm(normal)
+        if np.any(np.linalg.norm(np.cross(w[revolute], normal), axis=1) > tol):
+            return None
+        if np.any(np.abs(v[~revolute] @ normal) > tol):
+            return None
+        return normal
+
+    @property
+    def moves_in_plane(self) -> bool:
+        """Whether the mechanism is planar however it is written (:meth:`plane_normal`)."""
+        return self.plane_normal() is not None
 
     def index(self, joint: str | int) -> int:
         """Index of a joint given by name or index; a clear :class:`SpecError` for an unknown one."""
@@ -253,12 +292,13 @@ class Mechanism:
         optional ``value`` (the joint's reading at the start). The loops are a cycle basis of the body graph
         (fundamental cycles of a breadth-first spanning tree rooted at ``ground``).
         """
-        names, types, twists, offsets, pairs = [], [], [], [], []
+        names, types, twists, offsets, pairs, points = [], [], [], [], [], []
         for j in joints:
             point = np.asarray(j.get("point", (0.0, 0.0, 0.0)), dtype=float)
             direction = np.asarray(j["direction"], dtype=float)
             if point.shape == (2,):
                 point = np.append(point, 0.0)
+            points.append(point)
             if direction.shape == (2,):
                 direction = np.append(direction, 0.0)
             kind = str(j.get("type", "R"))
@@ -280,6 +320,7 @@ class Mechanism:
             joint_bodies=tuple(pairs),
             planar=planar,
             meta=dict(meta or {}),
+            hinge_points=np.array(points).reshape(len(names), 3),
         )
 
     @classmethod
@@ -292,8 +333,10 @@ class Mechanism:
         joint_types: Sequence[str] | None = None,
         *,
         meta: Mapping[str, Any] | None = None,
+        hinge_points: ArrayLike | None = None,
     ) -> Mechanism:
-        """A single closed loop of joints in loop order: link ``i`` lies between joint ``i`` and ``i + 1``."""
+        """A single closed loop of joints in loop order: link ``i`` lies between joint ``i`` and ``i + 1``
+        (``hinge_points``: the point written for each joint, if any)."""
         n = len(joint_names)
         bodies = tuple(f"link{i}" for i in range(n))
         pairs = tuple((bodies[i - 1], bodies[i]) for i in range(n))
@@ -307,6 +350,7 @@ class Mechanism:
             bodies=bodies,
             joint_bodies=pairs,
             meta=dict(meta or {}),
+            hinge_points=np.zeros((0, 3)) if hinge_points is None else np.asarray(hinge_points, dtype=float),
         )
 
 

@@ -140,6 +140,15 @@ def normalized_jacobian(mech: Mechanism, angles: ArrayLike) -> Array:
     return normalized_jacobians(mech, np.asarray(angles, dtype=float)[None])[0]
 
 
+def hinge_centres_along(mech: Mechanism, angles: ArrayLike) -> tuple[Array, Array]:
+    """Centre ``c (N, 3)`` and length scale ``L (N,)`` of the revolute hinge lines at every row of joint values
+    ``angles (N, n)`` (:func:`hinge_centres` of the joint axes in the base frame there): the same physical point
+    whichever body is the base, since the axes there are carried by that body's pose."""
+    values = np.atleast_2d(np.asarray(angles, dtype=float))
+    jac = _full_jacobians(mech, values - mech.offsets)
+    return hinge_centres(_axes(jac, len(mech.loops)), mech.joint_types)
+
+
 def length_scale(mech: Mechanism, angles: ArrayLike | None = None) -> float:
     """The linkage's own length ``L`` (RMS distance of the revolute hinge lines from their centre) at ``angles``.
 

@@ -30,7 +30,8 @@ class Bifurcation:
 
     ``angles`` are the joint values (radians) there, ``tangents`` the branch tangents as unit vectors over the
     joints (one per line through the point) and ``tangents_u`` the same over the unknowns, ``sigma`` the
-    Jacobian's singular values. ``kind`` is ``"bifurcation"`` (an isolated point with two or more branch
+    Jacobian's singular values; ``u`` is the point in the tracer's unknowns (displacements from the reference
+    configuration, one per independent joint). ``kind`` is ``"bifurcation"`` (an isolated point with two or more branch
     tangents), ``"fold"`` (a rank drop with fewer than two real branch tangents: the path touches the singular
     set and no other branch leaves it) or ``"component"`` (where the path meets a higher-dimensional component of
     the configuration space: ``dimension`` is its dimension, the mobility on it; no branch is switched to there).

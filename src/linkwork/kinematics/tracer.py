@@ -99,7 +99,7 @@ def trace(
     periodic = np.array([mech.joint_types[mech.group_members()[g][0]] == "R" for g in range(m)])
     settings = MarchSettings(
         drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=float(np.cos(max_turn)),
-        r_path=r_path, n_sigma=min(jac0.shape), periodic=periodic, lo=lo, hi=hi, tol=tol,
+        r_path=r_path, n_sigma=min(jac0.shape), periodic=periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
     )  # fmt: skip
     marcher = BranchMarcher(
         mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend

@@ -51,7 +51,9 @@ def robustness_dict(result: RobustnessResult, source: str = "") -> dict[str, Any
             "hinge_position": model.position_tol,
             "hinge_direction_deg": float(np.degrees(model.direction_tol)),
             "distribution": model.distribution,
-            "errors": "spatial" if model.spatial or not mech.planar else "in-plane",
+            "meaning": model.meaning,
+            "fraction_beyond": model.fraction_beyond,
+            "errors": "spatial" if model.spatial or not mech.moves_in_plane else "in-plane",
         },
         "scale": {
             "length": setup.scale.length,

@@ -65,16 +65,17 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
 
 
 def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array) -> tuple[Array, Array]:
-    """Per path point: the map ``G_k = N_k^T T B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
+    """Per path point: the map ``G_k = N_k^T T_k B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
     space), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's tangent (the last
-    right singular vector), in which the misfit is minimised."""
+    right singular vector), in which the misfit is minimised. ``T`` is one weight ``(6, 6)`` or one per point
+    ``(K, 6, 6)`` (:func:`linkwork.studies.scale.weights_along`)."""
     K = u_path.shape[0]
     E = mech.n_equations
     m = mech.n_unknowns
     G = np.zeros((K, E, 4 * mech.n_joints))
     normal = np.zeros((K, m, m - 1))
     for k in range(K):
-        J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T)
+        J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T[k] if T.ndim == 3 else T)
         U, sigma, Vt = np.linalg.svd(J, full_matrices=True)
         rank = numerical_rank(sigma)
         normal[k] = Vt[: m - 1].T

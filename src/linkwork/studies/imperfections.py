@@ -1,7 +1,9 @@
 """Manufacturing imperfections of hinge lines: the tolerance model, seeded noise, and the perturbed twists.
 
-Every hinge line of the reference (start) configuration is moved: its direction tilts within a cone of
-half-angle ``direction_tol`` and its position shifts normal to the line by up to ``position_tol``. The imperfect
+Every hinge line of the reference (start) configuration is moved: its direction tilts by about ``direction_tol``,
+about the hinge itself (the point written for it, or the joint point linkwork draws:
+:func:`linkwork.studies.scale.hinge_pivots`), and its position shifts normal to the line by about ``position_tol``
+(a standard deviation per component, or a hard bound: see :class:`ImperfectionModel`). The imperfect
 structure is thus assembled, free of strain, in the start configuration; the misfit measures what it must take up
 as it moves away from there. Four numbers per joint say how: ``(t1, t2, s1, s2)``, the tilt (radians) about and
 the shift (length) along the two unit vectors ``e1, e2`` normal to the line. A planar mechanism gets in-plane
@@ -28,7 +30,7 @@ from numpy.typing import NDArray
 from linkwork.errors import SpecError
 from linkwork.kernel_cache import kernel
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.studies.scale import line_points
+from linkwork.studies.scale import hinge_pivots
 
 Array = NDArray[np.float64]
 
@@ -37,7 +39,13 @@ DISTRIBUTIONS = ("normal", "uniform")
 
 @dataclass(frozen=True)
 class ImperfectionModel:
-    """Hinge tolerances (length units and radians), their distribution and whether errors leave the plane."""
+    """Hinge tolerances (length units and radians), their distribution and whether errors leave the plane.
+
+    What a tolerance means depends on the distribution (:attr:`meaning`): ``normal`` (the default) makes it the
+    standard deviation of each of the two error components normal to the hinge line, so the error's size exceeds
+    it for ``exp(-1/2)``, 61 %, of the hinges (:attr:`fraction_beyond`); ``uniform`` makes it a hard bound, the
+    error uniform in the disc (shift) or cone (tilt) of that radius.
+    """
 
     position_tol: float
     direction_tol: float
@@ -56,6 +64,21 @@ class ImperfectionModel:
                 f"distribution must be one of {', '.join(DISTRIBUTIONS)}, got {self.distribution!r}"
             )
 
+    @property
+    def meaning(self) -> str:
+        """What a tolerance is under this distribution, in one line (robustness.json ``tolerances.meaning``)."""
+        if self.distribution == "uniform":
+            return "hard bound: each hinge's shift is uniform in a disc, its tilt in a cone, of the tolerance's radius"
+        return (
+            "standard deviation of each of the two components normal to the hinge line: a hinge's shift or tilt "
+            "exceeds the tolerance with probability exp(-1/2) = 61 %"
+        )
+
+    @property
+    def fraction_beyond(self) -> float:
+        """The expected fraction of hinges whose shift (or tilt) is larger than its tolerance."""
+        return 0.0 if self.distribution == "uniform" else float(np.exp(-0.5))
+
 
 @dataclass(frozen=True)
 class HingeLines:
@@ -69,7 +92,8 @@ class HingeLines:
 
     @classmethod
     def of(cls, mech: Mechanism, centre: Array) -> HingeLines:
-        """The hinge lines of ``mech`` at its reference, each with the point nearest ``centre``.
+        """The hinge lines of ``mech`` at its reference, each with the point where the hinge physically is
+        (:func:`linkwork.studies.scale.hinge_pivots`): a direction error tilts the hinge about that point.
 
         ``e1`` points from the line towards ``centre`` (along their common normal) and ``e2 = direction x e1``,
         so that errors drawn in this basis do not depend on where the linkage stands or how it is turned; a line
@@ -79,7 +103,7 @@ class HingeLines:
         w = mech.twists[:, :3]
         revolute = np.einsum("ij,ij->i", w, w) > 0.5
         directions = np.where(revolute[:, None], w, mech.twists[:, 3:])
-        points = line_points(mech, centre)
+        points = hinge_pivots(mech)
         radial = np.asarray(centre, dtype=float)[None, :] - points
         radial -= np.einsum("ij,ij->i", radial, directions)[:, None] * directions
         size = np.linalg.norm(radial, axis=1)
@@ -148,13 +172,14 @@ def unit_noise(seeds: np.ndarray, n_joints: int, uniform: bool) -> np.ndarray:
 
 def component_scale(mech: Mechanism, model: ImperfectionModel, lines: HingeLines) -> Array:
     """``(n, 4)`` tolerance per noise component: tilts ``direction_tol``, shifts ``position_tol``; for in-plane
-    errors of a planar mechanism no tilt out of the plane (a revolute axis stays normal to it; a prismatic
-    direction turns only about the plane's normal), and zero shift for a prismatic joint."""
+    errors of a planar mechanism (however it is written: :meth:`Mechanism.plane_normal`) no tilt out of the plane
+    (a revolute axis stays normal to it; a prismatic direction turns only about the plane's normal), and zero
+    shift for a prismatic joint."""
     scale = np.empty((mech.n_joints, 4))
-    in_plane = mech.planar and not model.spatial
+    normal = mech.plane_normal()
     scale[:, :2] = model.direction_tol
-    if in_plane:
-        about_normal = np.abs(np.stack([lines.e1[:, 2], lines.e2[:, 2]], axis=1)) > 0.999
+    if normal is not None and not model.spatial:
+        about_normal = np.abs(np.stack([lines.e1 @ normal, lines.e2 @ normal], axis=1)) > 0.999
         scale[:, :2] = np.where(about_normal & ~lines.revolute[:, None], model.direction_tol, 0.0)
     scale[:, 2:] = np.where(lines.revolute, model.position_tol, 0.0)[:, None]
     return scale

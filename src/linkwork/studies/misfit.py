@@ -5,7 +5,8 @@ at ``k`` is ``min |T r(u)|`` over the unknowns ``u`` in the plane through ``u_k`
 tangent: where the drive parameterises the path this is the drive held, to first order exactly (the Jacobian
 annihilates the tangent, so every plane transverse to it gives the same least residual to first order), and unlike
 holding the drive it stays well posed at a fold of the drive, where the path turns back; ``r`` is the stacked loop logarithm (closure residual, Eq. (23) in twist form) and ``T`` the weight
-of :mod:`linkwork.studies.scale`, so the misfit is a length in the linkage's units. It is solved by Gauss-Newton
+of :mod:`linkwork.studies.scale` at point ``k`` (moments about the centre of the hinge lines there), so the misfit is
+a length in the linkage's units, whichever body is the ground. It is solved by Gauss-Newton
 (normal equations, Cholesky, with backtracking), warm-started along the path from the previous drive value's
 solution shifted by the nominal step. The compiled batch kernel runs many samples and all drive values in one call.
 
@@ -115,7 +116,8 @@ def misfit_along_path(
 
     At point ``k`` the unknowns move in the plane normal to the nominal path, ``u = u_k + Q_k y`` with
     ``normal[k] = Q_k (m, m - 1)`` orthonormal: the drive held wherever it parameterises the path, and still a
-    well-posed problem at a fold of the drive.
+    well-posed problem at a fold of the drive. ``T (K, 6, 6)`` is the weight at every point (its centre moves with
+    the linkage: :func:`linkwork.studies.scale.weights_along`).
     """
     u_path, normal = path
     loop_ptr, rows, groups = mech[3], mech[4], mech[5]
@@ -141,7 +143,7 @@ def misfit_along_path(
         for _ in range(max_iter):
             _on_plane(u_path, normal, k, y, u)
             expand(u, groups, q)
-            closure_pass(mech, q, T, r, J, matrices, vectors)
+            closure_pass(mech, q, T[k], r, J, matrices, vectors)
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
@@ -182,7 +184,7 @@ def misfit_batch(
 ) -> np.ndarray:
     """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path ``path =
     (u_path, normal)``; ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
-    its twists)."""
+    its twists); weights ``T (K, 6, 6)``, one per point."""
     S = twists.shape[0]
     out = np.empty((S, path[0].shape[0]))
     loop_joint, loop_sign, loop_ptr, rows, groups = loops

@@ -33,7 +33,7 @@ from linkwork.studies.imperfections import (
     sample_seeds,
 )
 from linkwork.studies.misfit import misfit_batch
-from linkwork.studies.scale import MisfitScale, misfit_scale
+from linkwork.studies.scale import MisfitScale, misfit_scale, weights_along
 
 Array = NDArray[np.float64]
 
@@ -57,6 +57,7 @@ class RobustnessSetup:
     drive_values: Array
     drive_unknown: int
     normal: Array
+    weights: Array
     G: Array
     ratio_normalised: Array
     keep_tol: float
@@ -65,7 +66,7 @@ class RobustnessSetup:
         """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists: ``(path, loops, weight)``."""
         joint, sign, ptr = self.mech.loop_arrays()
         rows = np.array(self.mech.rows, dtype=np.int64)
-        return (self.u_path, self.normal), (joint, sign, ptr, rows, self.mech.groups), self.scale.weight
+        return (self.u_path, self.normal), (joint, sign, ptr, rows, self.mech.groups), self.weights
 
 
 @dataclass
@@ -102,7 +103,8 @@ def prepare(
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
-    G, normal = sensitivity_maps(mech, u_path, lines, scale.weight)
+    weights = weights_along(mech, trace.angles[first], scale.length)
+    G, normal = sensitivity_maps(mech, u_path, lines, weights)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
@@ -116,6 +118,7 @@ def prepare(
         drive_values=trace.angles[first, drive_joint],
         drive_unknown=drive_unknown,
         normal=normal,
+        weights=weights,
         G=G,
         ratio_normalised=trace.condition()[first],
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,

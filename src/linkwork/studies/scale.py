@@ -32,6 +32,25 @@ class MisfitScale:
     weight: Array
 
 
+def weight(centre: Array, length: float) -> Array:
+    """The 6x6 map ``T (omega, v) = (L omega, v + omega x c)`` of centre ``c`` and length ``L``."""
+    T = np.zeros((6, 6))
+    T[:3, :3] = length * np.eye(3)
+    T[3:, 3:] = np.eye(3)
+    T[3:, :3] = -hat3(np.asarray(centre, dtype=float))  # omega x c = -c x omega
+    return T
+
+
+def weights_along(mech: Mechanism, angles: Array, length: float) -> Array:
+    """``(K, 6, 6)`` the weight at every row of joint values ``angles (K, n)``: moments about the centre of the
+    hinge lines in that configuration (a point that moves with the linkage, so the measure does not depend on
+    which body is held still as the ground), lengths in the linkage's scale ``length`` (from the start)."""
+    from linkwork.kinematics.normalization import hinge_centres_along
+
+    centres, _ = hinge_centres_along(mech, angles)
+    return np.ascontiguousarray(np.array([weight(c, length) for c in centres]).reshape(len(centres), 6, 6))
+
+
 def line_points(mech: Mechanism, centre: Array | None = None) -> Array:
     """``(n, 3)`` one point per hinge line: the point nearest ``centre`` (the origin if not given); prismatic
     joints give ``centre`` itself (their line has no position)."""
@@ -49,18 +68,49 @@ def line_points(mech: Mechanism, centre: Array | None = None) -> Array:
 def misfit_scale(mech: Mechanism) -> MisfitScale:
     """The centre, length scale and weight map of ``mech`` (see the module docstring)."""
     centre, length = centre_and_length(mech)
-    T = np.zeros((6, 6))
-    T[:3, :3] = length * np.eye(3)
-    T[3:, 3:] = np.eye(3)
-    T[3:, :3] = -hat3(centre)  # omega x c = -c x omega
-    return MisfitScale(centre=centre, length=length, weight=T)
+    return MisfitScale(centre=centre, length=length, weight=weight(centre, length))
+
+
+def hinge_pivots(mech: Mechanism) -> Array:
+    """``(n, 3)`` where each hinge physically is, on its line in the reference configuration: the point written
+    for the joint (``mech.hinge_points``) when it lies on the line, else the joint's point as linkwork draws and
+    exports it (:func:`linkwork.kinematics.positions.joint_points`: the feet of the common normals with its
+    neighbours). A prismatic joint's line has no position: its entry is that point too, and is not used."""
+    from linkwork.kinematics.positions import joint_points
+
+    pivots = joint_points(mech)
+    written = np.asarray(mech.hinge_points, dtype=float)
+    if len(written) != mech.n_joints:
+        return pivots
+    w = mech.twists[:, :3]
+    revolute = np.einsum("ij,ij->i", w, w) > 0.5
+    foot = np.cross(w, mech.twists[:, 3:])  # the line's point nearest the origin (v = p x w, |w| = 1)
+    along = np.einsum("ij,ij->i", written - foot, w)
+    off = np.linalg.norm(written - foot - along[:, None] * w, axis=1)
+    size = 1.0 + float(np.abs(written).max(initial=0.0)) + float(np.abs(foot).max(initial=0.0))
+    on_line = revolute & (off <= 1e-9 * size)
+    return np.where(on_line[:, None], foot + along[:, None] * w, pivots)
 
 
 def centre_and_length(mech: Mechanism) -> tuple[Array, float]:
     """The linkage's centre ``c`` and length ``L`` at its reference: those of the project's normalised Jacobian
     (:func:`linkwork.kinematics.normalization.hinge_centre`), so that the misfit and the normalised Sec. 5 ratio
-    share one scale."""
+    share one scale; except where every hinge line passes through ``c`` (a spherical linkage), whose lines have no
+    size: there ``L`` is the root-mean-square distance of the hinges themselves (:func:`hinge_pivots`) from ``c``,
+    so that the misfit is proportional to the linkage's size (1 only when every hinge sits at ``c``)."""
     from linkwork.kinematics.normalization import hinge_centre
 
     centre, length = hinge_centre(mech.twists, mech.joint_types)
-    return np.asarray(centre, dtype=float), float(length)
+    centre = np.asarray(centre, dtype=float)
+    w = mech.twists[:, :3]
+    revolute = np.einsum("ij,ij->i", w, w) > 0.5
+    if not np.any(revolute):
+        return centre, float(length)
+    foot = np.cross(w[revolute], mech.twists[revolute, 3:])
+    to_line = centre - foot
+    to_line -= np.einsum("ij,ij->i", to_line, w[revolute])[:, None] * w[revolute]
+    spread = 1.0 + float(np.abs(foot).max(initial=0.0))
+    if float(np.sqrt(np.mean(np.sum(to_line**2, axis=1)))) > 1e-12 * spread:
+        return centre, float(length)
+    size = float(np.sqrt(np.mean(np.sum((hinge_pivots(mech)[revolute] - centre) ** 2, axis=1))))
+    return centre, size if size > 1e-12 * spread else 1.0

@@ -105,7 +105,7 @@ def _robustness_columns(study: Study, mech: Any, path: Any, row: Row) -> Any:
         settings.position_tol,
         float(np.radians(settings.direction_tol_deg)),
         settings.distribution,
-        spatial=settings.spatial_errors or not mech.planar,
+        spatial=settings.spatial_errors or not mech.moves_in_plane,
     )
     res = robustness(mech, path, model, settings.samples, seed=settings.seed, workers=0)
     row["misfit_p50"] = float(np.median(res.misfit_max))
