@@ -236,7 +236,7 @@ def assert_reaches_every_target(mech: Mechanism, free: Trace, **options: object)
     d = mech.index(free.drive)
     for target in targets_inside(free):
         tr = lw.trace(mech, drive=free.drive, until=(free.drive, target), **options)  # type: ignore[arg-type]
-        assert "unmet" not in tr.stats, f"{mech.name}: {tr.stats.get('unmet')}"
+        assert tr.stats.unmet is None, f"{mech.name}: {tr.stats.unmet}"
         assert tr.branches[0].end_reason == "reached target"
         assert abs(tr.angles[tr.branch == 0, d][-1] - target) <= TARGET_TOL * max(1.0, abs(target))
 
