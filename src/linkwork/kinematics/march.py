@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
-from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_jacobian, expand
+from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand, work_arrays
 from linkwork.kinematics.stops import StopReason
 
 # The stop codes the march returns, as the plain ints numba freezes into the kernels (see StopReason).
@@ -54,16 +54,35 @@ MARCH_ARGUMENTS = {
 
 @kernel()
 def evaluate(mech, u, q, res, jac):
-    """Residual and reduced Jacobian at unknowns ``u`` of ``mech`` (the tuple of
-    :mod:`~linkwork.kinematics.kernels`; ``q``, ``res``, ``jac`` are work arrays)."""
+    """Residual norm, residual and reduced Jacobian at unknowns ``u`` of ``mech`` (the tuple of
+    :mod:`~linkwork.kinematics.kernels`; ``q``, ``res``, ``jac`` are work arrays, ``res`` and ``jac`` the
+    results)."""
+    matrices, vectors = work_arrays()
+    return evaluate_in(mech, u, (q, res, jac, matrices, vectors))
+
+
+@kernel()
+def evaluate_in(mech, u, work):
+    """:func:`evaluate` with every work array given, ``work = (q, res, jac, matrices, vectors)`` (the last two
+    from :func:`~linkwork.kinematics.kernels.work_arrays`): the march allocates them once per call, not once per
+    evaluation (a third of an evaluation's time on a small loop)."""
+    q, res, jac, matrices, vectors = work
     expand(u, mech[5], q)
-    closure_jacobian(mech, q, u.shape[0], res, jac)
+    closure_pass(mech, q, None, res, jac, matrices, vectors)
     return np.sqrt(np.sum(res * res))
 
 
 @kernel()
 def correct(mech, u, held, corrector, q, res, jac):
-    """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
+    """:func:`correct_in` with work arrays of its own beside ``q``, ``res``, ``jac``."""
+    matrices, vectors = work_arrays()
+    return correct_in(mech, u, held, corrector, (q, res, jac, matrices, vectors))
+
+
+@kernel()
+def correct_in(mech, u, held, corrector, work):
+    """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u`` (``work`` as in
+    :func:`evaluate_in`; its ``res`` and ``jac`` are the last evaluation's).
 
     ``corrector`` is ``(tol, exact, roundoff, truncate, max_iter)`` (:data:`CORRECTOR`).
     ``held`` is the unknown kept fixed (-1: none, minimum-norm correction over all unknowns). Returns
@@ -73,11 +92,12 @@ def correct(mech, u, held, corrector, q, res, jac):
     loop.
     """
     tol, exact, roundoff, truncate, max_iter = corrector
+    res, jac = work[1], work[2]
     m = u.shape[0]
     prev = np.inf
     accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
-        r = evaluate(mech, u, q, res, jac)
+        r = evaluate_in(mech, u, work)
         if not np.isfinite(r):
             return False, it, r
         if r < exact:
@@ -307,7 +327,9 @@ def march(mech, start, steps, corrector, bounds, out):
     u_try = np.empty(m)
     h = h0
     # ---- the start: row 0, its tangent oriented along t0
-    r0 = evaluate(mech, u, q, res, jac)
+    matrices, vectors = work_arrays()
+    work = (q, res, jac, matrices, vectors)  # every evaluation's work arrays, allocated once per call
+    r0 = evaluate_in(mech, u, work)
     tau = tangent_and_test(jac, t, basis, r_path, t_new, sig)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
@@ -322,7 +344,7 @@ def march(mech, start, steps, corrector, bounds, out):
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
-        ok, iters, r = correct(mech, u_try, held, corrector, q, res, jac)
+        ok, iters, r = correct_in(mech, u_try, held, corrector, work)
         turn, dist, tau_new = 1.0, 0.0, 0.0
         if ok:
             basis_try[:, :] = basis
