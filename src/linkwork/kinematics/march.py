@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
-from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_jacobian, expand
+from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand, work_arrays
 from linkwork.kinematics.stops import StopReason
 
 # The stop codes the march returns, as the plain ints numba freezes into the kernels (see StopReason).
@@ -54,16 +54,35 @@ MARCH_ARGUMENTS = {
 
 @kernel()
 def evaluate(mech, u, q, res, jac):
-    """Residual and reduced Jacobian at unknowns ``u`` of ``mech`` (the tuple of
-    :mod:`~linkwork.kinematics.kernels`; ``q``, ``res``, ``jac`` are work arrays)."""
+    """Residual norm, residual and reduced Jacobian at unknowns ``u`` of ``mech`` (the tuple of
+    :mod:`~linkwork.kinematics.kernels`; ``q``, ``res``, ``jac`` are work arrays, ``res`` and ``jac`` the
+    results)."""
+    matrices, vectors = work_arrays()
+    return evaluate_in(mech, u, (q, res, jac, matrices, vectors))
+
+
+@kernel()
+def evaluate_in(mech, u, work):
+    """:func:`evaluate` with every work array given, ``work = (q, res, jac, matrices, vectors)`` (the last two
+    from :func:`~linkwork.kinematics.kernels.work_arrays`): the march allocates them once per call, not once per
+    evaluation (a third of an evaluation's time on a small loop)."""
+    q, res, jac, matrices, vectors = work
     expand(u, mech[5], q)
-    closure_jacobian(mech, q, u.shape[0], res, jac)
+    closure_pass(mech, q, None, res, jac, matrices, vectors)
     return np.sqrt(np.sum(res * res))
 
 
 @kernel()
 def correct(mech, u, held, corrector, q, res, jac):
-    """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u``.
+    """:func:`correct_in` with work arrays of its own beside ``q``, ``res``, ``jac``."""
+    matrices, vectors = work_arrays()
+    return correct_in(mech, u, held, corrector, (q, res, jac, matrices, vectors))
+
+
+@kernel()
+def correct_in(mech, u, held, corrector, work):
+    """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u`` (``work`` as in
+    :func:`evaluate_in`; its ``res`` and ``jac`` are the last evaluation's).
 
     ``corrector`` is ``(tol, exact, roundoff, truncate, max_iter)`` (:data:`CORRECTOR`).
     ``held`` is the unknown kept fixed (-1: none, minimum-norm correction over all unknowns). Returns
@@ -73,11 +92,12 @@ def correct(mech, u, held, corrector, q, res, jac):
     loop.
     """
     tol, exact, roundoff, truncate, max_iter = corrector
+    res, jac = work[1], work[2]
     m = u.shape[0]
     prev = np.inf
     accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
-        r = evaluate(mech, u, q, res, jac)
+        r = evaluate_in(mech, u, work)
         if not np.isfinite(r):
             return False, it, r
         if r < exact:
@@ -110,9 +130,10 @@ def correct(mech, u, held, corrector, q, res, jac):
 
 
 @kernel()
-def correct_across(mech, u, t, corrector, q, res, jac):
+def correct_across(mech, u, t, corrector, work):
     """Gauss-Newton for the closure in the hyperplane through the predicted ``u`` normal to the tangent ``t``
-    (pseudo-arclength), in place on ``u``; returns ``(converged, iterations, residual)`` as :func:`correct`.
+    (pseudo-arclength), in place on ``u`` (``work`` as in :func:`evaluate_in`); returns ``(converged,
+    iterations, residual)`` as :func:`correct_in`.
 
     Each step is the truncated-SVD least-squares solution (Eq. (28)) of the closure's Jacobian bordered by
     ``t``: the point it converges to, where the path crosses that hyperplane, does not depend on how the closure
@@ -120,6 +141,7 @@ def correct_across(mech, u, t, corrector, q, res, jac):
     (a minimum-norm correction over all unknowns lands elsewhere on the path for each weighting).
     """
     tol, exact, roundoff, truncate, max_iter = corrector
+    res, jac = work[1], work[2]
     m = u.shape[0]
     E = res.shape[0]
     u0 = u.copy()
@@ -128,7 +150,7 @@ def correct_across(mech, u, t, corrector, q, res, jac):
     prev = np.inf
     accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
-        r = evaluate(mech, u, q, res, jac)
+        r = evaluate_in(mech, u, work)
         if not np.isfinite(r):
             return False, it, r
         if r < exact:
@@ -369,7 +391,9 @@ def march(mech, start, steps, corrector, bounds, out):
     u_try = np.empty(m)
     h = h0
     # ---- the start: row 0, its tangent oriented along t0
-    r0 = evaluate(mech, u, q, res, jac)
+    matrices, vectors = work_arrays()
+    work = (q, res, jac, matrices, vectors)  # every evaluation's work arrays, allocated once per call
+    r0 = evaluate_in(mech, u, work)
     tau = tangent_and_test(jac, t, basis, r_path, t_new, sig)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
@@ -385,9 +409,9 @@ def march(mech, start, steps, corrector, bounds, out):
             return count, TURNING, h
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
-            ok, _, r = correct_across(mech, u_try, t, corrector, q, res, jac)
+            ok, _, r = correct_across(mech, u_try, t, corrector, work)
         else:
-            ok, _, r = correct(mech, u_try, held, corrector, q, res, jac)
+            ok, _, r = correct_in(mech, u_try, held, corrector, work)
         turn, dist, tau_new = 1.0, 0.0, 0.0
         easy = ok and correction(u, t, step, u_try) <= 0.1 * abs(step)
         if ok:
