@@ -102,5 +102,6 @@ def test_quality_factor_is_the_documented_product(seat: tuple) -> None:
         assert design["stroke_factor"] == 1.0  # a slider drives: its guide is as long as it must be
         assert abs(design["min_transmission_deg"] - mu) <= 1e-9
         assert abs(design["link_ratio"] - ratio) <= 1e-9 * ratio
-        expected = math.sin(math.radians(mu)) / ratio * design["stroke_factor"]
+        assert design["shape_factor"] == 1.0  # exact three-profile guidance: on the joined chain's error
+        expected = math.sin(math.radians(mu)) / ratio * design["stroke_factor"] * design["shape_factor"]
         assert abs(design["quality"] - expected) <= 1e-12

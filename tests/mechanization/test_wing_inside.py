@@ -118,7 +118,11 @@ def test_quality_factor_is_the_documented_product(inside: tuple) -> None:
     )  # the crank, deg
     lengths = [d["length"] for d in report["dyads"] if d["type"] == "RR"]
     mu = min(d["transmission_deg"] for d in report["dyads"])
-    expected = math.sin(math.radians(mu)) * min(lengths) / max(lengths) * min(1.0, 180.0 / sweep)
+    # how near the profiles: 1 within 1 % of the size of the joined chain's error, else their ratio
+    slack = 0.01 * report["limits"]["largest_extent"]
+    shape = min(min(1.0, (p["joined_e_max"] + slack) / p["e_max"]) for p in report["profiles"])
+    assert report["quality"]["shape_factor"] == pytest.approx(shape, abs=1e-12)
+    expected = math.sin(math.radians(mu)) * min(lengths) / max(lengths) * min(1.0, 180.0 / sweep) * shape
     assert abs(report["quality"]["quality"] - expected) <= 1e-12
     assert report["designs"][0]["quality"] == report["quality"]["quality"]
 

@@ -47,8 +47,8 @@ BinaryLinks = Annotated[
 GroundRegion = Annotated[
     str | None,
     typer.Option(
-        help="Fixed pivots only in XMIN,YMIN,XMAX,YMAX, in a polygon X1,Y1;X2,Y2;X3,Y3;..., or 'inside' "
-        "every profile (profile units); key ground_region."
+        help="Fixed pivots only in XMIN,YMIN,XMAX,YMAX, in a polygon X1,Y1;X2,Y2;X3,Y3;... (profile units), or "
+        "'inside': every pivot, fixed and moving, and every link inside every profile; key ground_region."
     ),
 ]
 LinkOffset = Annotated[

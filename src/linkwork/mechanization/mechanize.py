@@ -29,6 +29,7 @@ from linkwork.mechanization.options import (
 from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
+    NoPlan,
     Plan,
     plan,
     prismatic_actuator,
@@ -99,11 +100,11 @@ class _Search:
         """Enough designs passed, or the time is up."""
         return self.out_of_time() or len(self.passed) >= self.options.designs
 
-    def unusable(self, line: str) -> None:
+    def unusable(self, line: str, *, near_inside: bool = False) -> None:
         """Record a plan or design that could not be traced (among the closest while nothing was traced; one
-        that says how a link leaves the shape ahead of one that does not)."""
+        that says how a link leaves the shape, ``near_inside``, ahead of one that does not)."""
         self.rejected.append(line)
-        self._closer(-1 if "leaves profile" in line else -2, line)
+        self._closer(-1 if near_inside else -2, line)
 
     def _closer(self, reached: int, line: str) -> None:
         """Keep the :data:`CLOSEST` designs that reached the most profiles (the first found first on a tie)."""
@@ -235,7 +236,10 @@ def mechanize(
             try:
                 pl = plan(chain, root, opts)
             except MechanizationError as exc:
-                state.unusable(f"root {root}, anchors {mode}: {exc}")
+                state.unusable(
+                    f"root {root}, anchors {mode}: {exc}",
+                    near_inside=isinstance(exc, NoPlan) and exc.near_inside,
+                )
                 continue
             _search(chain, pl, opts, label, state)
         if state.passed:  # the designs of one root are compared; other roots only when none passed

@@ -1,8 +1,8 @@
 """How good a verified mechanized design is to build: the quality factor that ranks the designs found.
 
-The quality factor of a design is the product of three numbers between 0 and 1 (1 is best):
+The quality factor of a design is the product of four numbers between 0 and 1 (1 is best):
 
-``Q = sin(mu_min) * (L_min / L_max) * f_stroke``
+``Q = sin(mu_min) * (L_min / L_max) * f_stroke * f_shape``
 
 * ``mu_min``: the smallest transmission angle of the design's binary links over the profiles as traced (the
   angle between a link and the direction its moving pivot is free to move in; 90 degrees is best, 0 a dead
@@ -28,12 +28,12 @@ from linkwork.mechanization.verify import Verification
 
 @dataclass(frozen=True)
 class Quality:
-    """The quality factor of a design and its three parts.
+    """The quality factor of a design and its four parts.
 
     Attributes
     ----------
     factor
-        ``Q``, the product of the three parts (higher is better).
+        ``Q``, the product of the four parts (higher is better).
     min_transmission
         ``mu_min``, radians.
     link_ratio
@@ -42,6 +42,8 @@ class Quality:
         The drive's travel between the first and the last profile: radians (revolute) or a length (prismatic).
     stroke_factor
         ``f_stroke``.
+    shape_factor
+        ``f_shape``.
     """
 
     factor: float
@@ -49,6 +51,7 @@ class Quality:
     link_ratio: float
     stroke: float
     stroke_factor: float
+    shape_factor: float = 1.0
 
     def to_dict(self, drive_type: str) -> dict[str, float | str]:
         """JSON-ready, angles in degrees."""
@@ -59,6 +62,7 @@ class Quality:
             "stroke": math.degrees(self.stroke) if drive_type == "R" else self.stroke,
             "stroke_unit": "deg" if drive_type == "R" else "length",
             "stroke_factor": self.stroke_factor,
+            "shape_factor": self.shape_factor,
         }
 
 
@@ -87,5 +91,14 @@ def quality(design: Design, check: Verification) -> Quality:
         f_stroke = min(1.0, math.pi / stroke) if stroke > 0 else 1.0
     else:  # a slider or the chain's own prismatic joint: its guide is as long as it must be
         f_stroke = 1.0
-    factor = math.sin(max(0.0, mu)) / ratio * f_stroke
-    return Quality(factor, mu, ratio, stroke, f_stroke)
+    slack = SHAPE_SLACK * design.chain.size
+    f_shape = min(
+        (min(1.0, (float(joined) + slack) / s.e_max) if s.e_max > 0 else 1.0)
+        for s, joined in zip(check.states, design.chain.joined_errors, strict=False)
+    )
+    factor = math.sin(max(0.0, mu)) / ratio * f_stroke * f_shape
+    return Quality(factor, mu, ratio, stroke, f_stroke, f_shape)
+
+
+#: ``f_shape`` is 1 while the mechanism keeps within this fraction of the size of the joined chain's error.
+SHAPE_SLACK = 0.01

@@ -46,6 +46,15 @@ POLISHED = 12
 STRUCTURAL_WEIGHT = 5e3
 
 
+class NoPlan(MechanizationError):
+    """No build-up of a root passes the candidate checks; ``near_inside``: the message says how the link that
+    came closest to staying inside the shape leaves it (``ground_region = "inside"``)."""
+
+    def __init__(self, message: str, *, near_inside: bool = False) -> None:
+        self.near_inside = near_inside
+        super().__init__(message)
+
+
 @dataclass(frozen=True)
 class Candidate:
     """A ranked RR dyad for one body: the link, and its score (higher is better)."""
@@ -462,13 +471,15 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
     if pinned_root is None:
         pairs = _root_pairs(chain, root, options)
         if not pairs:
-            raise MechanizationError(
+            leaves = least_leaving(chain, root, None, ["ground"], options)
+            raise NoPlan(
                 f"mechanize: no four-bar guides the root body {root}"
-                + least_leaving(chain, root, None, ["ground"], options)
+                + leaves
                 + "; none through the profiles with its crank turning "
                 f"one way and transmission angles above {math.degrees(options.min_transmission):.0f} deg "
                 f"and links no longer than {_limits(chain, options)} (try another root, a larger ground region, link "
-                "offset or max_link)"
+                "offset or max_link)",
+                near_inside=bool(leaves),
             )
     return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
 
@@ -525,14 +536,16 @@ def _steps(
                 done += [parent, body]
                 deferred.remove(parent)
                 continue
-            raise MechanizationError(
+            leaves = least_leaving(chain, body, None, anchors, options)
+            raise NoPlan(
                 f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it"
-                + least_leaving(chain, body, None, anchors, options)
+                + leaves
                 + ": "
                 f"every candidate pivot leaves the ground region, is longer than {_limits(chain, options)}, has a "
                 "transmission angle below "
                 f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
-                "(try a larger ground region or link offset)"
+                "(try a larger ground region or link offset)",
+                near_inside=bool(leaves),
             )
         cands = body_candidates(chain, body, via, anchors, options)
         if cands:
@@ -541,13 +554,15 @@ def _steps(
         else:
             deferred.append(body)
     if deferred:
-        raise MechanizationError(
+        leaves = least_leaving(chain, deferred[0], None, ["ground"], options)
+        raise NoPlan(
             f"mechanize: no dyad can guide body {deferred[0]} (root {root})"
-            + least_leaving(chain, deferred[0], None, ["ground"], options)
+            + leaves
             + "; it is the last body placed from it "
             f"(outside the ground region, longer than {_limits(chain, options)}, a transmission angle below "
             f"{math.degrees(options.min_transmission):.0f} deg or a change of assembly mode between profiles; try "
-            "a larger ground region, link offset or max_link)"
+            "a larger ground region, link offset or max_link)",
+            near_inside=bool(leaves),
         )
     return steps
 
