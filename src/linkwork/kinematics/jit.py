@@ -207,6 +207,8 @@ def _warm_up() -> None:
     trace(mech, until=(a, start + 0.3), steps=4)
     trace(mech, max_steps=8, max_step=math.radians(5.0))
     trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()
+    planar = resolve_spec("four-bar", {}).mechanism  # the closed-form dyad solver of planar paper-mode traces
+    trace(planar, until=("A", float(planar.offsets[0]) + 0.3), steps=4)
 
 
 def _compile_under_way() -> bool:

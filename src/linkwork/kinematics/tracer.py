@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.kinematics.dyads import closed_form_rows
 from linkwork.kinematics.march import STOP_REASONS
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
@@ -102,6 +103,15 @@ def trace(
     paper = steps is not None
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
     basis0 = np.ascontiguousarray(U0[:, :r_path])
+    if paper and steps is not None and steps <= max_steps:
+        # A planar driver-and-dyads mechanism: the same rows in closed form, unless a singular point is near.
+        rows = closed_form_rows(mech, ws.kernels, d_joint, settings, steps, t_start, basis0)
+        if rows is not None:
+            marcher.rows, marcher.budget = rows, max_steps - steps
+            marcher.branches.append(Branch(0, None, None, 1, steps, STOP_REASONS[1]))
+            if progress is not None:
+                progress(steps, max_steps)
+            return _assemble(mech, d_joint, marcher, tol, started, paper, until)
     # Paper mode keeps the sign: equal drive steps towards a target below the start value are negative.
     n0, reason0 = marcher.run_branch(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
