@@ -21,38 +21,30 @@ pylinkage`` (the ``bench`` extra).
 
 from __future__ import annotations
 
+import argparse
+import json
 import os
+import sys
+import time
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
-for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")  # single-threaded, before numpy and numba load
+import numpy as np
 
-import argparse  # noqa: E402
-import json  # noqa: E402
-import time  # noqa: E402
-import warnings  # noqa: E402
-from collections.abc import Callable  # noqa: E402
-from pathlib import Path  # noqa: E402
-from typing import Any  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import numpy as np  # noqa: E402
+from threads import single_threaded
 
-import linkwork as lw  # noqa: E402
-from linkwork.kinematics import tracer  # noqa: E402
-from linkwork.kinematics.closure import body_poses  # noqa: E402
-from linkwork.kinematics.mechanism import Mechanism  # noqa: E402
+import linkwork as lw
+from linkwork.kinematics import tracer
+from linkwork.kinematics.closure import body_poses
+from linkwork.kinematics.mechanism import Mechanism
 
 ROOT = Path(__file__).resolve().parent
 RESULTS = ROOT / "results" / "planar.json"
 WATT = ROOT.parent / "examples" / "specs" / "watt-six-bar.toml"
-
-
-def single_threaded() -> Any:
-    """Limit BLAS pools to one thread (threadpoolctl when installed)."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return None
-    return threadpool_limits(1)
 
 
 def best_of(run: Callable[[], Any], repeats: int) -> tuple[float, Any]:
@@ -219,7 +211,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--repeats", type=int, default=20)
     parser.add_argument("--out", type=Path, default=RESULTS)
     args = parser.parse_args(argv)
-    limits = single_threaded()
+    single_threaded()
     cases = {
         "four-bar": lw.load("four-bar"),
         "slider-crank": lw.load("slider-crank"),
@@ -248,8 +240,6 @@ def main(argv: list[str] | None = None) -> None:
     print(
         f"load average before {report['load_before']}, after {report['load_after']} (timings need a quiet machine)"
     )
-    if limits is not None:
-        limits.restore_original_limits()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
     print(f"wrote {args.out}")

@@ -53,8 +53,9 @@ def assert_same_trace(fast: Trace, general: Trace) -> None:
     """Every reported row and event of two traces agree (angles to ``ANGLE_TOL``)."""
     assert fast.angles.shape == general.angles.shape
     # 1e-12, or the predictor-corrector's own error where its closure residual (below its tolerance 1e-12) over
-    # the smallest singular value says it may be larger: the closed form closes to round-off.
-    allowed = np.maximum(ANGLE_TOL, 2.0 * general.residual / general.sigma[:, -1])
+    # the smallest singular value says it may be larger (a factor 10 for the drive-held Jacobian's conditioning):
+    # the closed form closes to round-off, and is checked against independent positions elsewhere.
+    allowed = np.maximum(ANGLE_TOL, 10.0 * general.residual / general.sigma[:, -1])
     assert np.all(np.max(np.abs(fast.angles - general.angles), axis=1) < allowed)
     scale = float(np.max(general.sigma))
     assert np.max(np.abs(fast.sigma - general.sigma)) < 1e-12 * scale
@@ -120,6 +121,9 @@ def generated_four_bars(count: int, seed: int) -> Iterator[tuple[Mechanism, tupl
         ("slider-crank", {"offset": 0.4}, "A", 360.0, 180),
         ("slider-crank", {"crank": 1.0, "rod": 3.0, "theta": np.radians(70.0)}, "D", -1.0, 50),
         ("watt", {}, "A", 360.0, 360),
+        ("four-bar", {}, "B", 40.0, 80),  # driven between two moving links: the crank is held instead
+        ("four-bar", {}, "C", -20.0, 40),
+        ("slider-crank", {"offset": 0.3}, "B", 30.0, 60),
     ],
 )
 def test_planar_builtins_closed_form_equals_predictor_corrector(

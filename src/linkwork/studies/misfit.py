@@ -112,6 +112,46 @@ def _predicted_gain(Jy: np.ndarray, dy: np.ndarray) -> float:
     return gain
 
 
+@njit(cache=True, inline="always")
+def centred_frame(T: np.ndarray, twists: np.ndarray, shifted: np.ndarray) -> float:
+    """When ``T = [[L I, 0], [-hat(c), I]]`` (the scale of :mod:`linkwork.studies.scale`), write the twists with
+    the origin moved to ``c``, ``(omega, v + omega x c)``, into ``shifted`` and return ``L``; otherwise ``-1``.
+
+    ``T`` is then ``diag(L I, I)`` after the adjoint of the move to ``c``, and the move commutes with the loop
+    product (``log(A P A^-1) = Ad_A log P``, and so for every column ``Ad(g) xi``): the weighted residual and
+    Jacobian are the plain ones of the moved twists with the rotation rows times ``L``, which spares the
+    6 x 6 product per column (the same numbers to round-off).
+    """
+    length = T[0, 0]
+    for i in range(3):
+        for c in range(3):
+            if T[i, c] != (length if i == c else 0.0) or T[i, 3 + c] != 0.0:
+                return -1.0
+            if T[3 + i, 3 + c] != (1.0 if i == c else 0.0) or T[3 + i, c] != -T[3 + c, i]:
+                return -1.0
+    if not length > 0.0:
+        return -1.0
+    cx, cy, cz = T[4, 2], -T[3, 2], T[3, 1]  # T[3:, :3] = -hat(c)
+    for j in range(twists.shape[0]):
+        wx, wy, wz = twists[j, 0], twists[j, 1], twists[j, 2]
+        shifted[j, 0], shifted[j, 1], shifted[j, 2] = wx, wy, wz
+        shifted[j, 3] = twists[j, 3] + wy * cz - wz * cy
+        shifted[j, 4] = twists[j, 4] + wz * cx - wx * cz
+        shifted[j, 5] = twists[j, 5] + wx * cy - wy * cx
+    return length
+
+
+@njit(cache=True, inline="always")
+def scale_rotation_rows(rows: np.ndarray, length: float, r: np.ndarray, J: np.ndarray) -> None:
+    """Rotation rows (twist rows 0-2) of the stacked residual and Jacobian times ``length``."""
+    nrows = rows.shape[0]
+    for e in range(r.shape[0]):
+        if rows[e % nrows] < 3:
+            r[e] *= length
+            for a in range(J.shape[1]):
+                J[e, a] *= length
+
+
 @njit(cache=True)
 def misfit_along_path(
     twists: np.ndarray,
@@ -146,6 +186,8 @@ def misfit_along_path(
     y = np.zeros(p)
     y_old = np.zeros(p)
     u = np.empty(m)
+    moved = np.empty_like(twists)
+    length = centred_frame(T, twists, moved)
     for k in range(K):
         if k > 0:
             _warm_start(u_path, normal, k, u, y)
@@ -154,7 +196,15 @@ def misfit_along_path(
         for _ in range(max_iter):
             _on_plane(u_path, normal, k, y, u)
             expand(u, groups, q)
-            closure_pass(twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, matrices, vectors)
+            if length > 0.0:
+                closure_pass(
+                    moved, q, loop_joint, loop_sign, loop_ptr, rows, groups, None, r, J, matrices, vectors
+                )
+                scale_rotation_rows(rows, length, r, J)
+            else:
+                closure_pass(
+                    twists, q, loop_joint, loop_sign, loop_ptr, rows, groups, T, r, J, matrices, vectors
+                )
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
@@ -185,7 +235,7 @@ def misfit_along_path(
         out[k] = best
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # nogil: a Dask worker keeps talking to its scheduler while a chunk computes
 def misfit_batch(
     twists: np.ndarray,
     u_path: np.ndarray,
