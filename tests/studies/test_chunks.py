@@ -61,3 +61,18 @@ def testcentred_frame_weighting_equals_the_weighted_closure() -> None:
     assert np.allclose(J, T @ jacobian(mech, q), rtol=0, atol=1e-13)
     T[0, 1] = 1e-3  # not of the scale's form: the kernel keeps the general weight
     assert centred_frame.py_func(T, twists, moved) == -1.0
+
+
+def test_bin_counts_add_up_to_the_full_histogram() -> None:
+    from linkwork.studies import bands
+
+    rng = np.random.default_rng(3)
+    values = 10.0 ** rng.uniform(-9, -2, size=(300, 40))
+    values[:, 0] = 0.0  # exact zeros (the start of a path) and a failed solve
+    values[5, 7] = np.nan
+    full = bands.histogram(values, 0.5)
+    total = np.zeros_like(full)
+    for part in np.array_split(values, 3):
+        bands.BinCounts.of(bands.histogram(part, 0.5)).add_into(total)
+    assert np.array_equal(total, full)
+    assert total.sum() == values.size

@@ -79,8 +79,8 @@ class ChunkResult:
     at_step: NDArray[np.int64]
     mobility_kept: NDArray[np.bool_]
     first_order_max: Array
-    hist: NDArray[np.int64]
-    hist_first: NDArray[np.int64]
+    hist: bands.BinCounts
+    hist_first: bands.BinCounts
     drive_max: Array
 
 
@@ -140,8 +140,8 @@ def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
         at_step=at.astype(np.int64),
         mobility_kept=worst <= setup.keep_tol,
         first_order_max=predicted.max(axis=1),
-        hist=bands.histogram(misfit, setup.scale.length),
-        hist_first=bands.histogram(predicted, setup.scale.length),
+        hist=bands.BinCounts.of(bands.histogram(misfit, setup.scale.length)),
+        hist_first=bands.BinCounts.of(bands.histogram(predicted, setup.scale.length)),
         drive_max=misfit.max(axis=0),
     )
 
@@ -203,8 +203,8 @@ def merge_chunks(
     drive_max = np.zeros(K)
     worst, first, kept = [], [], []
     for res in results:
-        hist += res.hist
-        hist_first += res.hist_first
+        res.hist.add_into(hist)
+        res.hist_first.add_into(hist_first)
         drive_max = np.maximum(drive_max, res.drive_max)
         worst.append(res.misfit_max)
         first.append(res.first_order_max)
