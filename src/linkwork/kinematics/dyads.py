@@ -200,7 +200,8 @@ def closed_form_rows(
     function).
     """
     m = mech.n_unknowns
-    if not isinstance(kernels, types.ModuleType) or settings.target is None or steps < 1:
+    compiled = getattr(kernels, "compiled", isinstance(kernels, types.ModuleType))  # a backend, or the module
+    if not compiled or settings.target is None or steps < 1:
         return None  # plain-Python kernels while numba's cache is cold: the tracer as before
     if settings.r_path != mech.n_equations or m != mech.n_equations + 1:
         return None
