@@ -188,3 +188,24 @@ def test_only_planar_driver_and_dyads_decompose() -> None:
     assert dyad_plan(lw.load("bennett"), 0) is None  # spatial
     assert dyad_plan(lw.load("four-bar").with_couplings([["A", "C"]]), 0) is None  # coupled joints
     assert dyad_plan(lw.load(str(WATT)), 0) is not None  # two dyads
+
+
+def stephenson_six_bar() -> Mechanism:
+    """A Stephenson six-bar built here: ternary ground (A, D, G) and ternary coupler (B, C, E), not joined."""
+    P = {"A": (0.0, 0.0), "B": (0.8, 1.0), "C": (3.0, 2.2), "D": (3.6, 0.0), "E": (2.0, 3.0), "F": (4.2, 4.0),
+         "G": (6.0, 0.5)}  # fmt: skip
+    pairs = {"A": ("ground", "crank"), "B": ("crank", "coupler"), "C": ("coupler", "rocker"),
+             "D": ("rocker", "ground"), "E": ("coupler", "link5"), "F": ("link5", "link6"), "G": ("link6", "ground")}  # fmt: skip
+    joints = [{"name": n, "bodies": pairs[n], "point": P[n], "direction": (0.0, 0.0, 1.0)} for n in P]
+    return Mechanism.from_joints("stephenson", joints, planar=True)
+
+
+def test_stephenson_six_bar_driven_by_its_crank_or_through_a_triad() -> None:
+    """Driven at A the rest is two dyads (closed form); driven at G it is a class-III group (no dyad to place
+    first): the tracer as before. Both equal the predictor-corrector."""
+    mech = stephenson_six_bar()
+    assert dyad_plan(mech, mech.index("A")) is not None and dyad_plan(mech, mech.index("G")) is None
+    for drive, turn, expect in (("A", 60.0, True), ("G", 10.0, False)):
+        fast, general, taken = traced_both_ways(mech, (drive, np.radians(turn)), 60)
+        assert taken == expect
+        assert_same_trace(fast, general)
