@@ -324,13 +324,34 @@ def null_vector(M, beta, t):
 
 
 @njit(cache=True, inline="always")
-def singular_values(M, W, sigma):
+def singular_values(M, W, V, sigma):
     """Singular values (descending) of the triangular factor ``R`` (upper triangle of ``M[:E]``) by one-sided
-    Jacobi rotations (Hestenes): the columns of ``W = R`` are made orthogonal; their norms are the values."""
+    Jacobi rotations (Hestenes): the columns of ``W = R V`` are made orthogonal; their norms are the values.
+
+    ``V`` (orthogonal, updated in place) is the previous point's right singular vectors: along a path they change
+    little, so ``R V`` starts nearly orthogonal and one sweep or two finish it. It is re-orthonormalised first
+    (Gram-Schmidt), so that rounding does not build up over a long path.
+    """
     E = M.shape[1]
+    for c in range(E):
+        for b in range(c):
+            dot = 0.0
+            for a in range(E):
+                dot += V[a, b] * V[a, c]
+            for a in range(E):
+                V[a, c] -= dot * V[a, b]
+        norm = 0.0
+        for a in range(E):
+            norm += V[a, c] * V[a, c]
+        norm = 1.0 / np.sqrt(norm)
+        for a in range(E):
+            V[a, c] *= norm
     for a in range(E):
         for c in range(E):
-            W[a, c] = M[a, c] if c >= a else 0.0
+            acc = 0.0
+            for b in range(a, E):
+                acc += M[a, b] * V[b, c]
+            W[a, c] = acc
     for _sweep in range(60):
         rotated = False
         for p in range(E - 1):
@@ -351,6 +372,9 @@ def singular_values(M, W, sigma):
                     wp, wr = W[a, p], W[a, r]
                     W[a, p] = cos * wp - sin * wr
                     W[a, r] = sin * wp + cos * wr
+                    vp, vr = V[a, p], V[a, r]
+                    V[a, p] = cos * vp - sin * vr
+                    V[a, r] = sin * vp + cos * vr
         if not rotated:
             break
     for c in range(E):
@@ -401,6 +425,7 @@ def closed_form_path(flat, plan, run):
     M = np.empty((m, E))
     beta = np.empty(2 * E)
     W = np.empty((E, E))
+    V = np.eye(E)  # the right singular vectors, carried from point to point
     t = np.empty(m)
     t_prev = t0.copy()
     sig = np.empty(E)
@@ -421,7 +446,7 @@ def closed_form_path(flat, plan, run):
         planar_closure(twists, loop_joint, loop_sign, loop_ptr, groups, q, res, jac)
         det_q = qr_of_transpose(jac, M, beta)
         null_vector(M, beta, t)
-        singular_values(M, W, sig)
+        singular_values(M, W, V, sig)
         dot = 0.0
         for a in range(m):
             dot += t[a] * t_prev[a]
