@@ -37,6 +37,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from baseline_paper import trace_paper
+from threads import single_threaded
 
 from linkwork.kinematics.tracer import trace
 from linkwork.linkages.hedgepeth import deployed_angle, hedgepeth
@@ -334,6 +335,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--quick", action="store_true", help="small sizes only (n <= 100, baseline n <= 20)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="where to write the JSON results")
     args = parser.parse_args(argv)
+    single_threaded()
     sizes = tuple(n for n in SIZES if n <= 100) if args.quick else SIZES
     baseline_sizes = tuple(n for n in BASELINE_SIZES if n <= 20) if args.quick else BASELINE_SIZES
 

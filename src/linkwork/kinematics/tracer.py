@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.kinematics.dyads import closed_form_rows
 from linkwork.kinematics.jit import select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
@@ -107,6 +108,16 @@ def trace(
     paper = steps is not None
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
     basis0 = np.ascontiguousarray(U0[:, :r_path])
+    if paper and steps is not None and steps <= max_steps:
+        # A planar driver-and-dyads mechanism: the same rows in closed form, unless a singular point is near.
+        rows = closed_form_rows(mech, backend, d_joint, settings, steps, t_start, basis0)
+        if rows is not None:
+            marcher.rows, marcher.budget = rows, max_steps - steps
+            end = marcher.end(StopReason.TARGET, StopReason.TARGET.text, rows.u[-1][-1])
+            marcher.branches.append(Branch.ended(0, None, None, 1, steps, end))
+            if progress is not None:
+                progress(steps, max_steps)
+            return _assemble(mech, d_joint, marcher, tol, started, paper, until)
     # Paper mode keeps the sign: equal drive steps towards a target below the start value are negative.
     n0, end0 = marcher.run_branch(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
@@ -300,3 +311,25 @@ def warm_up() -> None:
     trace(mech, until=(a, start + 0.3), steps=4)
     trace(mech, max_steps=8, max_step=math.radians(5.0))
     trace(mech, max_steps=20, limits={a: (start - 1.0, start + 0.05)})  # a limit: the marcher's own correct()
+    planar = _warm_up_four_bar()  # the closed-form dyad solver of planar paper-mode traces
+    trace(planar, until=("A", float(planar.offsets[0]) + 0.3), steps=4)
+
+
+def _warm_up_four_bar() -> Mechanism:
+    """A planar four-bar (ground 2, crank 1, coupler 2.5, rocker 2; crank at 60 deg, open assembly) for
+    :func:`warm_up`: the closed-form dyad solver runs on planar mechanisms only."""
+    theta = np.radians(60.0)
+    b, d = np.array([np.cos(theta), np.sin(theta)]), np.array([2.0, 0.0])
+    gap = float(np.linalg.norm(d - b))
+    e = (d - b) / gap
+    along = (2.5**2 - 2.0**2 + gap**2) / (2.0 * gap)
+    c = b + along * e + np.sqrt(2.5**2 - along**2) * np.array([-e[1], e[0]])
+    th3, th4 = np.arctan2(c[1] - b[1], c[0] - b[0]), np.arctan2(c[1] - d[1], c[0] - d[0])
+    z = (0.0, 0.0, 1.0)
+    joints = [
+        {"name": "A", "bodies": ("ground", "crank"), "point": (0.0, 0.0), "direction": z, "value": theta},
+        {"name": "B", "bodies": ("crank", "coupler"), "point": b, "direction": z, "value": th3 - theta},
+        {"name": "C", "bodies": ("coupler", "rocker"), "point": c, "direction": z, "value": th4 - th3},
+        {"name": "D", "bodies": ("ground", "rocker"), "point": d, "direction": z, "value": th4},
+    ]
+    return Mechanism.from_joints("four-bar", joints, planar=True)

@@ -174,7 +174,7 @@ def misfit_along_path(
         out[k] = best
 
 
-@kernel()
+@kernel(nogil=True)  # nogil: a Dask worker keeps talking to its scheduler while a chunk computes
 def misfit_batch(
     twists: np.ndarray,
     path: tuple[np.ndarray, np.ndarray],

@@ -39,8 +39,9 @@ Array = NDArray[np.float64]
 
 #: Gauss-Newton iterations per drive value at most.
 MAX_ITER = 30
-#: Samples per task unless fewer are asked.
+#: Samples per task at most, and at least (but for the last), unless a chunk size is asked for.
 CHUNK = 2000
+MIN_CHUNK = 100
 
 
 @dataclass(frozen=True)
@@ -79,8 +80,8 @@ class ChunkResult:
     at_step: NDArray[np.int64]
     mobility_kept: NDArray[np.bool_]
     first_order_max: Array
-    hist: NDArray[np.int64]
-    hist_first: NDArray[np.int64]
+    hist: bands.BinCounts
+    hist_first: bands.BinCounts
     drive_max: Array
 
 
@@ -141,8 +142,8 @@ def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
         at_step=at.astype(np.int64),
         mobility_kept=worst <= setup.keep_tol,
         first_order_max=predicted.max(axis=1),
-        hist=bands.histogram(misfit, setup.scale.length),
-        hist_first=bands.histogram(predicted, setup.scale.length),
+        hist=bands.BinCounts.of(bands.histogram(misfit, setup.scale.length)),
+        hist_first=bands.BinCounts.of(bands.histogram(predicted, setup.scale.length)),
         drive_max=misfit.max(axis=0),
     )
 
@@ -155,12 +156,20 @@ def first_order_only(setup: RobustnessSetup, start: int, stop: int) -> Array:
 
 
 def chunk_ranges(samples: int, chunk: int | None = None, workers: int = 1) -> list[tuple[int, int]]:
-    """``(start, stop)`` of every chunk of ``samples``: ``chunk`` samples each, by default enough chunks for four
-    per worker (so that the last ones balance) of 250 to :data:`CHUNK` samples. A sample's numbers never depend
-    on its chunk."""
-    size = chunk or min(CHUNK, max(250, -(-samples // (4 * max(1, workers)))))
-    size = max(1, size)
-    return [(a, min(a + size, samples)) for a in range(0, samples, size)]
+    """``(start, stop)`` of every chunk of ``samples``: ``chunk`` samples each when given; by default guided
+    chunks, each a quarter of the samples left per worker, between :data:`MIN_CHUNK` and :data:`CHUNK`: the first
+    chunks are large (little overhead per sample), the last ones small, so that the workers finish together
+    whatever their speeds (equal chunks of a tenth of a worker's share left one worker idle for up to a chunk at
+    the end). A sample's numbers never depend on its chunk."""
+    if chunk:
+        size = max(1, chunk)
+        return [(a, min(a + size, samples)) for a in range(0, samples, size)]
+    out, start, share = [], 0, 4 * max(1, workers)
+    while start < samples:
+        size = min(CHUNK, max(MIN_CHUNK, -(-(samples - start) // share)))
+        out.append((start, min(start + size, samples)))
+        start += size
+    return out
 
 
 @dataclass
@@ -196,8 +205,8 @@ def merge_chunks(
     drive_max = np.zeros(K)
     worst, first, kept = [], [], []
     for res in results:
-        hist += res.hist
-        hist_first += res.hist_first
+        res.hist.add_into(hist)
+        res.hist_first.add_into(hist_first)
         drive_max = np.maximum(drive_max, res.drive_max)
         worst.append(res.misfit_max)
         first.append(res.first_order_max)

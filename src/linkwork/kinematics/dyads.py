@@ -1,0 +1,238 @@
+"""Planar mechanisms as a driver and a sequence of dyads: the decomposition, and the closed-form paper-mode path.
+
+A planar mechanism whose body graph decomposes into the drive joint (from a body taken as fixed) and dyads (Assur
+groups of class II, RRR, RRP, PRR, PRP and RPR: two bodies and three joints, attached to bodies already placed)
+has closed-form positions at every drive value, as pylinkage and textbooks solve four-bars and slider-cranks. For
+such a mechanism traced in the paper's mode (equal steps of the drive to a target), :func:`closed_form_rows`
+gives the rows the predictor-corrector would record (joint values, singular values of the Jacobian, residual, test
+function, arclength) without iterating, keeping the start's assembly mode; it returns ``None`` wherever the
+predictor-corrector has more to do (near a fold or a bifurcation, a joint limit, a closed path before the target,
+a mechanism that is not of this kind), and the tracer then runs the predictor-corrector as before.
+"""
+
+from __future__ import annotations
+
+import types
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics import dyad_solver
+from linkwork.kinematics.dyad_solver import (
+    CLEAN,
+    N_SETTINGS,
+    PRISMATIC,
+    REVOLUTE,
+    S_DET_BASIS,
+    S_HMAX,
+    S_MIN_DRIVE,
+    S_MIN_MARGIN,
+    S_MIN_RATIO,
+    S_STEP,
+    S_STEPS,
+    S_TARGET,
+)
+from linkwork.kinematics.marcher import MarchSettings, Rows
+from linkwork.kinematics.mechanism import PLANAR_ROWS, Mechanism
+
+Array = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: How far from planar a twist may be (omega off the plane's normal, v off the plane) and still be solved here.
+PLANAR_TOL = 1e-12
+#: A dyad whose assembly mode at the start is this close to its limit (relative) is left to the tracer.
+START_MARGIN = 1e-9
+#: Smallest |drive component| of the unit tangent the closed form keeps: near a fold of the drive the
+#: predictor-corrector's long predictor steps decide what happens, so the tracer takes over there.
+MIN_DRIVE = 0.05
+#: Smallest relative distance of a dyad from its limit (a double root) accepted at a point.
+MIN_MARGIN = 1e-6
+
+
+@dataclass(frozen=True)
+class DyadPlan:
+    """A planar mechanism as a driver and dyads, in the arrays the compiled solver reads.
+
+    ``joint_int (n, 3)``: kind (:data:`~linkwork.kinematics.dyad_solver.REVOLUTE` or ``PRISMATIC``), before and
+    after body; ``joint_geo (n, 3)``: a revolute joint's point and ``omega_z`` (+1 or -1), a prismatic joint's
+    unit direction and 0; ``dyads (k, 7)``: ``j1, j2, j3, K1, B1, B2, K2`` (joint ``j1`` from placed body ``K1``
+    to ``B1``, ``j2`` between ``B1`` and ``B2``, ``j3`` from ``B2`` to placed ``K2``) in solving order; ``modes
+    (k,)`` the sign picking each dyad's assembly mode of the start; ``head``: the drive joint, the body it moves
+    and the number of bodies.
+    """
+
+    joint_int: IntArray
+    joint_geo: Array
+    dyads: IntArray
+    modes: Array
+    head: IntArray
+
+    def arrays(self) -> tuple[IntArray, Array, IntArray, Array, IntArray]:
+        """The plan tuple of :func:`~linkwork.kinematics.dyad_solver.closed_form_path`."""
+        return self.joint_int, self.joint_geo, self.dyads, self.modes, self.head
+
+
+def joint_geometry(mech: Mechanism) -> tuple[IntArray, Array] | None:
+    """``(kinds, geometry)`` of every joint of a mechanism whose twists lie in the plane (``None`` otherwise):
+    a revolute joint's point ``(x, y)`` and ``omega_z``, a prismatic joint's direction ``(x, y)`` and 0."""
+    kinds = np.empty(mech.n_joints, dtype=np.int64)
+    geo = np.zeros((mech.n_joints, 3))
+    for j, (w, v) in enumerate(zip(mech.twists[:, :3], mech.twists[:, 3:], strict=True)):
+        if abs(v[2]) > PLANAR_TOL or abs(w[0]) > PLANAR_TOL or abs(w[1]) > PLANAR_TOL:
+            return None
+        if mech.joint_types[j] == "R":
+            if abs(abs(w[2]) - 1.0) > PLANAR_TOL:
+                return None
+            kinds[j] = REVOLUTE
+            geo[j] = (-v[1] / w[2], v[0] / w[2], w[2])  # v = p x omega for a hinge through p
+        else:
+            if abs(w[2]) > PLANAR_TOL or abs(np.hypot(v[0], v[1]) - 1.0) > PLANAR_TOL:
+                return None
+            kinds[j] = PRISMATIC
+            geo[j] = (v[0], v[1], 0.0)
+    return kinds, geo
+
+
+def dyad_plan(mech: Mechanism, drive: int) -> DyadPlan | None:
+    """The decomposition of ``mech`` into the drive joint ``drive`` and dyads, or ``None`` when it has none.
+
+    The drive joint's first body (the ground when it is one of its bodies) is held fixed; then, repeatedly, a
+    joint between two bodies not yet placed, each joined by exactly one joint to placed bodies, forms a dyad. The
+    mechanism qualifies when this places every body using every joint once, every joint is its own unknown,
+    every twist lies in the plane and no dyad is at its limit at the start.
+    """
+    n = mech.n_joints
+    if not mech.planar or tuple(mech.rows) != PLANAR_ROWS or len(mech.joint_bodies) != n:
+        return None
+    if sorted(mech.groups.tolist()) != list(range(n)):
+        return None  # coupled or fixed joints: not a driver and dyads
+    geometry = joint_geometry(mech)
+    if geometry is None:
+        return None
+    kinds, geo = geometry
+    names = list(mech.bodies) or sorted({b for pair in mech.joint_bodies for b in pair})
+    index = {name: i for i, name in enumerate(names)}
+    ends = [(index[a], index[b]) for a, b in mech.joint_bodies]
+    fixed, driven = ends[drive]
+    if names[driven] == "ground":
+        fixed, driven = driven, fixed
+    placed, used = {fixed, driven}, {drive}
+    dyads: list[tuple[int, ...]] = []
+    while len(placed) < len(names):
+        dyad = _next_dyad(ends, placed, used)
+        if dyad is None:
+            return None
+        dyads.append(dyad)
+        placed |= {dyad[4], dyad[5]}
+        used |= set(dyad[:3])
+    if len(used) != n:
+        return None  # a joint between placed bodies: over-constrained
+    joint_int = np.array([[kinds[j], a, b] for j, (a, b) in enumerate(ends)], dtype=np.int64)
+    modes = [_start_mode(kinds, geo, dyad) for dyad in dyads]
+    if any(mode is None for mode in modes):
+        return None
+    return DyadPlan(
+        joint_int=joint_int,
+        joint_geo=geo,
+        dyads=np.array(dyads, dtype=np.int64).reshape(len(dyads), 7),
+        modes=np.array(modes, dtype=float),
+        head=np.array([drive, driven, len(names)], dtype=np.int64),
+    )
+
+
+def _next_dyad(ends: Sequence[tuple[int, int]], placed: set[int], used: set[int]) -> tuple[int, ...] | None:
+    """A dyad ``(j1, j2, j3, K1, B1, B2, K2)`` attached to ``placed`` bodies through unused joints, if any."""
+    for j2, (b1, b2) in enumerate(ends):
+        if j2 in used or b1 in placed or b2 in placed:
+            continue
+        between = [j for j, e in enumerate(ends) if j not in used and set(e) == {b1, b2}]
+        side1 = [j for j, e in enumerate(ends) if j not in used and b1 in e and (set(e) - {b1}) <= placed]
+        side3 = [j for j, e in enumerate(ends) if j not in used and b2 in e and (set(e) - {b2}) <= placed]
+        if len(between) == 1 and len(side1) == 1 and len(side3) == 1:
+            j1, j3 = side1[0], side3[0]
+            k1 = ends[j1][0] if ends[j1][1] == b1 else ends[j1][1]
+            k2 = ends[j3][0] if ends[j3][1] == b2 else ends[j3][1]
+            return (j1, j2, j3, k1, b1, b2, k2)
+    return None
+
+
+def _start_mode(kinds: IntArray, geo: Array, dyad: tuple[int, ...]) -> float | None:
+    """The sign that picks the start's assembly mode in :func:`~linkwork.kinematics.dyad_solver.place_dyad`
+    (``None``: the dyad is at its limit at the start, or of a kind not solved in closed form)."""
+    j1, j2, j3 = dyad[:3]
+    k1, k2, k3 = kinds[j1], kinds[j2], kinds[j3]
+    p1, p2, p3 = geo[j1, :2], geo[j2, :2], geo[j3, :2]
+    if k2 == REVOLUTE and k1 == REVOLUTE and k3 == REVOLUTE:
+        a, b = p3 - p1, p2 - p1
+        value, size = float(a[0] * b[1] - a[1] * b[0]), float(np.linalg.norm(a) * np.linalg.norm(b))
+    elif k2 == REVOLUTE and k1 == PRISMATIC and k3 == PRISMATIC:
+        return 1.0
+    elif k2 == REVOLUTE:
+        jr, jp = (j1, j3) if k1 == REVOLUTE else (j3, j1)
+        offset = p2 - geo[jr, :2]
+        value, size = float(geo[jp, :2] @ offset), float(np.linalg.norm(offset))
+    elif k1 == REVOLUTE and k3 == REVOLUTE:
+        offset = p3 - p1
+        value, size = float(geo[j2, :2] @ offset), float(np.linalg.norm(offset))
+    else:
+        return None
+    if not abs(value) > START_MARGIN * size:
+        return None
+    return 1.0 if value > 0.0 else -1.0
+
+
+def closed_form_rows(
+    mech: Mechanism,
+    kernels: object,
+    drive: int,
+    settings: MarchSettings,
+    steps: int,
+    t0: Array,
+    basis: Array,
+) -> Rows | None:
+    """The rows of a paper-mode trace (``steps`` equal steps of joint ``drive`` to ``settings.target``) in closed
+    form, or ``None`` when the predictor-corrector must trace it (see the module's docstring).
+
+    ``kernels`` is the tracer's kernel choice (the closed form is compiled only when the tracer's kernels are);
+    ``t0`` the start's tangent and ``basis`` the start's range basis (its determinant orients the march's test
+    function).
+    """
+    m = mech.n_unknowns
+    compiled = getattr(kernels, "compiled", isinstance(kernels, types.ModuleType))  # a backend, or the module
+    if not compiled or settings.target is None or steps < 1:
+        return None  # plain-Python kernels while numba's cache is cold: the tracer as before
+    if settings.r_path != mech.n_equations or m != mech.n_equations + 1:
+        return None
+    plan = dyad_plan(mech, drive)
+    if plan is None:
+        return None
+    run = np.zeros(N_SETTINGS)
+    run[S_STEP] = settings.target / steps
+    run[S_TARGET] = settings.target
+    run[S_STEPS] = steps
+    run[S_HMAX] = settings.max_step
+    run[S_DET_BASIS] = 1.0 if np.linalg.det(basis) >= 0.0 else -1.0
+    run[S_MIN_RATIO] = settings.tol.local_min
+    run[S_MIN_DRIVE] = MIN_DRIVE
+    run[S_MIN_MARGIN] = MIN_MARGIN
+    lj, ls, lp = mech.loop_arrays()
+    flat = (np.ascontiguousarray(mech.twists), lj, ls, lp, np.ascontiguousarray(mech.groups))
+    periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)
+    count, status, u, sigma, res, tau, s = dyad_solver.closed_form_path(
+        flat,
+        plan.arrays(),
+        (run, np.ascontiguousarray(t0, dtype=float), settings.lo, settings.hi, periodic),
+    )
+    if status != CLEAN:
+        return None
+    return Rows(
+        u=[u],
+        sigma=[sigma[:, : settings.n_sigma]],
+        res=[res],
+        tau=[tau],
+        s=[s],
+        branch=[np.zeros(count, dtype=np.int64)],
+        step=[np.arange(count, dtype=np.int64)],
+    )
