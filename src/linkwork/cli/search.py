@@ -10,6 +10,7 @@ from rich.text import Text
 
 from linkwork.cli import options as opt
 from linkwork.cli.common import check_range, check_workers, friendly_errors, progress_bar
+from linkwork.cli.out_folder import file_label, out_help, run_folder
 from linkwork.outputs.staging import check_output_folder, console
 
 MAX_GALLERY = 500
@@ -26,13 +27,17 @@ def search(
     ],
     scheduler: opt.Scheduler = None,
     workers: opt.Workers = None,
-    out: opt.OutFolder = Path("out"),
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help=out_help("search", "rect-frame-search"), show_default=False),
+    ] = None,
     gallery: Annotated[
         int,
         typer.Option(help="How many of the best candidates gallery.html draws (each with a viewer page)."),
     ] = 12,
 ) -> None:
-    """Trace every candidate of a study and judge it: candidates.csv/.parquet, ranked.csv, gallery.html in --out.
+    """Trace every candidate of a study and judge it: candidates.csv/.parquet, ranked.csv, gallery.html in --out
+    (default out/NAME-search/, NAME the study file's name).
 
     Re-running on the same --out continues an interrupted search (its records are in --out/.linkwork-search/).
 
@@ -50,6 +55,8 @@ def search(
     check_workers(workers)
     check_range("--gallery", gallery, 0, MAX_GALLERY, "a number of candidates")
     search_study = load_search(study_file)
+    if out is None:
+        out = run_folder("search", file_label(study_file))
     check_output_folder(out, OUTPUT_NAMES)
     total = search_study.total
     console.print(Text(search_study.study.name, style="bold"), f"search of {total} candidate(s)", sep=": ")
