@@ -36,7 +36,8 @@ def search(
         typer.Option(help="How many of the best candidates gallery.html draws (each with a viewer page)."),
     ] = 12,
 ) -> None:
-    """Trace every candidate of a study and judge it: candidates.csv/.parquet, ranked.csv, gallery.html in --out.
+    """Trace every candidate of a study and judge it: candidates.csv/.parquet, ranked.csv, gallery.html in --out
+    (default out/NAME-search/, NAME the study file's name).
 
     The default --out is out/NAME-search/, NAME the study file's name. Re-running on the same --out continues an interrupted search (its records are in --out/.linkwork-search/).
 

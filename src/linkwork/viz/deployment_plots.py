@@ -43,7 +43,7 @@ def stretch_figure(trace: Trace, deployment: Deployment | None = None) -> Figure
     axes[1].plot([steps[b]], [size[b]], "o", label=f"bundle ratio {dep.bundle_ratio:.3g}")
     axes[1].set_ylabel("size / deployed size (ratio)")
     for ax in axes:
-        ax.set_xlabel("step along branch 0")
+        ax.set_xlabel("step along branch 0 (count)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         for bif in trace.bifurcations:
