@@ -94,24 +94,26 @@ def test_the_mechanism_verified_in_memory_is_the_one_linkwork_trace_reads_from_t
 def test_path_end_reads_every_stop_of_the_tracer() -> None:
     from types import SimpleNamespace
 
-    from linkwork.kinematics.march import STOP_REASONS
+    from linkwork.kinematics.stops import StopReason
     from linkwork.mechanization.verify import path_end
 
-    kinds = {
-        path_end(SimpleNamespace(branches=[SimpleNamespace(end_reason=text)])).kind  # type: ignore[arg-type]
-        for text in STOP_REASONS.values()
-    }
-    # every stop the tracer can report is told apart (the rest, joint limit and no progress, are "other")
-    assert {"target", "turning", "failed", "bifurcation", "budget", "closed"} <= kinds
+    def kind(reason: StopReason, text: str = "whatever the words say") -> str:
+        branch = SimpleNamespace(end_reason=text, end_kind=reason)
+        return path_end(SimpleNamespace(branches=[branch])).kind  # type: ignore[arg-type]
+
+    # every stop the march can report that verification acts on is told apart, from the enum alone
+    assert {kind(r) for r in StopReason} >= {"target", "turning", "failed", "bifurcation", "budget", "closed"}
+    assert (
+        kind(StopReason.TURNING, "reached target") == "turning"
+    )  # the structured end decides, not the words
+    assert kind(StopReason.LIMIT) == "other" and kind(StopReason.NO_PROGRESS) == "other"
 
 
-def test_path_end_prefers_the_structured_end_when_the_tracer_gives_one() -> None:
-    from types import SimpleNamespace
-
+def test_path_end_of_a_real_trace_reads_its_branch() -> None:
+    import linkwork as lw
     from linkwork.mechanization.verify import path_end
 
-    # a structured end (``Branch.end_kind``, a StopReason) decides, whatever the words say
-    branch = SimpleNamespace(end_reason="reached target", end_kind=SimpleNamespace(name="TURNING"))
-    assert path_end(SimpleNamespace(branches=[branch])).kind == "turning"  # type: ignore[arg-type]
-    plain = SimpleNamespace(end_reason="drive turning point", end_kind=None)
-    assert path_end(SimpleNamespace(branches=[plain])).kind == "turning"  # type: ignore[arg-type]
+    mech = lw.load("four-bar")
+    start = float(mech.offsets[0])
+    assert path_end(lw.trace(mech, drive="A", until=("A", start + 0.5))).kind == "target"
+    assert path_end(lw.trace(mech, drive="A", max_steps=3)).kind == "budget"

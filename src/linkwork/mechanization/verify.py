@@ -25,6 +25,7 @@ from linkwork.kinematics.closure import body_poses, closure_residual, jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.normalization import NearMobility, near_mobility
 from linkwork.kinematics.rank import numerical_rank
+from linkwork.kinematics.stops import StopReason
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.tracer import trace
 from linkwork.mechanization.assemble import Design
@@ -120,30 +121,25 @@ class PathEnd:
     text: str
 
 
-#: The tracer's stop reasons (``StopReason`` names, and the words of each) as the verification reads them.
-_END_KINDS = (
-    ("TARGET", "reached target", "target"),
-    ("TURNING", "drive turning point", "turning"),
-    ("FAILED", "corrector failed", "failed"),
-    ("SIGN_CHANGE", "bifurcation", "bifurcation"),
-    ("BUDGET", "step budget", "budget"),
-    ("CLOSED", "closed path", "closed"),
-)
+#: How the verification reads each of the tracer's stop reasons (the rest, a joint limit, no progress, a known
+#: point or a component, are "other").
+_END_KINDS = {
+    StopReason.TARGET: "target",
+    StopReason.TURNING: "turning",
+    StopReason.FAILED: "failed",
+    StopReason.SIGN_CHANGE: "bifurcation",
+    StopReason.BUDGET: "budget",
+    StopReason.CLOSED: "closed",
+}
 
 
 def path_end(path: Trace) -> PathEnd:
-    """How the first branch of ``path`` ended: the ONE place mechanization reads a tracer's end reason.
-
-    The structured end (``Branch.end_kind``, a ``StopReason``) when the tracer gives one, else the words of
-    ``Branch.end_reason``.
-    """
+    """How the first branch of ``path`` ended, from its structured end (``Branch.end_kind``, a
+    :class:`~linkwork.kinematics.stops.StopReason`): the one place mechanization reads a tracer's end; the
+    branch's sentence is kept for people."""
     branch = path.branches[0]
-    text = branch.end_reason
-    structured = getattr(branch, "end_kind", None)
-    for name, words, kind in _END_KINDS:
-        if (getattr(structured, "name", None) == name) if structured is not None else text.startswith(words):
-            return PathEnd(kind, text)
-    return PathEnd("other", text)
+    kind = "other" if branch.end_kind is None else _END_KINDS.get(branch.end_kind, "other")
+    return PathEnd(kind, branch.end_reason)
 
 
 def chain_displacements(design: Design, mech: Mechanism, values: Array) -> dict[str, Array]:
