@@ -169,8 +169,8 @@ def _mechanism_traced(folder: Path, output: str) -> None:
     assert abs(d1a[-1] - 24.33117) < 1e-6
 
 
-def _inside_short_links(folder: Path, output: str) -> None:
-    report = json.loads((folder / "out" / "wing-inside" / "mechanization.json").read_text())
+def _short_links(folder: Path, output: str) -> None:
+    report = json.loads((folder / "out" / "wing-short" / "mechanization.json").read_text())
     links = report.get("dyads") or report.get("binary_links") or []
     assert links and all(link["length"] <= 1.0 + 1e-9 for link in links)  # the cruise profile's chord is 1
 
@@ -192,6 +192,32 @@ def _sweep(folder: Path, output: str) -> None:
     assert all(not row.get("error") for row in table)
 
 
+def _search(folder: Path, output: str) -> None:
+    study = tomllib.loads((folder / "examples" / "studies" / "rect-frame-search.toml").read_text())
+    out = folder / "out" / "rect-frame-search"
+    with open(out / "candidates.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    assert len(table) == math.prod(len(v) for v in study["grid"].values())  # one row per candidate
+    limits = study["criteria"]
+    with open(out / "ranked.csv", newline="") as fh:
+        ranked = list(csv.DictReader(fh))
+    assert ranked  # some frames deploy with one degree of freedom and no bifurcation
+    for row in ranked:  # every ranked frame meets the study's criteria as written in the file
+        assert row["mobility_start"] == row["mobility_max"] == str(limits["mobility"])
+        assert int(row["bifurcations_on_path"]) <= limits["max_bifurcations"]
+        assert float(row["membrane_stretch"]) <= limits["max_membrane_stretch"]
+        assert float(row["bundle_ratio"]) <= limits["max_bundle_ratio"]
+        assert f"viewers/candidate-{int(row['index']):05d}.html" in (out / "gallery.html").read_text()
+    guest = [r for r in table if r["cuts"] == "EW" and r["faces"] == "auto"]
+    assert guest and all(r["mobility_max"] == "2" and r["passes"] == "False" for r in guest)  # G&P Sec. 6
+
+
+def _compiled(folder: Path, output: str) -> None:
+    from linkwork.kernel_cache import CACHE, GROUPS
+
+    assert all(CACHE.ready(group) for group in GROUPS)  # the marker lists every group of kernels as compiled
+
+
 #: README command pattern -> the check of what its comment (or the sentence after it) says it shows.
 CLAIMS: dict[str, Check] = {
     r"^linkwork linkages$": _linkages,
@@ -208,7 +234,9 @@ CLAIMS: dict[str, Check] = {
     r"^linkwork synth wing$": _wing,
     r"^linkwork synth wing/mechanize\.toml": _mechanized,
     r"^linkwork trace out/wing-mech/mechanism\.toml": _mechanism_traced,
-    r"^linkwork mechanize out/wing-mech .*-o out/wing-inside$": _inside_short_links,
+    r"^linkwork mechanize out/wing-mech .*-o out/wing-short$": _short_links,
+    r"^linkwork search examples/studies/rect-frame-search\.toml -o out/rect-frame-search$": _search,
+    r"^linkwork compile$": _compiled,
     r"^linkwork robustness hedgepeth-rods": _robustness,
     r"^linkwork sweep examples/studies/bennett-twists\.toml$": _sweep,
 }
