@@ -31,38 +31,6 @@ def test_a_given_chunk_size_is_kept() -> None:
     assert chunk_ranges(10, 3) == [(0, 3), (3, 6), (6, 9), (9, 10)]
 
 
-def testcentred_frame_weighting_equals_the_weighted_closure() -> None:
-    """``T r`` and ``T J`` from the twists moved to the centre, rotation rows times L, against the 6 x 6 weight
-    applied to the plain closure of :mod:`linkwork.kinematics.closure` (numpy), on random spatial twists."""
-    from linkwork.geometry import hat3
-    from linkwork.kinematics.closure import closure_residual, jacobian
-    from linkwork.kinematics.kernels import closure_pass, work_arrays
-    from linkwork.kinematics.mechanism import Mechanism
-    from linkwork.studies.misfit import centred_frame, scale_rotation_rows
-
-    rng = np.random.default_rng(7)
-    n = 6
-    w = rng.normal(size=(n, 3))
-    w /= np.linalg.norm(w, axis=1, keepdims=True)
-    twists = np.hstack([w, np.cross(rng.normal(size=(n, 3)), w)])
-    mech = Mechanism.single_loop("random", [f"J{i}" for i in range(n)], twists)
-    centre, length = rng.normal(size=3), 0.7
-    T = np.zeros((6, 6))
-    T[:3, :3], T[3:, 3:], T[3:, :3] = length * np.eye(3), np.eye(3), -hat3(centre)
-    q = rng.normal(scale=0.3, size=n)
-    moved = np.empty_like(twists)
-    assert centred_frame.py_func(T, twists, moved) == length
-    joint, sign, ptr = mech.loop_arrays()
-    rows, groups = np.arange(6), np.arange(n)
-    r, J = np.empty(6), np.empty((6, n))
-    closure_pass.py_func(moved, q, joint, sign, ptr, rows, groups, None, r, J, *work_arrays.py_func())
-    scale_rotation_rows.py_func(rows, length, r, J)
-    assert np.allclose(r, T @ closure_residual(mech, q), rtol=0, atol=1e-13)
-    assert np.allclose(J, T @ jacobian(mech, q), rtol=0, atol=1e-13)
-    T[0, 1] = 1e-3  # not of the scale's form: the kernel keeps the general weight
-    assert centred_frame.py_func(T, twists, moved) == -1.0
-
-
 def test_bin_counts_add_up_to_the_full_histogram() -> None:
     from linkwork.studies import bands
 

@@ -20,15 +20,15 @@ def test_misfit_is_the_least_residual_in_the_normal_plane() -> None:
     setup = prepare(mech, path, ImperfectionModel(1e-3, np.radians(0.05)), seed=4)
     errors = hinge_errors(sample_seeds(4, 0, 2), setup.mech, setup.model, setup.lines)
     twists = perturbed_twists(errors, setup.lines)
-    u_path, normal, *rest = setup.kernel_args()
-    T = setup.scale.weight
-    misfit = misfit_batch(twists, u_path, normal, *rest, MAX_ITER)
+    path_args, loops, weights = setup.kernel_args()
+    u_path, normal = path_args
+    misfit = misfit_batch(twists, path_args, loops, weights, MAX_ITER)
     for s in range(len(twists)):
         imperfect = lw.Mechanism.single_loop("imperfect", mech.joint_names, twists[s])
         for k in (1, 2, 3, 30, 59):
 
             def weighted(y: np.ndarray, k: int = k, m: lw.Mechanism = imperfect) -> np.ndarray:
-                return T @ closure_residual(m, u_path[k] + normal[k] @ y)
+                return weights[k] @ closure_residual(m, u_path[k] + normal[k] @ y)
 
             best = least_squares(
                 weighted, np.zeros(normal.shape[2]), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15
