@@ -67,10 +67,12 @@ def robustness(
     """Imperfection sensitivity: robustness.json, samples.parquet and figures in --out."""
     import numpy as np
 
+    from linkwork.studies.engine import RunStatus, scheduler_address
     from linkwork.studies.imperfections import ImperfectionModel
     from linkwork.studies.robustness import nominal_ratio, prepare
 
     _check_counts(samples, seed, workers)
+    scheduler_address(scheduler)  # a malformed address is bad input, found before any work
     if steps is not None and until is None:
         raise fail("--steps needs --until JOINT=VALUE")
     target = parse_until(until)
@@ -95,6 +97,7 @@ def robustness(
         run_and_write_robustness,
     )
 
+    status = RunStatus()
     with progress_bar("samples", samples, fraction=True) as report:
         result, figures = run_and_write_robustness(
             setup,
@@ -103,22 +106,30 @@ def robustness(
             out,
             source=spec,
             plots=not no_plots,
-            engine={"scheduler": scheduler, "workers": workers},
+            engine={"scheduler": scheduler, "workers": workers, "status": status},
             progress=report,
         )
     print_robustness_summary(robustness_dict(result, spec))
     written = ["robustness.json", "samples.parquet", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
+    if not status.complete:
+        raise fail(
+            f"{status.stopped}; {result.samples} of {samples} samples computed and written (robustness.json says "
+            '"complete": false)',
+            code=status.code,
+        )
     if target is not None:
         _check_reached(mech, nominal, float(setup.drive_values[-1]), target)
 
 
 def _check_counts(samples: int, seed: int, workers: int | None) -> None:
-    """Refuse a study of no samples, a negative seed or a negative number of workers."""
-    if samples < 1:
-        raise fail(f"--samples {samples}: expected at least 1")
-    if seed < 0:
-        raise fail(f"--seed {seed}: expected a non-negative whole number")
+    """Refuse a study of no samples, a negative seed or a number of workers the machine does not have (the
+    flags are checked as they are parsed, see cli/options.py; this repeats it for a direct call)."""
+    from linkwork.limits import SAMPLES, SEED
+
+    for flag, value, limit in (("--samples", samples, SAMPLES), ("--seed", seed, SEED)):
+        if limit.broken(value):
+            raise fail(f"{flag} {value}: expected {limit.expected(flag)}")
     check_workers(workers)
 
 
