@@ -1,0 +1,164 @@
+"""The fuzz suite generated from the command definitions (issue 19 item 6): every parameter of every command gets
+hostile values (see cli_cases.py), each run in-process through the app, and every run must keep the promises:
+exit code 0, 2 or 3; no traceback; a failure is one ``error:`` line; --out unchanged on exit 2 and nothing outside
+it changed (fuzzkit.run_cli); no user file replaced; no non-finite number in an output; a bounded time per case;
+a value that must be refused before any work is refused (exit 2).
+
+CI runs a fixed, seeded sample (``LINKWORK_FUZZ_CASES``, default 40, with every command in it); run every case
+with ``LINKWORK_FUZZ=full python -m pytest tests/fuzz/test_generated_cli.py``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import re
+import signal
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from types import FrameType
+
+import pytest
+from cli_cases import (
+    SLOW,
+    Case,
+    cases,
+    command_line,
+    commands,
+    parameters,
+    restore_permissions,
+    sample,
+    valid,
+)
+from fuzzkit import run_cli
+from typer.testing import CliRunner
+
+from linkwork.cli import app
+
+#: Seconds one case may take (a loaded machine; the slowest valid run, a 1-second mechanization, takes ~10).
+CASE_SECONDS = 180
+
+#: Cases that fail in areas another part of issue 19 owns: turned on when that part is merged.
+XFAIL: dict[str, str] = {}
+
+STUDY = 'linkage = "bennett"\n[trace]\nuntil = "A=90"\nsteps = 5\n[grid]\nalpha1 = [30, 40]\n'
+
+
+def _real_runs() -> dict[str, Path]:
+    """Folders written by real runs (a trace, a synthesis) and a study file, made once per test session."""
+    home = Path(tempfile.mkdtemp(prefix="linkwork-fuzz-"))
+    runner = CliRunner()
+    trace, synth = home / "trace", home / "synth"
+    for args in (
+        ["trace", "bennett", "--max-steps", "40", "--no-plots", "-o", str(trace)],
+        ["synth", "wing", "--no-plots", "-o", str(synth)],
+    ):
+        result = runner.invoke(app, args)
+        assert result.exit_code == 0, (args, result.stderr)
+    study = home / "study.toml"
+    study.write_text(STUDY, encoding="utf-8")
+    return {"trace": trace, "synth": synth, "study": study}
+
+
+FIXTURES = _real_runs()
+FOLDER_FILES = {
+    token: sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
+    for token, folder in FIXTURES.items()
+    if folder.is_dir()
+}
+ALL = cases(FOLDER_FILES)
+FULL = os.environ.get("LINKWORK_FUZZ", "").lower() == "full"
+CHOSEN = ALL if FULL else sample(ALL, int(os.environ.get("LINKWORK_FUZZ_CASES", "40")))
+
+
+def test_the_generator_covers_every_command_and_parameter() -> None:
+    """A new command or flag is fuzzed without anyone writing its cases: every parameter of every command of
+    the app has generated cases, every required parameter a valid value, every numeric flag declared bounds."""
+    params = parameters()
+    assert {p.command for p in params} <= set(commands()) and len(commands()) >= 11
+    fuzzed = {(c.command, c.target) for c in ALL}
+    for param in params:
+        # a slow command (the demo) gets only the cases refused before any work
+        assert (param.command, param.key) in fuzzed or param.command in SLOW, param
+        if param.required:
+            assert valid(param) is not None, f"add a valid value of {param.key} to cli_cases.VALID"
+        if param.kind in ("int", "float"):
+            assert param.limit is not None, f"declare the bounds of {param.key} in cli/options.py FLAG_LIMITS"
+    assert {c.command for c in CHOSEN} == set(commands())  # the CI sample runs every command
+
+
+@pytest.fixture
+def home(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    monkeypatch.chdir(tmp_path)
+    yield tmp_path
+    restore_permissions(tmp_path)
+
+
+class CaseTimeout(Exception):
+    """A case ran longer than CASE_SECONDS."""
+
+
+def _alarm(signum: int, frame: FrameType | None) -> None:
+    raise CaseTimeout(f"a case took longer than {CASE_SECONDS} s")
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        pytest.param(c, id=c.id, marks=pytest.mark.xfail(reason=XFAIL[c.id], strict=False))
+        if c.id in XFAIL
+        else pytest.param(c, id=c.id)
+        for c in CHOSEN
+    ],
+)
+def test_a_generated_hostile_case_keeps_every_promise(home: Path, case: Case) -> None:
+    args, out = command_line(case, home, FIXTURES)
+    if any(a.startswith(f"{out}/") for a in args) and not out.exists():
+        out.mkdir()  # a single-file output goes into a folder of the test's own
+    notes = out / "notes.txt"
+    before_notes = notes.read_bytes() if notes.is_file() and not out.is_symlink() else None
+    previous = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(CASE_SECONDS)
+    try:
+        run = run_cli(args, out=out, home=home)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    if case.refused_before_work:
+        assert run.code == 2, (case.id, run)
+    if before_notes is not None:
+        assert notes.read_bytes() == before_notes, "a user's file in --out was replaced"
+    if (home / "elsewhere" / "notes.txt").exists():
+        assert (home / "elsewhere" / "notes.txt").read_text() == "keep\n"
+    if run.code in (0, 3):
+        for file in _outputs(out):
+            assert_finite(file)
+
+
+def _outputs(out: Path) -> list[Path]:
+    if out.is_symlink() or not out.exists():
+        return []
+    return [p for p in out.rglob("*") if p.is_file() and not p.is_symlink()]
+
+
+NONFINITE = re.compile(r"(?<![A-Za-z_])[-+]?(nan|inf|infinity)(?![A-Za-z_])", re.IGNORECASE)
+
+
+def assert_finite(file: Path) -> None:
+    """No NaN or infinity in a written file (JSON parsed strictly, CSV cell by cell, text formats by token)."""
+    if file.suffix == ".json":
+
+        def refuse(token: str) -> None:
+            raise AssertionError(f"{file.name}: non-finite {token}")
+
+        json.loads(file.read_text(encoding="utf-8"), parse_constant=refuse)
+    elif file.suffix == ".csv":
+        with file.open(encoding="utf-8", newline="") as fh:
+            for row in csv.reader(fh):
+                for cell in row:
+                    assert cell.strip().lower() not in ("nan", "inf", "-inf", "+inf"), (file.name, row)
+    elif file.suffix in (".stl", ".dxf", ".dat"):
+        text = file.read_bytes().decode("utf-8", errors="replace")
+        assert not NONFINITE.search(text), file.name
