@@ -23,6 +23,10 @@ MAX_SAMPLES = 10_000_000
 MAX_STUDY_SAMPLES = 100_000_000
 """The most Monte Carlo samples of a whole sweep: grid points times ``robustness.samples``."""
 
+MAX_PATH_POINTS = 10_000
+"""The most points of a robustness study's nominal path: every chunk in flight keeps two histograms of about
+1,900 counts per path point (about 30 kB per point), so a longer path would need gigabytes."""
+
 MAX_SEED = 2**63 - 1
 """The largest seed (the largest whole number a TOML file can hold)."""
 

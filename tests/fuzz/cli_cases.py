@@ -172,7 +172,8 @@ def _numbers(param: Param) -> list[str]:
     if param.limit is not None:
         low, high = param.limit.low, param.limit.upper
         step = 1 if param.limit.whole else abs(high - low) * 1e-9 or 1e-9
-        values += [repr(low - step), repr(high + step), repr(low), repr(high)]
+        # just outside both ends, and the low end itself (the high end is valid and can be hours of work)
+        values += [repr(low - step), repr(high + step), repr(low)]
     return values
 
 

@@ -16,6 +16,7 @@ import os
 import re
 import signal
 import tempfile
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
@@ -36,9 +37,10 @@ from fuzzkit import run_cli
 from typer.testing import CliRunner
 
 from linkwork.cli import app
+from linkwork.errors import SpecError
 
 #: Seconds one case may take (a loaded machine; the slowest valid run, a 1-second mechanization, takes ~10).
-CASE_SECONDS = 180
+CASE_SECONDS = int(os.environ.get("LINKWORK_FUZZ_CASE_SECONDS", "180"))
 
 #: Cases that fail in areas another part of issue 19 owns: turned on when that part is merged.
 XFAIL: dict[str, str] = {}
@@ -162,3 +164,71 @@ def assert_finite(file: Path) -> None:
     elif file.suffix in (".stl", ".dxf", ".dat"):
         text = file.read_bytes().decode("utf-8", errors="replace")
         assert not NONFINITE.search(text), file.name
+
+
+# ------------------------------------------------------------------------- study keys, from their bounds
+
+#: Hostile TOML values of a numeric key: wrong types, non-finite, huge, negative, zero, just outside.
+TOML_VALUES = ['"x"', "[1, 2]", "true", "{ a = 1 }", "nan", "inf", "-inf", "-1", "0", "1e300", "1.5",
+               "9223372036854775807"]  # fmt: skip
+
+
+def study_text(key: str, value: str) -> str:
+    """A valid linkage study with ``key`` (a key path) set to ``value`` (TOML text)."""
+    sections = {
+        "": 'linkage = "bennett"\n',
+        "trace": 'until = "A=90"\nsteps = 5\n',
+        "grid": "alpha1 = [30, 40]\n",
+        "robustness": "samples = 3\nhinge_position_tol = 0.001\nhinge_direction_tol = 0.05\n",
+    }
+    table, _, name = key.rpartition(".")
+    body = re.sub(rf"^{name} = .*\n", "", sections[table], flags=re.MULTILINE)
+    sections[table] = body + f"{name} = {value}\n"
+    return sections[""] + "".join(f"[{t}]\n{b}" for t, b in sections.items() if t)
+
+
+def _study_cases() -> list[tuple[str, str, str]]:
+    """``(key path, value, study text)`` for every numeric key of a study file (from its declared bounds) and
+    every hostile value."""
+    from linkwork.studies.study_file import KEY_LIMITS, SYNTHESIS_GRID_LIMITS
+
+    out = []
+    for key, limit in KEY_LIMITS.items():
+        edges = [repr(limit.low), repr(limit.upper), str(int(limit.low) - 1), str(int(limit.upper) + 1)]
+        for value in TOML_VALUES + edges:
+            out.append((key, value, study_text(key, value)))
+    for key, limit in SYNTHESIS_GRID_LIMITS.items():
+        for value in [*TOML_VALUES, repr(limit.low), repr(limit.upper)]:
+            out.append((f"grid.{key}[0]", value, f'problem = "seat"\n[grid]\n{key} = [{value}]\n'))
+    return out
+
+
+@pytest.mark.parametrize(("key", "value", "text"), _study_cases(), ids=lambda x: str(x)[:30])
+def test_a_hostile_study_key_is_refused_before_any_work(home: Path, key: str, value: str, text: str) -> None:
+    """Every numeric key of a study file: a value outside its declared bounds, or of the wrong type, is refused
+    before any point runs, in one line naming the file and the key (exit 2); one inside is read."""
+    import tomllib
+
+    from linkwork.studies.study_file import KEY_LIMITS, SYNTHESIS_GRID_LIMITS, load_study
+
+    study = home / "study.toml"
+    study.write_text(text, encoding="utf-8")
+    parsed = tomllib.loads(text)
+    name = key.split("[")[0]
+    limit = KEY_LIMITS.get(name) or SYNTHESIS_GRID_LIMITS[name.removeprefix("grid.")]
+    node: object = parsed
+    for part in name.split("."):
+        node = node[part]  # type: ignore[index]
+    given = node[0] if name.startswith("grid.") else node  # type: ignore[index]
+    if not limit.broken(given):
+        assert load_study(study).count() >= 1
+        return
+    with pytest.raises(SpecError) as refused:
+        load_study(study)
+    assert f"study.toml: {key}: expected " in str(refused.value) and "\n" not in str(refused.value)
+    if FULL or zlib.crc32(f"{key}{value}".encode()) % 8 == 0:  # the command line too, for a fixed eighth
+        out = home / "out"
+        run = run_cli(
+            ["sweep", str(study), "--workers", "0", "--no-plots", "-o", str(out)], out=out, home=home
+        )
+        assert run.code == 2 and str(refused.value) in run.stderr, run

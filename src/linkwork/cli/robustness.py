@@ -67,6 +67,7 @@ def robustness(
     """Imperfection sensitivity: robustness.json, samples.parquet and figures in --out."""
     import numpy as np
 
+    from linkwork.limits import MAX_PATH_POINTS
     from linkwork.studies.engine import RunStatus, scheduler_address
     from linkwork.studies.imperfections import ImperfectionModel
     from linkwork.studies.robustness import nominal_ratio, prepare
@@ -75,6 +76,11 @@ def robustness(
     scheduler_address(scheduler)  # a malformed address is bad input, found before any work
     if steps is not None and until is None:
         raise fail("--steps needs --until JOINT=VALUE")
+    if steps is not None and steps + 1 > MAX_PATH_POINTS:
+        raise fail(
+            f"--steps {steps}: expected at most {MAX_PATH_POINTS - 1} for a robustness study (the nominal path's "
+            "points each keep per-point histograms in memory)"
+        )
     target = parse_until(until)
     mech = _mechanism(spec, set_, couple, fixed)
     model = ImperfectionModel(

@@ -20,6 +20,7 @@ from linkwork.deprecation import trace_keyword
 from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
+from linkwork.limits import MAX_PATH_POINTS
 from linkwork.progress import Progress
 from linkwork.studies import bands
 from linkwork.studies.engine import RunStatus, default_workers, map_chunks
@@ -98,6 +99,12 @@ def prepare(
     u_path = np.ascontiguousarray(mech.u_from_q(q))
     if u_path.shape[0] < 1:
         raise SpecError("the nominal path has no points")
+    if u_path.shape[0] > MAX_PATH_POINTS:
+        raise SpecError(
+            f"the nominal path has {u_path.shape[0]} points; expected at most {MAX_PATH_POINTS} (memory: about "
+            f"{16 * bands.N_BINS // 1000} kB per point for every chunk in flight); give fewer --steps or a "
+            "shorter --until"
+        )
     drive_joint = mech.index(trace.drive)
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)

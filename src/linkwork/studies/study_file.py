@@ -357,6 +357,12 @@ def load_study(path: str | Path) -> Study:
         if grid:
             raise reader.error("grid", "a spec file has no parameters to vary; use a built-in linkage")
     robustness = _robustness(reader, table["robustness"]) if "robustness" in table else None
+    if robustness is not None and steps is not None and steps + 1 > limits.MAX_PATH_POINTS:
+        raise reader.error(
+            "trace.steps",
+            f"expected at most {limits.MAX_PATH_POINTS - 1} with [robustness] (the nominal path's points each keep "
+            f"per-point histograms in memory), got {steps}",
+        )
     study = Study(
         kind="linkage",
         name=name,
