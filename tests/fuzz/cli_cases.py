@@ -188,7 +188,8 @@ class Case:
 
     @property
     def id(self) -> str:
-        shown = self.value.encode("unicode_escape").decode()[:24]
+        shown = self.value.encode("unicode_escape").decode()
+        shown = shown if self.value.startswith("@") else shown[:24]
         return f"{' '.join(self.command)}|{self.target}|{shown}"
 
 

@@ -42,8 +42,22 @@ from linkwork.errors import SpecError
 #: Seconds one case may take (a loaded machine; the slowest valid run, a 1-second mechanization, takes ~10).
 CASE_SECONDS = int(os.environ.get("LINKWORK_FUZZ_CASE_SECONDS", "180"))
 
-#: Cases that fail in areas another part of issue 19 owns: turned on when that part is merged.
-XFAIL: dict[str, str] = {}
+
+def xfail_reason(case: Case) -> str | None:
+    """Why a case is expected to fail today: the areas of issue 19 that another change owns (reading damaged
+    files back, never replacing a user's file). Turn them on (delete the rule) once that change is merged."""
+    if case.command[0] != "export":
+        return None
+    if case.value.startswith("@damaged:trace:") and case.value.split(":")[2] in (
+        "drawing.json",
+        "report.json",
+        "path.csv",
+    ):
+        return "issue 19 item 1: export reading a damaged trace folder file ends in a traceback (one reader)"
+    if case.target == "--out" and case.value in ("@out-user-file", "@out-symlink"):
+        return "issue 19 item 2: export -o replaces a user's file or writes through a link (one writer)"
+    return None
+
 
 STUDY = 'linkage = "bennett"\n[trace]\nuntil = "A=90"\nsteps = 5\n[grid]\nalpha1 = [30, 40]\n'
 
@@ -109,8 +123,8 @@ def _alarm(signum: int, frame: FrameType | None) -> None:
 @pytest.mark.parametrize(
     "case",
     [
-        pytest.param(c, id=c.id, marks=pytest.mark.xfail(reason=XFAIL[c.id], strict=False))
-        if c.id in XFAIL
+        pytest.param(c, id=c.id, marks=pytest.mark.xfail(reason=str(xfail_reason(c)), strict=False))
+        if xfail_reason(c)
         else pytest.param(c, id=c.id)
         for c in CHOSEN
     ],
@@ -226,7 +240,7 @@ def test_a_hostile_study_key_is_refused_before_any_work(home: Path, key: str, va
     with pytest.raises(SpecError) as refused:
         load_study(study)
     assert f"study.toml: {key}: expected " in str(refused.value) and "\n" not in str(refused.value)
-    if FULL or zlib.crc32(f"{key}{value}".encode()) % 8 == 0:  # the command line too, for a fixed eighth
+    if FULL or zlib.crc32(f"{key}{value}".encode()) % 16 == 0:  # the command line, for a fixed 1/16
         out = home / "out"
         run = run_cli(
             ["sweep", str(study), "--workers", "0", "--no-plots", "-o", str(out)], out=out, home=home

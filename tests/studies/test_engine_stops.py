@@ -75,6 +75,7 @@ def test_a_signal_keeps_the_samples_computed_and_marks_them(tmp_path: Path, sig:
     assert not list(tmp_path.glob(".linkwork-*"))
 
 
+@pytest.mark.slow
 def test_a_signal_in_process_mode_keeps_the_samples_too(tmp_path: Path) -> None:
     out = tmp_path / "rb"
     proc = linkwork([*ROBUSTNESS, "--workers", "0", "-o", str(out)])
@@ -126,6 +127,7 @@ def silent_scheduler() -> Iterator[str]:
     server.close()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["robustness", "sweep"])
 def test_a_scheduler_that_never_answers_is_given_up_after_the_timeout(
     tmp_path: Path, silent_scheduler: str, command: str
@@ -170,3 +172,30 @@ def test_a_bad_connect_timeout_is_named(tmp_path: Path, monkeypatch: pytest.Monk
     monkeypatch.setenv("LINKWORK_CONNECT_TIMEOUT", "nan")
     with pytest.raises(SpecError, match="LINKWORK_CONNECT_TIMEOUT='nan': expected a number of seconds"):
         connect_timeout()
+
+
+def _chunk(shared: list[int], index: int) -> int:
+    """A chunk that sends this process a signal when it is chunk ``shared[0]`` (as a user's Ctrl-C would)."""
+    if index == shared[0]:
+        os.kill(os.getpid(), shared[1])
+    return index * index
+
+
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_the_engine_keeps_the_chunks_before_a_signal_and_says_why(sig: int, code: int) -> None:
+    from linkwork.studies.engine import RunStatus, map_chunks
+
+    status = RunStatus()
+    before = signal.getsignal(sig)
+    done = list(map_chunks(_chunk, [2, sig], [(i,) for i in range(6)], workers=0, status=status))
+    assert done == [0, 1, 4]  # chunks 0, 1 and the one in hand when the signal came, in order
+    assert (status.done, status.total, status.code) == (3, 6, code)
+    assert status.stopped == f"interrupted ({signal.Signals(sig).name})" and not status.complete
+    assert signal.getsignal(sig) == before  # the handlers are the caller's again
+
+
+def test_without_a_status_a_signal_is_the_usual_interrupt() -> None:
+    from linkwork.studies.engine import map_chunks
+
+    with pytest.raises(KeyboardInterrupt):
+        list(map_chunks(_chunk, [1, signal.SIGINT], [(i,) for i in range(4)], workers=0))
