@@ -215,7 +215,7 @@ def _values(param: Param, folder_files: dict[str, list[str]]) -> Iterator[tuple[
         for value in FILE_KINDS:
             yield value, True
         token = base.strip("{}")
-        for file in folder_files.get(token, []):
+        for file in folder_files.get(token, [""] if base.startswith("{") and token != "out" else []):
             for how in DAMAGES:
                 if how == "short-rows" and not file.endswith(".csv"):
                     continue
@@ -318,9 +318,9 @@ def materialize(value: str, home: Path, fixtures: dict[str, Path], out: Path) ->
             return value
         case "@damaged":
             _, token, file, how = value.split(":", 3)
-            folder = Path(_copy(fixtures, token, home))
-            damage(folder / file, how, user)
-            return str(folder)
+            copied = Path(_copy(fixtures, token, home))
+            damage(copied / file if file else copied, how, user)  # a file of a folder, or the file itself
+            return str(copied)
     return str(target)
 
 
@@ -364,7 +364,7 @@ def damage(file: Path, how: str, user: Path) -> None:
         case "binary":
             file.write_bytes(bytes(range(256)) * 4)
         case "short-rows":
-            lines = data.decode("utf-8").splitlines()
+            lines = data.decode("utf-8").splitlines() or [""]
             file.write_text("\n".join([lines[0], *(",".join(r.split(",")[:-1]) for r in lines[1:])]) + "\n")
         case "symlink":
             file.unlink()
