@@ -199,3 +199,42 @@ def test_without_a_status_a_signal_is_the_usual_interrupt() -> None:
 
     with pytest.raises(KeyboardInterrupt):
         list(map_chunks(_chunk, [1, signal.SIGINT], [(i,) for i in range(4)], workers=0))
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+@pytest.mark.slow
+def test_losing_the_scheduler_keeps_what_was_computed_and_exits_3(tmp_path: Path) -> None:
+    """A scheduler and two workers on 127.0.0.1 (dask's own commands); the scheduler is killed mid-run."""
+    dask = Path(sys.executable).with_name("dask")
+    if not dask.exists():
+        pytest.skip("the dask command is not installed")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    port = address.rsplit(":", 1)[1]
+    scheduler = subprocess.Popen(
+        [str(dask), "scheduler", "--host", "127.0.0.1", "--port", port, "--no-dashboard"], env=env, **quiet
+    )
+    workers = subprocess.Popen(
+        [str(dask), "worker", address, "--nthreads", "1", "--nworkers", "2", "--no-dashboard", "--host",
+         "127.0.0.1", "--death-timeout", "20"],
+        env=env, start_new_session=True, **quiet,
+    )  # fmt: skip
+    try:
+        out = tmp_path / "rb"
+        proc = linkwork([*ROBUSTNESS, "--scheduler", address, "-o", str(out)], LINKWORK_CONNECT_TIMEOUT="20")
+        wait_for_samples(proc, tmp_path)
+        scheduler.kill()
+        _, err = proc.communicate(timeout=120)
+        assert proc.returncode == 3, err
+        check_partial(out, err, "lost the Dask scheduler")
+    finally:
+        scheduler.kill()
+        os.killpg(workers.pid, signal.SIGKILL)
+        scheduler.wait(30)
+        workers.wait(30)
