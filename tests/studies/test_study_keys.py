@@ -152,3 +152,17 @@ def test_read_study_checks_everything_before_any_work(tmp_path: Path) -> None:
     study_file.write_text(LINKAGE.replace("alpha1", "alpha9"), encoding="utf-8")
     with pytest.raises(SpecError, match=r"s\.toml: grid\.alpha9: bennett has no parameter"):
         read_study(study_file)
+
+
+def test_design_each_over_many_base_points_is_indexed_without_rescanning() -> None:
+    """50,000 base points of 2 designs each: every point is found from cumulative counts made once (a scan of
+    the base points per lookup was 10^9 steps for the whole grid)."""
+    lengths = [0.1 + 1e-6 * i for i in range(50_000)]
+    study = Study(kind="synthesis", name="s", target="t", grid={"piece_length": lengths, "segments": [1],
+                                                                 "design": ["each"]})  # fmt: skip
+    assert study.count() == 100_000
+    start = time.perf_counter()
+    points = [study.point(i) for i in range(0, 100_000, 7)]
+    assert time.perf_counter() - start < 20.0  # seconds, generous for a loaded machine (was minutes)
+    assert points[1] == {"piece_length": lengths[3], "segments": 1, "design": "C"}  # index 7 = 3 * 2 + 1
+    assert study.point(99_999) == {"piece_length": lengths[-1], "segments": 1, "design": "C"}

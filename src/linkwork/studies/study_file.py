@@ -85,6 +85,7 @@ class Study:
     source: Path | None = None
     extra: dict[str, Any] = field(default_factory=dict)
     time_per_point: float = 600.0
+    _cache: dict[Any, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def each_design(self) -> bool:
@@ -118,15 +119,24 @@ class Study:
         base = self._base()
         if not self.each_design:
             return self._base_point(base, index)
-        for combo in range(self._base_count(base)):
-            point = self._base_point(base, combo)
-            designs = self._designs_of(point)
-            if index < designs:
-                q = int(point.get("segments", self.extra.get("segments") or 0))
-                letters = "".join("C" if index >> (q - 1 - i) & 1 else "M" for i in range(q))
-                return {**point, "design": letters}
-            index -= designs
-        raise IndexError(index)
+        if not 0 <= index < self.count():
+            raise IndexError(index)
+        ends = self._design_ends(base)
+        combo = int(np.searchsorted(ends, index, side="right"))
+        point = self._base_point(base, combo)
+        index -= int(ends[combo - 1]) if combo else 0
+        q = int(point.get("segments", self.extra.get("segments") or 0))
+        letters = "".join("C" if index >> (q - 1 - i) & 1 else "M" for i in range(q))
+        return {**point, "design": letters}
+
+    def _design_ends(self, base: list[str]) -> np.ndarray:
+        """The cumulative number of design vectors after each base point (computed once per study)."""
+        key = ("design_ends", id(self.grid), self.extra.get("segments"))
+        if key not in self._cache:
+            counts = [self._designs_of(self._base_point(base, i)) for i in range(self._base_count(base))]
+            self._cache.clear()
+            self._cache[key] = np.cumsum(np.asarray(counts, dtype=np.int64))
+        return self._cache[key]
 
     def _base_count(self, base: list[str]) -> int:
         total = 1
