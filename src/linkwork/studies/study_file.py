@@ -43,6 +43,7 @@ TOP_KEYS = (
     "trace",
     "grid",
     "robustness",
+    "criteria",
 )
 TRACE_KEYS = ("until", "steps", "branches", "max_steps")
 ROBUSTNESS_KEYS = (
@@ -385,6 +386,7 @@ def load_study(path: str | Path) -> Study:
         robustness=robustness,
         source=path,
         time_per_point=budget,
+        extra={"criteria": table["criteria"]} if "criteria" in table else {},  # linkwork search's table
     )
     check_work(reader, study)
     return study
