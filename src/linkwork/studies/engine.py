@@ -25,6 +25,7 @@ import threading
 import time
 import uuid
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import CancelledError
 from dataclasses import dataclass
 from types import FrameType
 from typing import Any, TypeVar
@@ -322,6 +323,10 @@ def map_chunks(
             _check_signal(state)
             with dask_client(address, workers) as own:
                 yield from _run_on(own, func, shared, chunks, progress, state, failed)
+    except CancelledError:  # work the cluster dropped, met anywhere else in the run
+        if status is None:
+            raise RequestNotMetError("lost the Dask cluster: the work in hand was cancelled") from None
+        status.stop("lost the Dask cluster; the work in hand was cancelled", 3)
     except _Stop as exc:
         if status is None:
             raise RequestNotMetError(str(exc)) from None
@@ -342,6 +347,7 @@ def _run_on(
 ) -> Iterator[T]:
     """Submit chunks to ``client`` with a bounded window and yield their results in order."""
     from dask.distributed import wait
+    from distributed.comm.core import CommClosedError
 
     n_workers = max(1, _worker_count(client))
     window = max(2, 3 * n_workers)
@@ -370,6 +376,8 @@ def _run_on(
                 done = wait(list(futures), timeout=POLL, return_when="FIRST_COMPLETED").done
             except TimeoutError:
                 done = set()
+            except (CancelledError, CommClosedError, OSError):  # wait() raises for work the cluster dropped
+                raise _Stop(watch.lost()) from None
             if not done:
                 watch.check(finished)
                 continue
@@ -397,8 +405,6 @@ def _result(
 ) -> T:
     """A finished future's result; a chunk that failed on its worker is ``failed(chunk, reason)`` or ends the
     run; a future cancelled because the scheduler is gone ends the run."""
-    from concurrent.futures import CancelledError
-
     from dask.distributed import KilledWorker
     from distributed.comm.core import CommClosedError
 
