@@ -26,7 +26,7 @@ from linkwork.cli import (
     synth,
     trace,
 )
-from linkwork.cli.common import fail
+from linkwork.cli.common import check_flags, fail
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
     from typer._click import exceptions as click_exceptions
@@ -53,6 +53,7 @@ class OneLineErrors(help.Group):
         windows_expand_args: bool = True,
         **extra: Any,
     ) -> Any:
+        check_flags(self)  # every numeric flag's bounds (cli/options.py), checked before any work starts
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, False, windows_expand_args, **extra)
         try:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import signal
 import warnings
 from collections.abc import Callable, Iterator
 from functools import wraps
@@ -19,7 +20,13 @@ from rich.text import Text
 
 from linkwork.errors import LinkworkError, RequestNotMetError
 from linkwork.io.toml_reader import escape_line, show
+from linkwork.limits import Limit
 from linkwork.progress import Progress
+
+try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
+    from typer._click import exceptions as click_exceptions
+except ImportError:  # pragma: no cover - older typer uses click itself
+    from click import exceptions as click_exceptions  # type: ignore[no-redef]
 
 if TYPE_CHECKING:
     from linkwork.kinematics.mechanism import Mechanism
@@ -69,6 +76,15 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(f"{where}{exc.strerror or exc}", code=3) from None
         except MemoryError:
             raise fail("ran out of memory; the request is too large for this machine", code=3) from None
+        except KeyboardInterrupt:  # Ctrl-C outside a study's run (which keeps its results itself)
+            raise fail("interrupted (SIGINT)", code=130) from None
+        except BaseException as exc:
+            from linkwork.studies.engine import EXIT_SIGTERM, Interrupted
+
+            if not isinstance(exc, Interrupted):
+                raise
+            code = EXIT_SIGTERM if exc.signum == signal.SIGTERM else 130
+            raise fail(f"interrupted twice ({exc}); stopped at once", code=code) from None
 
     return wrapper
 
@@ -103,10 +119,75 @@ def check_range(
         raise fail(f"{flag} {show(value)}: expected {what}, {low:g} {sign} {flag} <= {high:g}")
 
 
+def numeric_params(command: Any) -> Iterator[tuple[str, Any, Any]]:
+    """``(command path, command, parameter)`` of every int or float parameter of every (sub)command of the
+    click ``command`` (the typer app as built), whatever module declares it."""
+    commands = getattr(command, "commands", None)
+    if commands is not None:
+        for name, sub in commands.items():
+            for path, owner, param in numeric_params(sub):
+                yield f"{name} {path}".strip(), owner, param
+        return
+    for param in getattr(command, "params", []):
+        if _number_type(param) is not None:
+            yield "", command, param
+
+
+def _number_type(param: Any) -> type | None:
+    """``int`` or ``float`` for a parameter holding one number (or a list of them), else ``None``."""
+    descriptor = getattr(param, "type_descriptor", None)
+    annotation = getattr(descriptor, "annotation", None)
+    if annotation is None:  # a plain click parameter
+        name = getattr(getattr(param, "type", None), "name", "")
+        return {"integer": int, "float": float}.get(name)
+    if annotation in (int, list[int]):
+        return int
+    if annotation in (float, list[float]):
+        return float
+    return None
+
+
+def check_flags(app_command: Any) -> None:
+    """Attach the bounds of :data:`linkwork.cli.options.FLAG_LIMITS` to every numeric flag of the built command
+    line, so each value is checked (type, finite, range) as it is parsed, before any command starts its work.
+
+    A numeric flag without declared bounds still has to be a finite number; the fuzz suite fails on it so that
+    its bounds get declared. A refused value is one ``error:`` line naming the flag and its bounds (exit 2).
+    """
+    from linkwork.cli.options import FLAG_LIMITS
+
+    for _, _, param in numeric_params(app_command):
+        if getattr(param, "_linkwork_checked", False):
+            continue
+        flag = max(param.opts, key=len) if param.opts else param.name
+        limit = FLAG_LIMITS.get(flag)
+        param.callback = _checked_callback(flag, limit, param.callback)
+        param._linkwork_checked = True
+
+
+def _checked_callback(flag: str, limit: Limit | None, then: Callable[..., Any] | None) -> Callable[..., Any]:
+    """A click parameter callback refusing a value outside ``limit`` (or any non-finite number)."""
+
+    def check(ctx: Any, param: Any, value: Any) -> Any:
+        for item in value if isinstance(value, list | tuple) else [value]:
+            if item is None:
+                continue
+            if limit is not None and limit.broken(item):
+                raise click_exceptions.UsageError(f"{flag} {show(item)}: expected {limit.expected(flag)}")
+            if limit is None and not math.isfinite(float(item)):
+                raise click_exceptions.UsageError(f"{flag} {show(item)}: expected a finite number")
+        return then(ctx, param, value) if then is not None else value
+
+    return check
+
+
 def check_workers(workers: int | None) -> None:
-    """Refuse a negative ``--workers`` (0 runs a study in this process)."""
-    if workers is not None and workers < 0:
-        raise fail(f"--workers {workers}: expected 0 or more")
+    """Refuse a ``--workers`` outside ``0 ..`` the machine's cores (0 runs a study in this process); the flag
+    is checked as it is parsed, this repeats it for a caller that passes the value itself."""
+    from linkwork.limits import WORKERS
+
+    if workers is not None and WORKERS.broken(workers):
+        raise fail(f"--workers {show(workers)}: expected {WORKERS.expected('--workers')}")
 
 
 @contextlib.contextmanager

@@ -11,6 +11,8 @@ from typing import Annotated
 
 import typer
 
+from linkwork import limits
+
 SpecName = Annotated[
     str, typer.Argument(help="A TOML spec file or a built-in name (see `linkwork linkages`).")
 ]
@@ -38,12 +40,48 @@ NoPlots = Annotated[bool, typer.Option("--no-plots", help="Do not draw figures."
 
 Scheduler = Annotated[
     str | None,
-    typer.Option(help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes)."),
+    typer.Option(
+        help="Dask scheduler tcp://HOST:PORT (default $LINKWORK_SCHEDULER, else local processes); one that does "
+        "not answer within $LINKWORK_CONNECT_TIMEOUT seconds (default 30) is an error."
+    ),
 ]
 """``--scheduler``: where a study's tasks run."""
 
 Workers = Annotated[
     int | None,
-    typer.Option(help="Local worker processes (default: one per core; 0 runs in this process)."),
+    typer.Option(
+        help="Local worker processes (default: one per core; 0 runs in this process; at most os.cpu_count())."
+    ),
 ]
 """``--workers``: the local processes of a study."""
+
+
+#: The bounds of every numeric flag of every command, by flag name (a flag means the same wherever it appears).
+#: :func:`linkwork.cli.common.check_flags` attaches them to the parsed command line, so a value outside is refused
+#: before any work starts, in one line naming the flag and the bounds. A test fails when a numeric flag has none.
+FLAG_LIMITS: dict[str, limits.Limit] = {
+    "--steps": limits.STEPS,
+    "--max-steps": limits.STEPS,
+    "--max-step": limits.Limit("a number of degrees", 0.0, 90.0, open_low=True),
+    "--closure-tol": limits.Limit("a closure misfit", 0.0, limits.MAX_MAGNITUDE, open_low=True),
+    "--samples": limits.SAMPLES,
+    "--seed": limits.SEED,
+    "--hinge-position-tol": limits.POSITION_TOL,
+    "--hinge-direction-tol": limits.DIRECTION_TOL,
+    "--workers": limits.WORKERS,
+    "--dof": limits.Limit("a whole number of degrees of freedom", 1, 20, whole=True),
+    "--link-offset": limits.Limit("a number of body lengths", 0.0, limits.MAX_MAGNITUDE),
+    "--max-link": limits.Limit("a factor of the profiles' extent", 0.0, limits.MAX_MAGNITUDE, open_low=True),
+    "--min-transmission": limits.Limit("an angle in degrees", 0.0, 90.0, open_high=True),
+    "--attempts": limits.Limit("a whole number of designs", 1, 100_000, whole=True),
+    "--designs": limits.Limit("a whole number of designs", 1, 20, whole=True),
+    "--time-limit": limits.Limit("a number of seconds", 0.0, 7 * 24 * 3600.0, open_low=True),
+    "--branch": limits.Limit("a branch number (see report.json)", 0, 1_000_000, whole=True),
+    "--point": limits.Limit(
+        "a point number (negative counts from the end)",
+        -limits.MAX_TRACE_STEPS,
+        limits.MAX_TRACE_STEPS,
+        whole=True,
+    ),
+    "--scale": limits.Limit("a positive factor", 0.0, 1e9, open_low=True),
+}

@@ -86,12 +86,20 @@ def robustness(
     out/NAME-robustness/, NAME the linkage's name with its --set values or the spec file's name)."""
     import numpy as np
 
+    from linkwork.limits import MAX_PATH_POINTS
+    from linkwork.studies.engine import RunStatus, scheduler_address
     from linkwork.studies.imperfections import ImperfectionModel
     from linkwork.studies.robustness import nominal_ratio, prepare
 
     _check_counts(samples, seed, workers)
+    scheduler_address(scheduler)  # a malformed address is bad input, found before any work
     if steps is not None and until is None:
         raise fail("--steps needs --until JOINT=VALUE")
+    if steps is not None and steps + 1 > MAX_PATH_POINTS:
+        raise fail(
+            f"--steps {steps}: expected at most {MAX_PATH_POINTS - 1} for a robustness study (the nominal path's "
+            "points each keep per-point histograms in memory)"
+        )
     target = parse_until(until)
     if out is None:
         out = run_folder("robustness", spec_label(spec, parse_assignments(set_, "--set")))
@@ -116,6 +124,7 @@ def robustness(
         run_and_write_robustness,
     )
 
+    status = RunStatus()
     with progress_bar("samples", samples, fraction=True) as report:
         result, figures = run_and_write_robustness(
             setup,
@@ -124,22 +133,30 @@ def robustness(
             out,
             source=spec,
             plots=not no_plots,
-            engine={"scheduler": scheduler, "workers": workers},
+            engine={"scheduler": scheduler, "workers": workers, "status": status},
             progress=report,
         )
     print_robustness_summary(robustness_dict(result, spec))
     written = ["robustness.json", "samples.parquet", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
+    if not status.complete:
+        raise fail(
+            f"{status.stopped}; {result.samples} of {samples} samples computed and written (robustness.json says "
+            '"complete": false)',
+            code=status.code,
+        )
     if target is not None:
         _check_reached(mech, nominal, float(setup.drive_values[-1]), target)
 
 
 def _check_counts(samples: int, seed: int, workers: int | None) -> None:
-    """Refuse a study of no samples, a negative seed or a negative number of workers."""
-    if samples < 1:
-        raise fail(f"--samples {samples}: expected at least 1")
-    if seed < 0:
-        raise fail(f"--seed {seed}: expected a non-negative whole number")
+    """Refuse a study of no samples, a negative seed or a number of workers the machine does not have (the
+    flags are checked as they are parsed, see cli/options.py; this repeats it for a direct call)."""
+    from linkwork.limits import SAMPLES, SEED
+
+    for flag, value, limit in (("--samples", samples, SAMPLES), ("--seed", seed, SEED)):
+        if limit.broken(value):
+            raise fail(f"{flag} {value}: expected {limit.expected(flag)}")
     check_workers(workers)
 
 

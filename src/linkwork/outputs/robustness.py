@@ -46,6 +46,9 @@ def robustness_dict(result: RobustnessResult, source: str = "") -> dict[str, Any
         "source": source,
         "drive": drive,
         "samples": int(result.samples),
+        "samples_asked": int(result.samples_asked or result.samples),
+        "complete": result.complete,
+        **({"stopped": result.stopped} if result.stopped else {}),
         "seed": setup.seed,
         "tolerances": {
             "hinge_position": model.position_tol,
@@ -111,7 +114,7 @@ def run_and_write_robustness(
             result = run_study(setup, samples, ratio_paper, sink=w.write, progress=progress, **(engine or {}))
         summary = robustness_dict(result, source)
         (stage / "robustness.json").write_text(json_text(summary), encoding="utf-8")
-        if plots:
+        if plots and result.samples > 0:
             if have_matplotlib():
                 from linkwork.viz.robustness_plots import write_robustness_figures
 

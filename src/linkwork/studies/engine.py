@@ -5,6 +5,13 @@ of worker processes on this machine is started and shut down again (no set-up); 
 that cluster (its workers need linkwork installed). A study of a single chunk, or ``workers=0``, runs in this
 process. Results come back in chunk order whichever worker finished first, so written files never depend on the
 schedule; at most a few chunks per worker are in flight, so memory stays bounded however many chunks there are.
+
+A run given a :class:`RunStatus` ends early, keeping every chunk finished so far, when it is interrupted (SIGINT,
+SIGTERM), when every worker or the scheduler is lost, or when a chunk cannot be computed; the status says which
+and how much was done, and the caller writes what it has. A scheduler must answer within
+``$LINKWORK_CONNECT_TIMEOUT`` seconds (default :data:`CONNECT_TIMEOUT`): one that accepts the connection and then
+says nothing is an error after that time, and so is a cluster left without any worker for that long. Dask's own
+log lines and tracebacks are kept off the terminal while a run lasts.
 """
 
 from __future__ import annotations
@@ -12,24 +19,115 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import re
+import signal
+import threading
+import time
 import uuid
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import CancelledError
+from dataclasses import dataclass
+from types import FrameType
 from typing import Any, TypeVar
 
-from linkwork.errors import LinkworkError
+from linkwork.errors import LinkworkError, RequestNotMetError, SpecError
 from linkwork.progress import Progress
 
 T = TypeVar("T")
 
 ENV_SCHEDULER = "LINKWORK_SCHEDULER"
+ENV_CONNECT_TIMEOUT = "LINKWORK_CONNECT_TIMEOUT"
+
+CONNECT_TIMEOUT = 30.0
+"""Seconds a scheduler has to answer a connection, and a cluster may stay without a worker, before the run gives
+up (override with ``$LINKWORK_CONNECT_TIMEOUT``)."""
+
+POLL = 0.5
+"""Seconds between checks of the cluster's health while waiting for results."""
+
+EXIT_SIGINT = 130
+EXIT_SIGTERM = 143
+
+
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM during a run (a :class:`BaseException`, like :class:`KeyboardInterrupt`)."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(signal.Signals(signum).name)
+
+
+@dataclass
+class RunStatus:
+    """How a run on the engine ended: complete, or why it stopped early and how much was done.
+
+    Attributes
+    ----------
+    total
+        Chunks asked for.
+    done
+        Chunks finished and handed back, in order (the first ``done`` chunks).
+    stopped
+        Why the run stopped early (``""`` when it is complete): e.g. ``"interrupted (SIGINT)"``.
+    code
+        The exit code that fits: 0 complete, 130 SIGINT, 143 SIGTERM, 3 a lost cluster.
+    signal
+        The first SIGINT or SIGTERM received during the run (0: none).
+    """
+
+    total: int = 0
+    done: int = 0
+    stopped: str = ""
+    code: int = 0
+    signal: int = 0
+
+    @property
+    def complete(self) -> bool:
+        """Whether every chunk was computed."""
+        return not self.stopped
+
+    def stop(self, reason: str, code: int) -> None:
+        """Record the first reason the run stopped early."""
+        if not self.stopped:
+            self.stopped, self.code = reason, code
+
+
+def connect_timeout() -> float:
+    """``$LINKWORK_CONNECT_TIMEOUT`` seconds, else :data:`CONNECT_TIMEOUT`."""
+    raw = os.environ.get(ENV_CONNECT_TIMEOUT, "").strip()
+    if not raw:
+        return CONNECT_TIMEOUT
+    try:
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value <= 3600.0:
+        raise SpecError(
+            f"{ENV_CONNECT_TIMEOUT}={raw[:40]!r}: expected a number of seconds, 0 < seconds <= 3600"
+        )
+    return value
+
+
+_ADDRESS = re.compile(
+    r"(?:(?P<scheme>[a-z][a-z0-9+.-]*)://)?(?P<host>\[[0-9a-fA-F:.]+\]|[^:/\s\[\]]+):(?P<port>\d+)"
+)
 
 
 def scheduler_address(scheduler: str | None) -> str | None:
-    """The scheduler to use: the given address, else ``$LINKWORK_SCHEDULER``, else ``None`` (local)."""
+    """The scheduler to use: the given address, else ``$LINKWORK_SCHEDULER``, else ``None`` (local).
+
+    An address is ``tcp://HOST:PORT`` (or ``tls://``, or ``HOST:PORT``) with a port from 1 to 65535."""
+    flag = "--scheduler" if scheduler else ENV_SCHEDULER
     address = scheduler or os.environ.get(ENV_SCHEDULER) or None
-    if address is not None and "://" not in address and ":" not in address:
-        raise LinkworkError(f"scheduler {address!r}: expected an address like tcp://HOST:PORT")
-    return address
+    if address is None:
+        return None
+    match = _ADDRESS.fullmatch(address.strip())
+    scheme = (match.group("scheme") or "tcp") if match else ""
+    if match is None or scheme not in ("tcp", "tls") or not 1 <= int(match.group("port")[:6]) <= 65535:
+        from linkwork.io.toml_reader import show
+
+        raise SpecError(f"{flag} {show(address)}: expected an address like tcp://HOST:PORT, port 1 to 65535")
+    return f"{scheme}://{match.group('host')}:{int(match.group('port'))}"
 
 
 def default_workers() -> int:
@@ -40,33 +138,146 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+_DASK_LOGGERS = ("distributed", "tornado", "asyncio", "bokeh")
+
+
+@contextlib.contextmanager
+def quiet_dask(restore: bool = True) -> Iterator[None]:
+    """Dask's loggers silenced (their tracebacks would reach the terminal) while the block runs, and after it
+    unless ``restore`` (a client's reconnection attempts may still log while the process ends)."""
+    import distributed  # noqa: F401 - configures its loggers, which are then silenced
+
+    loggers = [logging.getLogger(name) for name in _DASK_LOGGERS]
+    loggers += [
+        logging.getLogger(name)
+        for name in list(logging.root.manager.loggerDict)
+        if name.split(".")[0] in _DASK_LOGGERS and "." in name
+    ]
+    before = [log.level for log in loggers]
+    for log in loggers:
+        log.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        if restore:
+            for log, level in zip(loggers, before, strict=True):
+                log.setLevel(level)
+
+
+@contextlib.contextmanager
+def caught_signals(state: RunStatus) -> Iterator[None]:
+    """While the block runs, the first SIGINT or SIGTERM is recorded in ``state.signal`` (the run then stops
+    after the chunks in hand and keeps them); a second one raises :class:`Interrupted` at once. Only in the
+    main thread; elsewhere nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def record(signum: int, frame: FrameType | None) -> None:
+        if state.signal:
+            raise Interrupted(signum)
+        state.signal = signum
+
+    before = {sig: signal.signal(sig, record) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+
+
+class _Stop(Exception):
+    """The run stops early: a signal was received, or the cluster is gone (the message says which)."""
+
+
+def _check_signal(state: RunStatus) -> None:
+    if state.signal:
+        raise _Stop(f"interrupted ({signal.Signals(state.signal).name})")
+
+
+@contextlib.contextmanager
+def _signals_ignored() -> Iterator[None]:
+    """SIGINT and SIGTERM ignored while a local cluster starts its worker processes, which inherit that (an
+    ignored signal stays ignored in a new Python process): a Ctrl-C in the terminal, sent to every process of
+    the group, then reaches this process alone, which stops the workers itself. A signal during the start-up
+    itself (seconds) is not seen."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+
+
+def _connect(address: str, timeout: float) -> Any:
+    """A :class:`~dask.distributed.Client` of the scheduler at ``address``, or a :class:`RequestNotMetError` when
+    it cannot be reached or does not answer within ``timeout`` seconds (Dask's own timeout does not cover a
+    server that accepts the connection and then says nothing, so the connection is made in a thread)."""
+    from dask.distributed import Client
+
+    box: dict[str, Any] = {}
+
+    def connect() -> None:
+        try:
+            box["client"] = Client(address, timeout=f"{timeout}s")
+        except BaseException as exc:  # reported below, in the caller's thread
+            box["error"] = exc
+
+    worker = threading.Thread(target=connect, name="linkwork-connect", daemon=True)
+    worker.start()
+    worker.join(timeout + 5.0)
+    if worker.is_alive():
+        raise RequestNotMetError(
+            f"the Dask scheduler at {address} accepted the connection but did not answer within {timeout:g} s "
+            f"(set {ENV_CONNECT_TIMEOUT} to wait longer)"
+        )
+    if "error" in box:
+        exc = box["error"]
+        raise RequestNotMetError(
+            f"cannot reach the Dask scheduler at {address} within {timeout:g} s: {type(exc).__name__} {exc}"[
+                :500
+            ]
+        ) from None
+    return box["client"]
+
+
 @contextlib.contextmanager
 def dask_client(scheduler: str | None, workers: int | None = None) -> Iterator[Any]:
     """A connected :class:`~dask.distributed.Client`: to ``scheduler``, or to a fresh local cluster of
     ``workers`` single-threaded processes that is shut down on exit."""
     from dask.distributed import Client, LocalCluster
 
+    timeout = connect_timeout()
     if scheduler is not None:
+        client = _connect(scheduler, timeout)
         try:
-            client = Client(scheduler, timeout="10s")
-        except OSError as exc:
-            raise LinkworkError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from None
-        with client:
             yield client
+        finally:
+            with contextlib.suppress(Exception):
+                client.close(timeout=timeout)
         return
     n = workers or default_workers()
-    with (
-        LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address=":0",
-            silence_logs=logging.ERROR,
-        ) as cluster,
-        Client(cluster) as client,
-    ):
-        yield client
+    try:
+        with _signals_ignored():
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=logging.CRITICAL,
+            )
+    except Exception as exc:  # a machine that cannot start worker processes
+        raise RequestNotMetError(f"cannot start {n} local Dask worker processes: {exc}"[:500]) from None
+    try:
+        with Client(cluster) as client:
+            yield client
+    finally:
+        with contextlib.suppress(Exception):
+            cluster.close(timeout=timeout)
 
 
 def map_chunks(
@@ -78,26 +289,51 @@ def map_chunks(
     workers: int | None = None,
     client: Any = None,
     progress: Progress | None = None,
+    status: RunStatus | None = None,
+    failed: Callable[[tuple[Any, ...], str], T] | None = None,
 ) -> Iterator[T]:
     """Yield ``func(shared, *chunk)`` for every chunk, in chunk order.
 
     ``shared`` (the study's set-up) is sent to every worker once. ``client`` reuses a connected Dask client;
     otherwise one is made from ``scheduler`` / ``workers`` (``workers=0``: run here, in this process).
+
+    With ``status``, SIGINT and SIGTERM, the loss of every worker or of the scheduler, or a chunk that cannot
+    be computed end the run quietly after the chunks finished so far (``status`` says why); without it they
+    raise (:class:`KeyboardInterrupt`, :class:`~linkwork.errors.RequestNotMetError`). ``failed(chunk, reason)``
+    stands in for a chunk whose task failed on a worker (it killed its workers, or raised), so the run goes on.
     """
     address = scheduler_address(scheduler)
-    total = len(chunks)
-    if client is None and address is None and (workers == 0 or total <= 1):
-        for done, chunk in enumerate(chunks, start=1):
-            result = func(shared, *chunk)
-            if progress is not None:
-                progress(done, total)
-            yield result
-        return
-    if client is not None:
-        yield from _run_on(client, func, shared, chunks, progress)
-        return
-    with dask_client(address, workers) as own:
-        yield from _run_on(own, func, shared, chunks, progress)
+    state = status if status is not None else RunStatus()
+    state.total = len(chunks)
+    guard = caught_signals(state) if status is not None else contextlib.nullcontext()
+    try:
+        with guard, quiet_dask(restore=status is None):
+            if client is None and address is None and (workers == 0 or len(chunks) <= 1):
+                for chunk in chunks:
+                    _check_signal(state)
+                    result = func(shared, *chunk)
+                    state.done += 1
+                    if progress is not None:
+                        progress(state.done, state.total)
+                    yield result
+                return
+            if client is not None:
+                yield from _run_on(client, func, shared, chunks, progress, state, failed)
+                return
+            _check_signal(state)
+            with dask_client(address, workers) as own:
+                yield from _run_on(own, func, shared, chunks, progress, state, failed)
+    except CancelledError:  # work the cluster dropped, met anywhere else in the run
+        if status is None:
+            raise RequestNotMetError("lost the Dask cluster: the work in hand was cancelled") from None
+        status.stop("lost the Dask cluster; the work in hand was cancelled", 3)
+    except _Stop as exc:
+        if status is None:
+            raise RequestNotMetError(str(exc)) from None
+        if state.signal:
+            status.stop(str(exc), EXIT_SIGTERM if state.signal == signal.SIGTERM else EXIT_SIGINT)
+        else:
+            status.stop(str(exc), 3)
 
 
 def _run_on(
@@ -106,17 +342,23 @@ def _run_on(
     shared: Any,
     chunks: Sequence[tuple[Any, ...]],
     progress: Progress | None,
+    state: RunStatus,
+    failed: Callable[[tuple[Any, ...], str], T] | None,
 ) -> Iterator[T]:
     """Submit chunks to ``client`` with a bounded window and yield their results in order."""
-    from dask.distributed import as_completed
+    from dask.distributed import wait
+    from distributed.comm.core import CommClosedError
 
-    n_workers = max(1, len(client.scheduler_info(n_workers=-1).get("workers", {})))
+    n_workers = max(1, _worker_count(client))
     window = max(2, 3 * n_workers)
     [remote] = client.scatter([shared], broadcast=True, hash=False)
     token = uuid.uuid4().hex
     pending = iter(enumerate(chunks))
     futures: dict[Any, int] = {}
-    done_set = as_completed()
+    ready: dict[int, T] = {}
+    next_index = 0
+    finished = 0
+    watch = _Watch(client, connect_timeout())
 
     def submit_next() -> None:
         item = next(pending, None)
@@ -124,27 +366,109 @@ def _run_on(
             index, chunk = item
             fut = client.submit(func, remote, *chunk, pure=False, key=f"linkwork-chunk-{token}-{index}")
             futures[fut] = index
-            done_set.add(fut)
 
     for _ in range(window):
         submit_next()
-    ready: dict[int, T] = {}
-    next_index = 0
-    finished = 0
-    for fut in done_set:
-        index = futures.pop(fut)
+    try:
+        while futures:
+            _check_signal(state)
+            try:
+                done = wait(list(futures), timeout=POLL, return_when="FIRST_COMPLETED").done
+            except TimeoutError:
+                done = set()
+            except (CancelledError, CommClosedError, OSError):  # wait() raises for work the cluster dropped
+                raise _Stop(watch.lost()) from None
+            if not done:
+                watch.check(finished)
+                continue
+            _check_signal(state)
+            for fut in [f for f in futures if f in done]:
+                index = futures.pop(fut)
+                ready[index] = _result(fut, chunks[index], failed, watch)
+                fut.release()
+                finished += 1
+                if progress is not None:
+                    progress(finished, len(chunks))
+                submit_next()
+            while next_index in ready:
+                state.done += 1
+                yield ready.pop(next_index)
+                next_index += 1
+    finally:
+        for fut in futures:
+            with contextlib.suppress(Exception):
+                fut.cancel()
+
+
+def _result(
+    fut: Any, chunk: tuple[Any, ...], failed: Callable[[tuple[Any, ...], str], T] | None, watch: _Watch
+) -> T:
+    """A finished future's result; a chunk that failed on its worker is ``failed(chunk, reason)`` or ends the
+    run; a future cancelled because the scheduler is gone ends the run."""
+    from dask.distributed import KilledWorker
+    from distributed.comm.core import CommClosedError
+
+    if fut.status == "cancelled":
+        raise _Stop(watch.lost())
+    try:
+        return fut.result()
+    except ImportError as exc:
+        raise LinkworkError(
+            f"a Dask worker cannot import what the study needs ({exc}); install linkwork (the same version) "
+            "on every worker"
+        ) from None
+    except (CancelledError, CommClosedError, OSError, TimeoutError):
+        raise _Stop(watch.lost()) from None
+    except KilledWorker:
+        reason = "its task killed the Dask workers that ran it (out of memory?)"
+    except Exception as exc:  # a worker-side failure of one chunk
+        if isinstance(exc, LinkworkError) and failed is None:
+            raise
+        reason = f"failed on a Dask worker: {type(exc).__name__}: {exc}"[:500]
+    if failed is None:
+        raise _Stop(f"a chunk of the study {reason}")
+    return failed(chunk, reason)
+
+
+def _worker_count(client: Any) -> int:
+    """The workers the scheduler knows now."""
+    return len(client.scheduler_info(n_workers=-1).get("workers", {}))
+
+
+class _Watch:
+    """Gives up on a cluster that has had no worker, or no scheduler connection, for ``timeout`` seconds."""
+
+    def __init__(self, client: Any, timeout: float) -> None:
+        self.client = client
+        self.timeout = timeout
+        self.bad_since: float | None = None
+
+    def check(self, finished: int) -> None:
+        """Raise :class:`_Stop` when the scheduler is gone, or has had no worker for ``timeout`` seconds."""
+        now = time.monotonic()
+        status = getattr(self.client, "status", "running")
+        if status in ("closed", "closing", "failed"):
+            raise _Stop(f"lost the Dask scheduler (client {status}) after {finished} finished chunk(s)")
+        healthy = status == "running" and self._workers() > 0
+        if healthy:
+            self.bad_since = None
+            return
+        self.bad_since = self.bad_since or now
+        if now - self.bad_since > self.timeout:
+            what = "the Dask scheduler" if status != "running" else "every Dask worker"
+            raise _Stop(f"lost {what} for {self.timeout:g} s (set {ENV_CONNECT_TIMEOUT} to wait longer)")
+
+    def lost(self) -> str:
+        """What was lost, when the scheduler cancelled the work in hand."""
+        status = getattr(self.client, "status", "running")
+        if status != "running":
+            return f"lost the Dask scheduler (client {status}); the work in hand was cancelled"
+        if self._workers() == 0:
+            return "lost every Dask worker; the work in hand was cancelled"
+        return "the Dask scheduler cancelled the work in hand (was it restarted?)"
+
+    def _workers(self) -> int:
         try:
-            ready[index] = fut.result()
-        except ImportError as exc:
-            raise LinkworkError(
-                f"a Dask worker cannot import what the study needs ({exc}); install linkwork (the same version) "
-                "on every worker"
-            ) from None
-        fut.release()
-        finished += 1
-        if progress is not None:
-            progress(finished, len(chunks))
-        submit_next()
-        while next_index in ready:
-            yield ready.pop(next_index)
-            next_index += 1
+            return _worker_count(self.client)
+        except Exception:  # an unreachable scheduler has no workers we can use
+            return 0

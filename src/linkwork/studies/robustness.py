@@ -20,9 +20,10 @@ from linkwork.deprecation import trace_keyword
 from linkwork.errors import SpecError
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
+from linkwork.limits import MAX_PATH_POINTS
 from linkwork.progress import Progress
 from linkwork.studies import bands
-from linkwork.studies.engine import default_workers, map_chunks
+from linkwork.studies.engine import RunStatus, default_workers, map_chunks
 from linkwork.studies.first_order import first_order_misfit, sensitivity_maps
 from linkwork.studies.imperfections import (
     HingeLines,
@@ -100,6 +101,12 @@ def prepare(
     u_path = np.ascontiguousarray(mech.u_from_q(q))
     if u_path.shape[0] < 1:
         raise SpecError("the nominal path has no points")
+    if u_path.shape[0] > MAX_PATH_POINTS:
+        raise SpecError(
+            f"the nominal path has {u_path.shape[0]} points; expected at most {MAX_PATH_POINTS} (memory: about "
+            f"{16 * bands.N_BINS // 1000} kB per point for every chunk in flight); give fewer --steps or a "
+            "shorter --until"
+        )
     drive_joint = mech.index(trace.drive)
     drive_unknown = int(mech.groups[drive_joint])
     scale = misfit_scale(mech)
@@ -185,6 +192,13 @@ class RobustnessResult:
     hist_first: NDArray[np.int64]
     drive_max: Array
     ratio_paper: Array
+    samples_asked: int = 0
+    stopped: str = ""
+
+    @property
+    def complete(self) -> bool:
+        """Whether every sample asked for was computed (an interrupted run keeps the samples it finished)."""
+        return not self.stopped
 
     def band(self, q: float, first_order: bool = False) -> Array:
         """``(K,)`` the ``q``-quantile of the misfit (or its first-order prediction) at every drive value."""
@@ -238,8 +252,12 @@ def run_study(
     chunk: int | None = None,
     progress: Progress | None = None,
     sink: Callable[[ChunkResult], None] | None = None,
+    status: RunStatus | None = None,
 ) -> RobustnessResult:
-    """Run ``samples`` samples of a prepared study on the Dask engine and merge them."""
+    """Run ``samples`` samples of a prepared study on the Dask engine and merge them.
+
+    With ``status`` (see :func:`linkwork.studies.engine.map_chunks`) an interrupted run, or one whose cluster is
+    lost, returns the samples of the chunks finished so far (the first ones, in order), with ``stopped`` set."""
     if samples < 1:
         raise SpecError(f"samples must be at least 1, got {samples}")
     if client is not None:
@@ -254,8 +272,12 @@ def run_study(
         workers=workers,
         client=client,
         progress=progress,
+        status=status,
     )
-    return merge_chunks(setup, results, ratio_paper, sink)
+    merged = merge_chunks(setup, results, ratio_paper, sink)
+    merged.samples_asked = samples
+    merged.stopped = status.stopped if status is not None else ""
+    return merged
 
 
 @trace_keyword
