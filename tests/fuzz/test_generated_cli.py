@@ -45,30 +45,6 @@ CASE_SECONDS = int(os.environ.get("LINKWORK_FUZZ_CASE_SECONDS", "180"))
 
 #: Damaged files of a trace folder that ``export`` reads into a traceback today (JSONDecodeError,
 #: UnicodeDecodeError, IndexError), found by this suite: ``(command, file, damage)``.
-BROKEN = ("truncate", "empty", "binary", "symlink")
-EXPORT_READS = {
-    *(("stl", "drawing.json", how) for how in BROKEN),
-    *(("dxf", "drawing.json", how) for how in BROKEN),
-    *(("mjcf", "drawing.json", how) for how in BROKEN),
-    *(("mjcf", "report.json", how) for how in BROKEN),
-    *((command, "path.csv", how) for command in ("stl", "dxf") for how in ("empty", "binary")),
-}
-
-
-def xfail_reason(case: Case) -> str | None:
-    """Why a case is expected to fail today: the areas of issue 19 that another change owns (reading damaged
-    files back, never replacing a user's file). Turn them on (delete the rule) once that change is merged."""
-    if case.command[0] != "export":
-        return None
-    if case.value.startswith("@damaged:trace:"):
-        _, _, name, how = case.value.split(":", 3)
-        if (case.command[1], name, how) in EXPORT_READS:
-            return (
-                "issue 19 item 1: export reading a damaged trace folder file ends in a traceback (one reader)"
-            )
-    if case.command == ("export", "mjcf") and case.value in ("@out-user-file", "@out-symlink"):
-        return "issue 19 item 2: export mjcf -o replaces a user's file or writes through a link (one writer)"
-    return None
 
 
 STUDY = 'linkage = "bennett"\n[trace]\nuntil = "A=90"\nsteps = 5\n[grid]\nalpha1 = [30, 40]\n'
@@ -134,12 +110,7 @@ def _alarm(signum: int, frame: FrameType | None) -> None:
 
 @pytest.mark.parametrize(
     "case",
-    [
-        pytest.param(c, id=c.id, marks=pytest.mark.xfail(reason=str(xfail_reason(c)), strict=False))
-        if xfail_reason(c)
-        else pytest.param(c, id=c.id)
-        for c in CHOSEN
-    ],
+    [pytest.param(c, id=c.id) for c in CHOSEN],
 )
 def test_a_generated_hostile_case_keeps_every_promise(home: Path, case: Case) -> None:
     args, out = command_line(case, home, FIXTURES)
