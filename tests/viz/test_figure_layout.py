@@ -267,8 +267,8 @@ ROBUSTNESS = ["robustness", "--samples", "16", "--workers", "0", "--hinge-positi
 ROBUSTNESS += ["--hinge-direction-tol", "0.05"]
 
 #: A run of a command that writes figures: its arguments (``OUT`` is its output folder) and the study file it
-#: needs, if any. Guest's frame's singular values jump at the closed path's last point (a wrong last value,
-#: fixed by the tracing bookkeeping of issue 18): the check catches it until that fix is in (KNOWN).
+#: needs, if any. (The jump check caught Guest's frame's wrong last singular values, and the four-bar's and
+#: slider-crank's at a target landed on with a progress callback, until the tracing bookkeeping was fixed.)
 RUNS = {
     "trace-guest-frame": (["trace", "guest-frame", "--branches", "--max-steps", "3000", "-o", "OUT"], None),
     "trace-hexagon": (
@@ -298,15 +298,6 @@ RUNS = {
     "sweep-lines": (["sweep", "STUDY", "--workers", "0", "-o", "OUT"], LINE_STUDY),
     "synth": (["synth", "wing", "-o", "OUT"], None),
     "search": (["search", "STUDY", "-o", "OUT"], SEARCH_STUDY),
-}
-LANDING = (
-    "singular values wrong at the point a step lands on (the target, the closed path's end) when traced "
-)
-LANDING += "with a progress callback, as the CLI does: 3.526 for 4.194 (issue 18, tracing bookkeeping)"
-KNOWN = {
-    "trace-guest-frame": "singular values jump at the closed path's last point (issue 18, tracing bookkeeping)",
-    "trace-four-bar": LANDING,
-    "trace-slider-crank": LANDING,
 }
 
 
@@ -351,11 +342,7 @@ def test_every_figure_a_command_writes_reads_well(caught: list[str], tmp_path: P
         if "search" not in {c.name for c in app.registered_commands}:
             pytest.skip("no `linkwork search` command in this version")
     problems = run_and_check(args, study, tmp_path, caught)
-    known = [p for p in problems if run in KNOWN and p.startswith("singular_values.png") and "jumps" in p]
-    others = [p for p in problems if p not in known]
-    assert not others, "\n".join(others)
-    if known:
-        pytest.xfail(f"{KNOWN[run]}: {known[0]}")
+    assert not problems, "\n".join(problems)
 
 
 @pytest.mark.slow
