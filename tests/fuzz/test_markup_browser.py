@@ -114,4 +114,4 @@ def test_names_differing_only_in_case_or_dropped_characters_get_distinct_dxf_lay
     result = synthesize(Problem(profiles=lines, piece_length=0.3, design="MC", starts=1, names=names))
     write_outline_dxf(tmp_path / "outline.dxf", result)
     layers = {layer.dxf.name for layer in ezdxf.readfile(tmp_path / "outline.dxf").layers}
-    assert {"Wing-chain", "wing-2-chain", "a_b-chain", "a_b-2-chain"} <= layers
+    assert {"Wing-chain", "wing_2-chain", "a_b-chain", "a_b_2-chain"} <= layers  # linkwork.names.dxf_layers

@@ -71,7 +71,14 @@ FLAG_LIMITS: dict[str, limits.Limit] = {
     "--workers": limits.WORKERS,
     "--dof": limits.Limit("a whole number of degrees of freedom", 1, 20, whole=True),
     "--link-offset": limits.Limit("a number of body lengths", 0.0, limits.MAX_MAGNITUDE),
-    "--max-link": limits.Limit("a factor of the profiles' extent", 0.0, limits.MAX_MAGNITUDE, open_low=True),
+    "--max-link": limits.Limit("a length in the profiles' units", 0.0, limits.MAX_MAGNITUDE, open_low=True),
+    "--max-link-fraction": limits.Limit(
+        "a multiple of the profiles' largest extent", 0.0, limits.MAX_MAGNITUDE, open_low=True
+    ),
+    "--max-structural-error": limits.Limit(
+        "a length in the profiles' units", 0.0, limits.MAX_MAGNITUDE, open_low=True
+    ),
+    "--gallery": limits.Limit("a number of candidates", 0, 500, whole=True),
     "--min-transmission": limits.Limit("an angle in degrees", 0.0, 90.0, open_high=True),
     "--attempts": limits.Limit("a whole number of designs", 1, 100_000, whole=True),
     "--designs": limits.Limit("a whole number of designs", 1, 20, whole=True),

@@ -75,6 +75,11 @@ class LinkageEntry:
             kwargs[key] = param.default if key not in given else self._checked(key, param, given[key])
         return self.build(**kwargs)
 
+    def check_value(self, key: str, value: Any) -> float | int | str:
+        """``value`` (file units) of parameter ``key`` checked against its range or pattern and converted to API
+        units; a :class:`SpecError` naming the parameter otherwise."""
+        return self._checked(key, self.params[key], value)
+
     def _checked(self, key: str, param: Param, value: Any) -> float | int | str:
         """``value`` (file units) checked against ``param`` and converted to API units."""
         if param.unit == "text":

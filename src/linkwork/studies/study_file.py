@@ -226,12 +226,17 @@ def _grid_values(reader: TomlReader, value: Any, key: str) -> list[Any]:
 
 
 def _check_linkage_grid(reader: TomlReader, grid: dict[str, list[Any]]) -> None:
-    """Every value of a built-in's parameter a finite number (its range is the built-in's own, checked by
-    :func:`linkwork.studies.sweep.prepare_study`)."""
+    """Every value of a built-in's parameter a finite number, or a one-line text for a text parameter (its range
+    or pattern is the built-in's own, checked by :func:`linkwork.studies.sweep.prepare_study`)."""
     for key, values in grid.items():
         for i, value in enumerate(values):
+            if isinstance(value, str) and 0 < len(value) <= MAX_NAME_CHARS and value.isprintable():
+                continue
             if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(float(value)):
-                raise reader.error(f"grid.{key}[{i}]", f"expected a finite number, got {show(value)}")
+                raise reader.error(
+                    f"grid.{key}[{i}]",
+                    f"expected a finite number (or a text parameter's value), got {show(value)}",
+                )
 
 
 def _check_synthesis_grid(reader: TomlReader, grid: dict[str, list[Any]]) -> None:

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from linkwork.errors import LinkworkError, RequestNotMetError
+from linkwork.errors import LinkworkError, RequestNotMetError, SpecError
 from linkwork.io.toml_reader import TomlReader
 from linkwork.messages import escape_line, show
 from linkwork.names import NameMap, csv_columns
@@ -239,6 +239,12 @@ def prepare_study(study: Study) -> Study:
             param = entry.params[key]
             low, high = param.bounds
             for i, value in enumerate(values):
+                if param.unit == "text" or isinstance(value, str):
+                    try:
+                        entry.check_value(key, value)
+                    except SpecError as exc:
+                        raise reader.error(f"grid.{key}[{i}]", str(exc).split(": ", 1)[-1]) from None
+                    continue
                 whole = param.unit != "int" or float(value).is_integer()
                 if not (whole and low <= value <= high):
                     kind = "a whole number" if param.unit == "int" else "a number"
