@@ -18,7 +18,7 @@ from typing import Any
 
 from linkwork.errors import SpecError
 from linkwork.io.toml_reader import show
-from linkwork.outputs.staging import console, staged_output
+from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.search import MEASURE_COLUMNS, SearchStudy, evaluate, ranked
 
 RECORDS = Path(".linkwork-search") / "records.jsonl"
@@ -31,8 +31,9 @@ OUTPUT_NAMES = (
     "gallery.html",
     "viewers",
     "search.json",
+    "candidates.png",
 )
-"""What a search writes into its output folder at the end."""
+"""What a search writes into its output folder at the end (the figure when matplotlib is installed)."""
 
 RECORD_FORMAT = "linkwork-search-records/1"
 
@@ -138,6 +139,17 @@ def write_search_outputs(
     with staged_output(out) as stage:
         write_table(rows, cols, stage / "candidates.parquet", stage / "candidates.csv")
         _write_ranked(best, ["rank", *cols], stage / "ranked.csv")
+        if have_matplotlib():
+            from linkwork.viz.search_plots import plot_candidates
+
+            limits = search.criteria
+            plot_candidates(
+                search.study.name,
+                rows,
+                stage / "candidates.png",
+                limits.max_membrane_stretch,
+                limits.max_bundle_ratio,
+            )
         (stage / "search.json").write_text(
             json.dumps(_finite(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
