@@ -36,6 +36,7 @@ from linkwork.mechanization.search import (
     roots,
 )
 from linkwork.mechanization.verify import Verification, verify
+from linkwork.messages import show
 from linkwork.synthesis.result import SynthesisResult
 
 
@@ -326,6 +327,37 @@ REDRIVES = 3
 LINK_JOINT = re.compile(r"^(D[1-9][0-9]*[ams]|A1[ams])$")
 
 
+#: The names a chain built by :mod:`linkwork.mechanization.chain` gives its joints (``J<k>`` revolute, ``S<k>``
+#: slides) and bodies (``ground``, ``s<k>``, a split segment's ``s<k>a`` / ``s<k>b``).
+CHAIN_JOINT = re.compile(r"^[JS][1-9][0-9]*$")
+CHAIN_BODY = re.compile(r"^(ground|s[1-9][0-9]*[ab]?)$")
+
+
+def check_name_forms(options: MechanizeOptions) -> None:
+    """Refuse a ``drive`` or ``root`` that no chain can have, before anything is synthesised or searched: a drive
+    is a chain joint (``J<k>``, ``S<k>``) or a joint of an added link; a root a body (``ground``, ``s<k>``,
+    ``s<k>a``, ``s<k>b``). Whether the chain at hand has it is :func:`check_names`'s.
+
+    Raises
+    ------
+    SpecError
+        Naming the option and the forms expected (bad input, exit code 2).
+    """
+    if options.root is not None and not CHAIN_BODY.match(options.root):
+        raise SpecError(
+            f"unknown body {show(options.root)}; expected a body of the chain: ground, s<k>, s<k>a or s<k>b",
+            key="root",
+        )
+    if options.drive is not None and not (
+        CHAIN_JOINT.match(options.drive) or LINK_JOINT.match(options.drive)
+    ):
+        raise SpecError(
+            f"unknown joint {show(options.drive)}; expected a chain joint (J<k>, S<k>) or a joint of an added link: "
+            "D<k>a, D<k>m, D<k>s or A1s",
+            key="drive",
+        )
+
+
 def check_names(chain: ShapeChain, options: MechanizeOptions) -> None:
     """Refuse a ``drive`` or ``root`` that no design of this chain can have, naming the choices.
 
@@ -356,6 +388,7 @@ def _check(options: MechanizeOptions) -> None:
     SpecError
         Naming the option and what was expected.
     """
+    check_name_forms(options)
     if options.dof < 1:
         raise SpecError(f"{options.dof}: expected a whole number >= 1", key="dof")
     for key, choices in (("actuator", ACTUATORS), ("binary_links", BINARY_LINKS), ("anchors", ANCHORS)):

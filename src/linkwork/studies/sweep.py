@@ -239,12 +239,16 @@ def prepare_study(study: Study) -> Study:
             param = entry.params[key]
             low, high = param.bounds
             for i, value in enumerate(values):
-                if param.unit == "text" or isinstance(value, str):
+                if param.unit == "text":
                     try:
                         entry.check_value(key, value)
-                    except SpecError as exc:
-                        raise reader.error(f"grid.{key}[{i}]", str(exc).split(": ", 1)[-1]) from None
+                    except SpecError:
+                        raise reader.error(
+                            f"grid.{key}[{i}]", f"expected {param.help}, got {show(value)}"
+                        ) from None
                     continue
+                if isinstance(value, str):
+                    raise reader.error(f"grid.{key}[{i}]", f"expected a finite number, got {show(value)}")
                 whole = param.unit != "int" or float(value).is_integer()
                 if not (whole and low <= value <= high):
                     kind = "a whole number" if param.unit == "int" else "a number"
