@@ -89,6 +89,10 @@ def synth(
 
     options = resolve_options(spec, flags)  # a bad flag or key stops here, before the synthesis
     mechanizing = (spec.mechanize or bool(flags)) if mechanize is None else mechanize
+    if mechanizing:  # a drive or root no chain can have: refused before anything is synthesised
+        from linkwork.mechanization.mechanize import check_name_forms
+
+        check_name_forms(options)
     with progress_bar("[bold]synthesising[/]", None) as progress:
         result = synthesize(spec, progress=progress, search=search, prune=not exhaustive)  # type: ignore[arg-type]
 

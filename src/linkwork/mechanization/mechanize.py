@@ -388,7 +388,6 @@ def _check(options: MechanizeOptions) -> None:
     SpecError
         Naming the option and what was expected.
     """
-    check_name_forms(options)
     if options.dof < 1:
         raise SpecError(f"{options.dof}: expected a whole number >= 1", key="dof")
     for key, choices in (("actuator", ACTUATORS), ("binary_links", BINARY_LINKS), ("anchors", ANCHORS)):

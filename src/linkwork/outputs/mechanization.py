@@ -26,13 +26,10 @@ def resolve_options(problem: Problem, flags: Mapping[str, Any] | None = None) ->
         Naming the problem file's key or the flag, and what was expected.
     """
     from linkwork.mechanization import options_from_values
-    from linkwork.mechanization.mechanize import check_name_forms
 
     source = str(problem.source) if problem.source is not None else None
     options = options_from_values(problem.mechanize_options, source=source)
-    options = options_from_values(flags or {}, base=options, flags=True)
-    check_name_forms(options)  # a drive or root no chain can have: refused before anything is synthesised
-    return options
+    return options_from_values(flags or {}, base=options, flags=True)
 
 
 def mechanize_into(
