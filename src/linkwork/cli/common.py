@@ -228,6 +228,12 @@ def progress_bar(label: str, total: int | None, *, fraction: bool = False) -> It
 
 def parse_until(text: str | None) -> tuple[str, float] | None:
     """``--until JOINT=VALUE`` (VALUE in degrees, or a length for a prismatic joint), or None without the flag."""
+    return parse_joint_value(text, "--until", "A=87.0067")
+
+
+def parse_joint_value(text: str | None, flag: str, example: str) -> tuple[str, float] | None:
+    """A ``flag JOINT=VALUE`` (VALUE in degrees, or a length for a prismatic joint), or None without the flag;
+    anything else is one line naming the flag, with ``example``."""
     if text is None:
         return None
     name, sep, raw = text.partition("=")
@@ -236,7 +242,7 @@ def parse_until(text: str | None) -> tuple[str, float] | None:
     except ValueError:
         value = float("nan")
     if not sep or not name.strip() or not math.isfinite(value):
-        raise fail(f"--until {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=87.0067")
+        raise fail(f"{flag} {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. {example}")
     return name.strip(), value
 
 

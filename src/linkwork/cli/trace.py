@@ -16,13 +16,13 @@ from linkwork.cli.common import (
     friendly_errors,
     parse_assignments,
     parse_couple,
+    parse_joint_value,
     parse_until,
     progress_bar,
     until_in_api_units,
 )
 from linkwork.cli.out_folder import out_help, run_folder, spec_label
 from linkwork.errors import RequestNotMetError
-from linkwork.io.toml_reader import show
 from linkwork.outputs.staging import check_output_folder, console
 
 MAX_STEP_DEG = 90.0
@@ -191,16 +191,7 @@ def trace(
 
 def _parse_deployed_at(text: str | None) -> tuple[str, float] | None:
     """``--deployed-at JOINT=VALUE`` (degrees, or a length), or None without the flag."""
-    if text is None:
-        return None
-    name, sep, raw = text.partition("=")
-    try:
-        value = float(raw)
-    except ValueError:
-        value = float("nan")
-    if not sep or not name.strip() or not math.isfinite(value):
-        raise fail(f"--deployed-at {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. A=128.6822")
-    return name.strip(), value
+    return parse_joint_value(text, "--deployed-at", "A=128.6822")
 
 
 def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:
