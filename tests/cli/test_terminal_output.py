@@ -65,3 +65,22 @@ def test_a_name_far_from_every_built_in_gets_no_suggestion() -> None:
     result = runner.invoke(app, ["trace", "zzqqxx"])
     assert result.exit_code == 2
     assert "did you mean" not in result.stderr and "built-ins are bennett" in result.stderr
+
+
+def test_a_section_rule_printed_to_a_pipe_stays_a_line_wide(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The console is 10,000 characters wide on a pipe (for tables); a rule (the demo's section titles) must not
+    fill that: at most RULE_WIDTH characters, title included."""
+    from rich.text import Text
+
+    from linkwork.outputs.staging import RULE_WIDTH, console
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    buffer = io.StringIO()
+    with redirect_stdout(buffer):
+        console.file = buffer
+        try:
+            console.rule(Text("1. Tracing", style="bold"))
+        finally:
+            console.file = None  # type: ignore[assignment]
+    lines = [ANSI.sub("", line) for line in buffer.getvalue().splitlines() if line.strip()]
+    assert len(lines) == 1 and "1. Tracing" in lines[0] and 40 <= len(lines[0]) <= RULE_WIDTH

@@ -6,7 +6,11 @@ from __future__ import annotations
 
 import os
 
+from rich.align import AlignMethod
 from rich.console import Console, ConsoleDimensions
+from rich.rule import Rule
+from rich.style import Style
+from rich.text import Text
 
 from linkwork.io.writer import MANIFEST, check_output_file, check_output_folder, staged_output, write_file
 
@@ -19,6 +23,9 @@ __all__ = [
     "staged_output",
     "write_file",
 ]
+
+RULE_WIDTH = 120
+"""The widest a section rule is drawn (characters)."""
 
 FILE_WIDTH = 10_000
 """The width (characters) of the console when standard output is a file or a pipe and ``COLUMNS`` is not set."""
@@ -39,6 +46,19 @@ class _SummaryConsole(Console):
     @size.setter
     def size(self, new_size: tuple[int, int]) -> None:
         self._width, self._height = new_size
+
+    def rule(
+        self,
+        title: str | Text = "",
+        *,
+        characters: str = "\u2500",
+        style: str | Style = "rule.line",
+        align: AlignMethod = "center",
+    ) -> None:
+        """A horizontal rule no wider than :data:`RULE_WIDTH` (on a file or a pipe the console is
+        :data:`FILE_WIDTH` wide for tables, which a rule would fill)."""
+        rule = Rule(title, characters=characters, style=style, align=align)
+        self.print(rule, width=min(self.size.width, RULE_WIDTH))
 
 
 console: Console = _SummaryConsole(markup=False)
