@@ -7,8 +7,10 @@ annihilates the tangent, so every plane transverse to it gives the same least re
 holding the drive it stays well posed at a fold of the drive, where the path turns back; ``r`` is the stacked loop logarithm (closure residual, Eq. (23) in twist form) and ``T`` the weight
 of :mod:`linkwork.studies.scale` at point ``k`` (moments about the centre of the hinge lines there), so the misfit is
 a length in the linkage's units, whichever body is the ground. It is solved by Gauss-Newton
-(normal equations, Cholesky, with backtracking), warm-started along the path from the previous drive value's
-solution shifted by the nominal step. The compiled batch kernel runs many samples and all drive values in one call.
+(normal equations, Cholesky, with backtracking), warm-started along the path from the solutions' offsets from the
+nominal path at the last three drive values, extrapolated (each refined by its last, unevaluated Gauss-Newton
+step): one evaluation usually ends a solve. The compiled batch kernel runs many samples and all drive values in
+one call.
 
 References
 ----------
@@ -70,12 +72,21 @@ def _on_plane(u_path: np.ndarray, normal: np.ndarray, k: int, y: np.ndarray, u: 
 
 
 @kernel(inline="always")
-def _warm_start(u_path: np.ndarray, normal: np.ndarray, k: int, u: np.ndarray, y: np.ndarray) -> None:
-    """``y = Q_k^T (u - u_{k-1})``: the previous point's offset from the path, carried into point ``k``'s plane."""
+def _warm_start(u_path: np.ndarray, normal: np.ndarray, k: int, offsets: np.ndarray, y: np.ndarray) -> None:
+    """``y = Q_k^T e``: the solutions' offset from the path ``e``, extrapolated to point ``k`` and carried into its
+    plane; ``offsets[i]`` is the offset at point ``k - 1 - i`` (a polynomial through the last three: the offset
+    changes smoothly along the path, so the guess is close enough that one evaluation usually ends the solve)."""
+    have = min(k, 3)
     for c in range(y.shape[0]):
         acc = 0.0
-        for a in range(u.shape[0]):
-            acc += normal[k, a, c] * (u[a] - u_path[k - 1, a])
+        for a in range(u_path.shape[1]):
+            if have == 3:
+                e = 3.0 * offsets[0, a] - 3.0 * offsets[1, a] + offsets[2, a]
+            elif have == 2:
+                e = 2.0 * offsets[0, a] - offsets[1, a]
+            else:
+                e = offsets[0, a]
+            acc += normal[k, a, c] * e
         y[c] = acc
 
 
@@ -135,16 +146,21 @@ def misfit_along_path(
     y = np.zeros(p)
     y_old = np.zeros(p)
     u = np.empty(m)
+    offsets = np.zeros((3, m))  # the solutions' offsets from the path at the last three points, newest first
     for k in range(K):
         if k > 0:
-            _warm_start(u_path, normal, k, u, y)
+            _warm_start(u_path, normal, k, offsets, y)
         best = np.inf
         halvings = 0
+        gain = np.inf  # what the last step was predicted to gain
+        refined = False
         for _ in range(max_iter):
             _on_plane(u_path, normal, k, y, u)
             expand(u, groups, q)
             closure_pass(mech, q, T[k], r, J, matrices, vectors)
             norm = np.sqrt(np.sum(r * r))
+            if norm > best * (1.0 + 1e-10) and gain <= 1e-6 * best * best:
+                break  # a step predicted to gain next to nothing came out worse: round-off; best is the minimum
             if norm > best * (1.0 + 1e-10) and halvings < 30:
                 # The step made things worse: go back half way (Gauss-Newton with backtracking).
                 for c in range(p):
@@ -162,7 +178,13 @@ def misfit_along_path(
             _solve_normal(Jy, r, dy, A, b)
             # The step lowers |r|^2 by |Jy dy|^2 to first order: when that is below 1e-8 |r|^2 the misfit is
             # known to 1e-8 relative already, and a further evaluation would not change it.
-            if _predicted_gain(Jy, dy) <= 1e-8 * norm * norm:
+            gain = _predicted_gain(Jy, dy)
+            if gain <= 1e-8 * norm * norm:
+                # The misfit is ``best``; the next points start from this solution refined by the step (not
+                # evaluated), so that their extrapolated start is accurate.
+                for c in range(p):
+                    y[c] = y_old[c] + dy[c]
+                refined = True
                 break
             step = 0.0
             for c in range(p):
@@ -170,7 +192,10 @@ def misfit_along_path(
                 step = max(step, abs(dy[c]))
             if step < 1e-15:
                 break
-        _on_plane(u_path, normal, k, y_old, u)
+        _on_plane(u_path, normal, k, y if refined else y_old, u)
+        for a in range(m):
+            offsets[2, a], offsets[1, a] = offsets[1, a], offsets[0, a]
+            offsets[0, a] = u[a] - u_path[k, a]
         out[k] = best
 
 
