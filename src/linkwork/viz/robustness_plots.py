@@ -19,6 +19,19 @@ def _positive(values: list[float | None]) -> np.ndarray:
     return np.where(a > 0, a, np.nan)
 
 
+#: A misfit below this many of the linkage's length L is round-off (the corrector's closure tolerance is 1e-12):
+#: the bands draw it on this floor, so that noise of a structure that keeps its mobility is not drawn as decades
+#: of spikes on the log axis.
+ROUNDOFF = 1e-12
+
+
+def _misfit(values: list[float | None], floor: float) -> np.ndarray:
+    """A misfit band with round-off drawn on ``floor``; zero (the start, where the imperfect structure is
+    assembled) and missing values stay gaps."""
+    a = np.array([np.nan if v is None else v for v in values], dtype=float)
+    return np.where(a > 0, np.maximum(a, floor), np.nan)
+
+
 def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     """Misfit percentiles (5-95 % band, median, largest) against the drive, the first-order median and 95 %
     curves, and on a second axis the paper's ratio of largest to smallest non-zero singular value."""
@@ -35,16 +48,22 @@ def plot_bands(summary: dict[str, Any], file: Path) -> Path:
     # A path on which the drive turns back (a closed path, a fold) is drawn against the point number instead.
     x = drive if monotonic else np.arange(drive.size, dtype=float)
     fig, ax = plt.subplots(figsize=(8.0, 5.0), layout="constrained")
-    ax.fill_between(x, _positive(b["p5"]), _positive(b["p95"]), color="tab:blue", alpha=0.25, label="5-95 %")
-    ax.plot(x, _positive(b["p50"]), color="tab:blue", label="median (Monte Carlo)")
-    ax.plot(x, _positive(b["max"]), ":", color="tab:blue", label="largest sample")
-    ax.plot(x, _positive(b["first_order_p50"]), "--", color="tab:orange", label="median (first order)")
-    ax.plot(x, _positive(b["first_order_p95"]), "-.", color="tab:orange", label="95 % (first order)")
-    top = np.nanmax(_positive(b["max"])) if np.any(np.isfinite(_positive(b["max"]))) else np.nan
-    if np.isfinite(top):
+    floor = ROUNDOFF * float(summary["scale"]["length"])
+    ax.fill_between(
+        x, _misfit(b["p5"], floor), _misfit(b["p95"], floor), color="tab:blue", alpha=0.25, label="5-95 %"
+    )
+    ax.plot(x, _misfit(b["p50"], floor), color="tab:blue", label="median (Monte Carlo)")
+    ax.plot(x, _misfit(b["max"], floor), ":", color="tab:blue", label="largest sample")
+    ax.plot(x, _misfit(b["first_order_p50"], floor), "--", color="tab:orange", label="median (first order)")
+    ax.plot(x, _misfit(b["first_order_p95"], floor), "-.", color="tab:orange", label="95 % (first order)")
+    largest = _misfit(b["max"], floor)
+    if np.any(np.isfinite(largest)):
+        top = float(np.nanmax(largest))
         ax.set_yscale("log")
-        # The start (where the imperfect structure is assembled) has no misfit: show five decades below the top.
-        ax.set_ylim(bottom=10.0 ** (np.floor(np.log10(top)) - 4.0), top=top * 2.0)
+        # The start (where the imperfect structure is assembled) has no misfit: show five decades below the top,
+        # down to the round-off floor at most.
+        bottom = max(10.0 ** (np.floor(np.log10(top)) - 4.0), 0.5 * floor)
+        ax.set_ylim(bottom=bottom, top=max(top * 2.0, 10.0 * floor))
     unit = "deg" if key == "drive_deg" else "length unit"
     if monotonic:
         ax.set_xlabel(f"drive {plain(str(summary['drive']))} ({unit})")
