@@ -46,12 +46,13 @@ def wait_for_samples(proc: subprocess.Popen[bytes], folder: Path, timeout: float
     time.sleep(1.0)  # a few chunks more
 
 
-def check_partial(out: Path, err: bytes, reason: str) -> dict[str, object]:
+def check_partial(out: Path, err: bytes, reason: str | tuple[str, ...]) -> dict[str, object]:
     import pyarrow.parquet as pq
 
     text = err.decode()
+    reasons = (reason,) if isinstance(reason, str) else reason
     assert "Traceback" not in text and len(text.strip().splitlines()) == 1, text[:3000]
-    assert text.startswith(f"error: {reason}"), text
+    assert text.startswith(tuple(f"error: {r}" for r in reasons)), text
     summary = json.loads((out / "robustness.json").read_text())
     assert summary["complete"] is False and summary["samples_asked"] == 2_000_000
     table = pq.read_table(out / "samples.parquet")
@@ -232,7 +233,9 @@ def test_losing_the_scheduler_keeps_what_was_computed_and_exits_3(tmp_path: Path
         scheduler.kill()
         _, err = proc.communicate(timeout=120)
         assert proc.returncode == 3, err
-        check_partial(out, err, "lost the Dask scheduler")
+        # The scheduler's death reaches the client either as such or as every worker gone with it (they lose
+        # their scheduler too): which comes first is a race; both keep what was computed, exit 3.
+        check_partial(out, err, ("lost the Dask scheduler", "lost every Dask worker"))
     finally:
         scheduler.kill()
         os.killpg(workers.pid, signal.SIGKILL)
