@@ -79,6 +79,26 @@ def correct(mech, u, held, corrector, q, res, jac):
     return correct_in(mech, u, held, corrector, (q, res, jac, matrices, vectors))
 
 
+GOING, FAILED_SOLVE, CONVERGED = -1, 0, 1
+"""What :func:`verdict` says of a corrector iteration."""
+
+
+@kernel(inline="always")
+def verdict(r, prev, it, exact, accept, max_iter):
+    """The corrector's stopping rule after iteration ``it`` left residual ``r`` (``prev`` the one before):
+    :data:`CONVERGED` below ``exact``, or stalled (fell by less than half) below ``accept``; :data:`FAILED_SOLVE`
+    not finite, out of iterations, or growing after two; else :data:`GOING`. One rule for every corrector."""
+    if not np.isfinite(r):
+        return FAILED_SOLVE
+    if r < exact:
+        return CONVERGED
+    if r < accept and r > 0.5 * prev:
+        return CONVERGED
+    if it == max_iter or (it >= 2 and r > prev):
+        return FAILED_SOLVE
+    return GOING
+
+
 @kernel()
 def correct_in(mech, u, held, corrector, work):
     """Gauss-Newton with the truncated-SVD pseudo-inverse (Eq. (28)), in place on ``u`` (``work`` as in
@@ -98,14 +118,9 @@ def correct_in(mech, u, held, corrector, work):
     accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
         r = evaluate_in(mech, u, work)
-        if not np.isfinite(r):
-            return False, it, r
-        if r < exact:
-            return True, it, r
-        if r < accept and r > 0.5 * prev:
-            return True, it, r
-        if it == max_iter or (it >= 2 and r > prev):
-            return False, it, r
+        state = verdict(r, prev, it, exact, accept, max_iter)
+        if state != GOING:
+            return state == CONVERGED, it, r
         prev = r
         if held >= 0:
             for e in range(jac.shape[0]):
@@ -151,14 +166,9 @@ def correct_across(mech, u, t, corrector, work):
     accept = max(tol, roundoff * exact)
     for it in range(max_iter + 1):
         r = evaluate_in(mech, u, work)
-        if not np.isfinite(r):
-            return False, it, r
-        if r < exact:
-            return True, it, r
-        if r < accept and r > 0.5 * prev:
-            return True, it, r
-        if it == max_iter or (it >= 2 and r > prev):
-            return False, it, r
+        state = verdict(r, prev, it, exact, accept, max_iter)
+        if state != GOING:
+            return state == CONVERGED, it, r
         prev = r
         gap = 0.0
         for a in range(m):
