@@ -58,6 +58,18 @@ class MarchSettings:
 FOLD_MOVING = 1e-8
 
 
+def first_joints(mech: Mechanism) -> list[int]:
+    """The first joint of each unknown, in unknown order (``mech.group_members()[g][0]`` for every ``g``, in one
+    pass over the joints)."""
+    first: list[int] = []
+    for j, g in enumerate(mech.groups.tolist()):
+        if g >= len(first):
+            first.extend([-1] * (g + 1 - len(first)))
+        if g >= 0 and first[g] < 0:
+            first[g] = j
+    return first
+
+
 @dataclass
 class Chunk:
     """The rows one call of the compiled march wrote (row 0 is its start), its stop code (a
@@ -136,9 +148,12 @@ class BranchMarcher:
         switch_branches: bool,
         progress: Progress | None = None,
         kernels: Backend | None = None,
+        workspace: Workspace | None = None,
     ) -> None:
         self.mech = mech
-        self.ws = Workspace.of(mech, kernels)  # the kernels the whole trace runs (chosen by its caller)
+        # The kernels the whole trace runs (chosen by its caller), in the caller's workspace when it has one.
+        self.ws = workspace if workspace is not None else Workspace.of(mech, kernels)
+        self.first_joint = first_joints(mech)
         self.cfg = settings
         self.max_steps = max_steps
         self.budget = max_steps
@@ -229,8 +244,10 @@ class BranchMarcher:
         """The :class:`End` of a branch whose last point is ``u``: ``about`` is the unknown the reason is about
         (``None``: the drive), reported as its first joint and that joint's value at ``u``."""
         g = self.cfg.drive if about is None else about
-        j = self.mech.group_members()[g][0]
-        value = float(self.mech.angles_from_q(self.mech.q_from_u(u))[j])
+        j = self.first_joint[g]
+        value = float(
+            u[g] + self.mech.offsets[j]
+        )  # the joint's value (angles_from_q of q_from_u, at joint j)
         return End(kind, text, self.mech.joint_names[j], value, point)
 
     def _march_branch(
@@ -272,10 +289,11 @@ class BranchMarcher:
                         StopReason.TARGET
                     )  # the closing step passed over the target (or ends on it): land there
             limit = self._land_on_limit(chunk) if chunk.code == StopReason.LIMIT else None
-            component = self._component_entry(chunk)
+            ranks = numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)  # every row's rank, once
+            component = self._component_entry(chunk, ranks)
             if component is not None:
                 chunk.count = component + 1
-            landed = self._landed_row(chunk, component)
+            landed = self._landed_row(chunk, component, ranks)
             if (
                 landed is not None
             ):  # a step landed on a singular point: the rows after it may be on another branch
@@ -346,20 +364,20 @@ class BranchMarcher:
         cfg, c = self.cfg, chunk.count
         u_b = chunk.u[c - 1]
         over = np.flatnonzero((u_b < cfg.lo) | (u_b > cfg.hi))
-        reason = "limit " + ", ".join(self.mech.joint_names[self.mech.group_members()[g][0]] for g in over)
+        reason = "limit " + ", ".join(self.mech.joint_names[self.first_joint[g]] for g in over)
         g = int(over[0])
         self._land(chunk, g, cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g])
         return g, reason
 
-    def _landed_row(self, chunk: Chunk, component: int | None) -> int | None:
+    def _landed_row(self, chunk: Chunk, component: int | None, ranks: NDArray[np.int64]) -> int | None:
         """The first row after the chunk's start where the Jacobian's rank has dropped below the path's, unless
         it is where the branch enters a higher-dimensional component: a step that landed on a singular point
         (equal drive steps landing on a bifurcation point), where the march's tangent is any vector of a null
-        space of dimension two and the sign of the test function means nothing."""
+        space of dimension two and the sign of the test function means nothing. ``ranks``: the rank of each row
+        of the chunk (as the march returned it)."""
         if chunk.count < 2:
             return None
-        ranks = numerical_ranks(chunk.sigma[1 : chunk.count], self.cfg.tol)
-        low = np.flatnonzero(ranks < self.cfg.r_path)
+        low = np.flatnonzero(ranks[1 : chunk.count] < self.cfg.r_path)
         if len(low) == 0:
             return None
         row = int(low[0]) + 1
@@ -525,12 +543,15 @@ class BranchMarcher:
             self.max_misfit = max(self.max_misfit, float(np.max(chunk.res[begin:count])))
 
     # ---- what a chunk meets
-    def _component_entry(self, chunk: Chunk) -> int | None:
-        """Index of the first of ``component_points`` consecutive points of mobility >= 2, if any."""
+    def _component_entry(self, chunk: Chunk, ranks: NDArray[np.int64]) -> int | None:
+        """Index of the first of ``component_points`` consecutive points of mobility >= 2, if any (``ranks``: the
+        rank of each row of the chunk)."""
         need = self.cfg.tol.component_points
         if chunk.count < need:
             return None
-        mobility = len(chunk.u[0]) - numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)
+        mobility = len(chunk.u[0]) - ranks
+        if not np.any(mobility >= 2):
+            return None
         run = 0
         for k, mob in enumerate(mobility):
             run = run + 1 if mob >= 2 else 0
@@ -561,9 +582,9 @@ class BranchMarcher:
             return
         ratio = chunk.sigma[:count, r_path - 1] / chunk.sigma[:count, 0]
         tau = chunk.tau
-        for k in range(1, count - 1):
-            if not (ratio[k] <= ratio[k - 1] and ratio[k] < ratio[k + 1] and ratio[k] < tol.local_min):
-                continue
+        inner = ratio[1:-1]
+        minima = (inner <= ratio[:-2]) & (inner < ratio[2:]) & (inner < tol.local_min)
+        for k in (minima.nonzero()[0] + 1).tolist():
             if tau[k - 1] * tau[k] < 0.0 or tau[k] * tau[k + 1] < 0.0:
                 continue  # a sign change: located by the test function
             u_min, r_min = locate_minimum(
@@ -586,7 +607,7 @@ class BranchMarcher:
         d = self.cfg.drive
         td = chunk.t[: chunk.count, d]
         moving = np.maximum(np.abs(td[:-1]), np.abs(td[1:])) > FOLD_MOVING
-        joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.mech.group_members()[d][0]
+        joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.first_joint[d]
         for k in np.flatnonzero((td[:-1] * td[1:] < 0.0) & moving):
             u_a, u_b = chunk.u[k], chunk.u[k + 1]
             u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol)
