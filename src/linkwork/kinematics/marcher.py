@@ -84,11 +84,13 @@ class Chunk:
     count: int
     code: int
     h: float
+    rank: NDArray[np.int64] | None = None  # each row's numerical rank, once the marcher has computed it
 
 
 @dataclass
 class Rows:
-    """Growing per-point storage, one block of rows per compiled march call."""
+    """Growing per-point storage, one block of rows per compiled march call (``rank``: each row's numerical rank,
+    kept beside ``sigma`` when every block has it, else computed by the caller)."""
 
     u: list[Array] = field(default_factory=list)
     sigma: list[Array] = field(default_factory=list)
@@ -97,9 +99,11 @@ class Rows:
     s: list[Array] = field(default_factory=list)
     branch: list[NDArray[np.int64]] = field(default_factory=list)
     step: list[NDArray[np.int64]] = field(default_factory=list)
+    rank: list[NDArray[np.int64]] = field(default_factory=list)
 
-    def add_point(self, u: Array, sigma: Array, res: float, branch: int) -> None:
+    def add_point(self, u: Array, sigma: Array, res: float, branch: int, rank: int) -> None:
         """Append one point (a bifurcation point opening a branch: arclength 0, step 0, test 0)."""
+        self.rank.append(np.array([rank], dtype=np.int64))
         self.u.append(u[None, :].copy())
         self.sigma.append(sigma[None, :].copy())
         self.res.append(np.array([res]))
@@ -290,6 +294,7 @@ class BranchMarcher:
                     )  # the closing step passed over the target (or ends on it): land there
             limit = self._land_on_limit(chunk) if chunk.code == StopReason.LIMIT else None
             ranks = numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)  # every row's rank, once
+            chunk.rank = ranks
             component = self._component_entry(chunk, ranks)
             if component is not None:
                 chunk.count = component + 1
@@ -534,6 +539,9 @@ class BranchMarcher:
         begin = 0 if first else 1
         rows.u.append(chunk.u[begin:count])
         rows.sigma.append(chunk.sigma[begin:count])
+        if chunk.rank is None:
+            chunk.rank = numerical_ranks(chunk.sigma[:count], self.cfg.tol)
+        rows.rank.append(chunk.rank[begin:count])
         rows.res.append(chunk.res[begin:count])
         rows.tau.append(chunk.tau[begin:count])
         rows.s.append(s_base + chunk.s[begin:count])
@@ -675,6 +683,7 @@ class BranchMarcher:
         rows = self.rows
         rows.u[-1][-1] = point
         rows.sigma[-1][-1] = np.linalg.svd(j_known, compute_uv=False)[: self.cfg.n_sigma]
+        rows.rank[-1][-1] = numerical_rank(rows.sigma[-1][-1], self.cfg.tol)
         rows.res[-1][-1] = r_known
         rows.tau[-1][-1] = 0.0
         self._arrived(known, diff)
@@ -742,7 +751,7 @@ class BranchMarcher:
             # Record the bifurcation point itself as the branch's first point, then march on.
             r_star, _, jst = self.ws.evaluate(job.u)
             sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
-            self.rows.add_point(job.u, sigma_star, r_star, bid)
+            self.rows.add_point(job.u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
             s_off = float(np.linalg.norm(u1 - job.u))
             start_len = len(self.rows.u)
             basis = np.ascontiguousarray(U1[:, : cfg.r_path])

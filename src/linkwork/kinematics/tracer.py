@@ -216,7 +216,8 @@ def _assemble(
     U = np.concatenate(rows.u)
     q = mech.q_from_u(U)
     sigma = np.concatenate(rows.sigma)
-    ranks = numerical_ranks(sigma, tol)
+    # every row's rank, as the marcher computed it (the closed-form rows come without)
+    ranks = np.concatenate(rows.rank) if len(rows.rank) == len(rows.sigma) else numerical_ranks(sigma, tol)
     branch = np.concatenate(rows.branch)
     angles = mech.angles_from_q(q)
     m = mech.n_unknowns
@@ -229,10 +230,11 @@ def _assemble(
     ]
     unmet = None
     if until is not None:
-        on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
         first = branch_list[0]
         end = End(first.end_kind or StopReason.BUDGET, first.end_reason, first.end_joint, first.end_value)
-        unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
+        if end.kind != StopReason.TARGET:  # reached: no verdict to write (target_verdict says None)
+            on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
+            unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
     residual = np.concatenate(rows.res)
     stats = TraceStats(
         start_rank=marcher.cfg.r_path,
