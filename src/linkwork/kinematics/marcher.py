@@ -546,9 +546,11 @@ class BranchMarcher:
         rows.tau.append(chunk.tau[begin:count])
         rows.s.append(s_base + chunk.s[begin:count])
         rows.branch.append(np.full(count - begin, branch_id, dtype=np.int64))
-        rows.step.append(n_steps + np.arange(begin, count) - begin + (0 if first else 1))
+        rows.step.append(
+            np.arange(n_steps + (0 if first else 1), n_steps + count - begin + (0 if first else 1))
+        )
         if count > begin:
-            self.max_misfit = max(self.max_misfit, float(np.max(chunk.res[begin:count])))
+            self.max_misfit = max(self.max_misfit, float(chunk.res[begin:count].max()))
 
     # ---- what a chunk meets
     def _component_entry(self, chunk: Chunk, ranks: NDArray[np.int64]) -> int | None:
@@ -614,9 +616,12 @@ class BranchMarcher:
         """
         d = self.cfg.drive
         td = chunk.t[: chunk.count, d]
+        turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
+        if len(turned) == 0:
+            return
         moving = np.maximum(np.abs(td[:-1]), np.abs(td[1:])) > FOLD_MOVING
         joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.first_joint[d]
-        for k in np.flatnonzero((td[:-1] * td[1:] < 0.0) & moving):
+        for k in turned[moving[turned]]:
             u_a, u_b = chunk.u[k], chunk.u[k + 1]
             u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol)
             beyond = np.sign(td[k]) * (u_f[d] - np.array([u_a[d], u_b[d]]))

@@ -214,12 +214,14 @@ def _assemble(
     the target."""
     rows = marcher.rows
     U = np.concatenate(rows.u)
-    q = mech.q_from_u(U)
     sigma = np.concatenate(rows.sigma)
     # every row's rank, as the marcher computed it (the closed-form rows come without)
     ranks = np.concatenate(rows.rank) if len(rows.rank) == len(rows.sigma) else numerical_ranks(sigma, tol)
     branch = np.concatenate(rows.branch)
-    angles = mech.angles_from_q(q)
+    if mech.groups.min() >= 0:  # every joint its own unknown or coupled: q_from_u is a gather
+        angles = U[:, mech.groups] + mech.offsets
+    else:
+        angles = mech.angles_from_q(mech.q_from_u(U))
     m = mech.n_unknowns
     branch_list = [
         replace(
