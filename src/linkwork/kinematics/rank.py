@@ -118,8 +118,8 @@ def numerical_rank(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> int:
     if s.size == 0 or s[0] <= 0.0:
         return 0
     rel = s / s[0]
-    sure = int(np.sum(rel > tol.loose))
-    candidates = int(np.sum(rel > tol.floor))
+    sure = int((rel > tol.loose).sum())
+    candidates = int((rel > tol.floor).sum())
     if candidates == sure:
         return sure
     # Cut among the uncertain values at the largest gap (ratio of consecutive values, zeros as the floor).
