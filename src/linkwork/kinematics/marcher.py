@@ -70,6 +70,16 @@ def first_joints(mech: Mechanism) -> list[int]:
     return first
 
 
+def leading_sign(tangent: Array, drive: int, moving: float = 1e-6) -> int:
+    """+1 or -1: the sign of ``tangent``'s drive component, or, when that is below ``moving`` of its largest, of
+    its first component that is not (round-off cannot flip it)."""
+    size = float(np.max(np.abs(tangent)))
+    for x in (tangent[drive], *tangent):
+        if abs(x) > moving * size:
+            return 1 if x > 0.0 else -1
+    return 1
+
+
 @dataclass
 class Chunk:
     """The rows one call of the compiled march wrote (row 0 is its start), its stop code (a
@@ -669,13 +679,18 @@ class BranchMarcher:
         return None
 
     def _add_point(self, bif: Bifurcation, branch_id: int, incoming: Array) -> None:
-        """Keep a classified point and queue its new branches (both directions) when switching branches."""
+        """Keep a classified point and queue its new branches (both directions) when switching branches.
+
+        Of a branch's two directions the one along which the drive increases is queued (and so traced) first, or,
+        where the drive stays put, the one along which the first unknown that moves increases: a branch tangent's
+        sign is whatever the SVD of the point's Jacobian gave it, which round-off can flip."""
         self.found.append(bif)
         if not self.switch_branches or bif.kind != "bifurcation":
             return
         for tb in bif.tangents_u:
             if abs(tb @ incoming) < self.cfg.tol.same_branch:
-                for direction in (1, -1):
+                first = leading_sign(tb, self.cfg.drive)
+                for direction in (first, -first):
                     self.queue.append(QueuedBranch(branch_id, bif.id, bif.u, direction * tb, direction))
 
     def _end_on_known(self, chunk: Chunk, known: int) -> None:
