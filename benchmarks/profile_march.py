@@ -2,10 +2,12 @@
 
 Prints the best time per trace and per step, then the kernels a step is made of, each timed alone in a compiled
 loop (best of ``--repeats``): a closure evaluation (residual and Jacobian, G&P Eqs. (21), (23)), the corrector
-from a predicted point (Eq. (28); Gauss-Newton with the drive held, Cholesky on the normal equations), the tangent
-and test function (one SVD of the Jacobian, its range basis kept continuous, two small determinants) and, inside
-it, numba's ``np.linalg.svd`` of the 6x6 Jacobian (LAPACK ``gesdd``). It also counts, with the plain-Python
-twins, how many of each a trace calls. The share of the SVD in a step is what limits the march.
+from a predicted point one tangent step away (Eq. (28); Gauss-Newton with the drive held, Cholesky on the normal
+equations; the march's cubic predictor usually leaves it one iteration), the tangent and test function as the
+march runs it (one-sided Jacobi SVD warm-started from the previous point's right singular vectors, along the
+trace's own Jacobians; the test function from the singular values and orientations) and, for comparison, the
+same from a cold start and numba's ``np.linalg.svd`` of the 6x6 Jacobian (LAPACK ``gesdd``, what the march called
+before). It also counts, with the plain-Python twins, how many of each a trace calls.
 
 Run: ``python benchmarks/profile_march.py [--repeats 5]`` (single-threaded, on a quiet machine).
 """
@@ -56,6 +58,24 @@ def _tangents(jac: Any, t: Any, basis: Any, r_path: int, t_out: Any, sigma: Any,
     acc = 0.0
     for _ in range(n):
         acc += kernels.tangent_and_test(jac, t, basis.copy(), r_path, t_out, sigma)
+    return acc
+
+
+@njit
+def _warm_tangents(jacs: Any, t0: Any, basis0: Any, r_path: int, sigma: Any, n: int) -> float:
+    """The march's tangent kernel along a trace's Jacobians, warm-started from row to row (per call: one row)."""
+    acc = 0.0
+    E, m = jacs.shape[1], jacs.shape[2]
+    t, t_out = t0.copy(), np.empty(m)
+    svd = kernels.svd_work(E, m)
+    basis = basis0.copy()
+    for i in range(n):
+        k = i % jacs.shape[0]
+        if k == 0:
+            basis[:, :] = basis0
+            t[:] = t0
+        acc += kernels.tangent_and_test_in(jacs[k], t, basis, r_path, t_out, sigma, svd)
+        t[:] = t_out
     return acc
 
 
@@ -115,7 +135,7 @@ def counts(hexagon: lw.Mechanism, until: tuple[str, float]) -> dict[str, int]:
     patched = []
     for scope, name in (
         ("march", "correct_in"),
-        ("march", "tangent_and_test"),
+        ("march", "tangent_and_test_in"),
         ("correct_in", "evaluate_in"),
     ):
         original = scopes[scope][name]
@@ -159,13 +179,16 @@ def main() -> None:
     basis, t = np.ascontiguousarray(U[:, :r_path]), Vt[-1].copy()
     t_out, sigma = np.empty_like(t), np.empty(min(jac.shape))
     corrector = Workspace.corrector(Tolerances())
+    trace = lw.trace(hexagon, until=until, steps=STEPS)
+    jacs = np.array([ws.evaluate(u)[2] for u in hexagon.u_from_q(hexagon.q_from_angles(trace.angles))])
     parts = {
         "closure evaluation": lambda: _evaluations(mech, u, q, res, jac.copy(), LOOPS),
         "corrector from a predicted point": lambda: _corrections(
             mech, u, t, corrector, q, res, jac.copy(), LOOPS
         ),
-        "tangent and test function": lambda: _tangents(jac, t, basis, r_path, t_out, sigma, LOOPS),
-        "  of which np.linalg.svd (6x6)": lambda: _svds(jac, LOOPS),
+        "tangent and test function (warm)": lambda: _warm_tangents(jacs, t, basis, r_path, sigma, LOOPS),
+        "  the same from a cold start": lambda: _tangents(jac, t, basis, r_path, t_out, sigma, LOOPS),
+        "  np.linalg.svd (6x6), for comparison": lambda: _svds(jac, LOOPS),
     }
     for call in parts.values():
         call()  # compile the timing loops

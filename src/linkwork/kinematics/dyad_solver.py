@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
+from linkwork.kinematics.small_svd import orthogonalize_columns, orthonormalize_columns
 
 #: Joint kinds in ``joint_int[:, 0]``.
 REVOLUTE, PRISMATIC = 0, 1
@@ -331,53 +332,18 @@ def singular_values(M, W, V, sigma):
 
     ``V`` (orthogonal, updated in place) is the previous point's right singular vectors: along a path they change
     little, so ``R V`` starts nearly orthogonal and one sweep or two finish it. It is re-orthonormalised first
-    (Gram-Schmidt), so that rounding does not build up over a long path.
+    (Gram-Schmidt), so that rounding does not build up over a long path. The rotations are the shared kernels of
+    :mod:`linkwork.kinematics.small_svd`.
     """
     E = M.shape[1]
-    for c in range(E):
-        for b in range(c):
-            dot = 0.0
-            for a in range(E):
-                dot += V[a, b] * V[a, c]
-            for a in range(E):
-                V[a, c] -= dot * V[a, b]
-        norm = 0.0
-        for a in range(E):
-            norm += V[a, c] * V[a, c]
-        norm = 1.0 / np.sqrt(norm)
-        for a in range(E):
-            V[a, c] *= norm
+    orthonormalize_columns(V)
     for a in range(E):
         for c in range(E):
             acc = 0.0
             for b in range(a, E):
                 acc += M[a, b] * V[b, c]
             W[a, c] = acc
-    for _sweep in range(60):
-        rotated = False
-        for p in range(E - 1):
-            for r in range(p + 1, E):
-                alpha, beta, gamma = 0.0, 0.0, 0.0
-                for a in range(E):
-                    alpha += W[a, p] * W[a, p]
-                    beta += W[a, r] * W[a, r]
-                    gamma += W[a, p] * W[a, r]
-                if abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
-                    continue
-                rotated = True
-                zeta = (beta - alpha) / (2.0 * gamma)
-                tan = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
-                cos = 1.0 / np.sqrt(1.0 + tan * tan)
-                sin = cos * tan
-                for a in range(E):
-                    wp, wr = W[a, p], W[a, r]
-                    W[a, p] = cos * wp - sin * wr
-                    W[a, r] = sin * wp + cos * wr
-                    vp, vr = V[a, p], V[a, r]
-                    V[a, p] = cos * vp - sin * vr
-                    V[a, r] = sin * vp + cos * vr
-        if not rotated:
-            break
+    orthogonalize_columns(W, V, sigma)  # sigma: work space until the norms below
     for c in range(E):
         acc = 0.0
         for a in range(E):

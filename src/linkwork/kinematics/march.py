@@ -20,6 +20,7 @@ import numpy as np
 
 from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import cholesky_in_place, cholesky_solve, closure_pass, expand, work_arrays
+from linkwork.kinematics.small_svd import det_sign_in_place, jacobi_svd
 from linkwork.kinematics.stops import StopReason
 
 # The stop codes the march returns, as the plain ints numba freezes into the kernels (see StopReason).
@@ -58,15 +59,16 @@ def evaluate(mech, u, q, res, jac):
     :mod:`~linkwork.kinematics.kernels`; ``q``, ``res``, ``jac`` are work arrays, ``res`` and ``jac`` the
     results)."""
     matrices, vectors = work_arrays()
-    return evaluate_in(mech, u, (q, res, jac, matrices, vectors))
+    return evaluate_in(mech, u, (q, res, jac, matrices, vectors, solve_work(jac.shape[1])))
 
 
 @kernel()
 def evaluate_in(mech, u, work):
-    """:func:`evaluate` with every work array given, ``work = (q, res, jac, matrices, vectors)`` (the last two
-    from :func:`~linkwork.kinematics.kernels.work_arrays`): the march allocates them once per call, not once per
-    evaluation (a third of an evaluation's time on a small loop)."""
-    q, res, jac, matrices, vectors = work
+    """:func:`evaluate` with every work array given, ``work = (q, res, jac, matrices, vectors, solve)``
+    (``matrices`` and ``vectors`` from :func:`~linkwork.kinematics.kernels.work_arrays`, ``solve`` the
+    corrector's, :func:`solve_work`): the march allocates them once per call, not once per evaluation (a third
+    of an evaluation's time on a small loop)."""
+    q, res, jac, matrices, vectors = work[0], work[1], work[2], work[3], work[4]
     expand(u, mech[5], q)
     closure_pass(mech, q, None, res, jac, matrices, vectors)
     return np.sqrt(np.sum(res * res))
@@ -76,7 +78,13 @@ def evaluate_in(mech, u, work):
 def correct(mech, u, held, corrector, q, res, jac):
     """:func:`correct_in` with work arrays of its own beside ``q``, ``res``, ``jac``."""
     matrices, vectors = work_arrays()
-    return correct_in(mech, u, held, corrector, (q, res, jac, matrices, vectors))
+    return correct_in(mech, u, held, corrector, (q, res, jac, matrices, vectors, solve_work(jac.shape[1])))
+
+
+@kernel()
+def solve_work(m):
+    """Work arrays of :func:`least_squares_step` for ``m`` unknowns: ``(idx, A, b, y)``."""
+    return np.empty(m, dtype=np.int64), np.empty((m, m)), np.empty(m), np.empty(m)
 
 
 GOING, FAILED_SOLVE, CONVERGED = -1, 0, 1
@@ -128,7 +136,7 @@ def correct_in(mech, u, held, corrector, work):
             # With the drive held the remaining columns have full rank away from singular points, and Eq. (28)
             # keeps every singular value: its pseudo-inverse step is then the least-squares step, solved here
             # by Cholesky on the normal equations; an ill-conditioned case falls back to the truncated SVD.
-            if least_squares_step(jac, res, held, u):
+            if least_squares_step(jac, res, held, u, work[5]):
                 continue
         U, s, Vt = np.linalg.svd(jac)
         cut = truncate * s[0]
@@ -194,22 +202,21 @@ def correct_across(mech, u, t, corrector, work):
 
 
 @kernel()
-def least_squares_step(jac, res, held, u):
-    """``u -= argmin |J du + r|`` over the unknowns other than ``held``, by Cholesky of ``J^T J``.
+def least_squares_step(jac, res, held, u, solve):
+    """``u -= argmin |J du + r|`` over the unknowns other than ``held``, by Cholesky of ``J^T J`` (``solve``: the
+    work arrays of :func:`solve_work`).
 
     Returns False (and leaves ``u`` alone) when a pivot is below ``1e-10`` of the largest diagonal, i.e. when
     the condition number exceeds about 1e5: then the truncated SVD must decide what to keep.
     """
     E, m = jac.shape
     k = m - 1
-    idx = np.empty(k, dtype=np.int64)
+    idx, A, b, y = solve
     c = 0
     for a in range(m):
         if a != held:
             idx[c] = a
             c += 1
-    A = np.zeros((k, k))
-    b = np.zeros(k)
     for i in range(k):
         for j in range(i + 1):
             acc = 0.0
@@ -223,13 +230,25 @@ def least_squares_step(jac, res, held, u):
     dmax = 0.0
     for i in range(k):
         dmax = max(dmax, A[i, i])
-    if not cholesky_in_place(A, 1e-10 * dmax, 0.0):
+    if not cholesky_in_place(A[:k, :k], 1e-10 * dmax, 0.0):
         return False
-    y = np.empty(k)
-    cholesky_solve(A, b, y)
+    cholesky_solve(A[:k, :k], b[:k], y[:k])
     for i in range(k):
         u[idx[i]] -= y[i]
     return True
+
+
+JACOBI_UNKNOWNS = 12
+"""Up to this many unknowns the tangent's SVD is the compiled one-sided Jacobi of
+:mod:`~linkwork.kinematics.small_svd` (warm-started, allocation-free); beyond, LAPACK's (its cost grows more slowly
+with the size)."""
+
+
+@kernel()
+def svd_work(E, m):
+    """Work arrays of :func:`tangent_and_test_in` for an ``(E, m)`` Jacobian: ``(V, W, norms, order, G)``, ``V``
+    the identity (a cold start)."""
+    return np.eye(m), np.empty((E, m)), np.empty(m), np.empty(m, dtype=np.int64), np.empty((m, m))
 
 
 @kernel()
@@ -237,8 +256,66 @@ def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
     """Oriented null vector, singular values and the signed test function at the current Jacobian.
 
     ``basis (E, r_path)`` is the previous oriented range basis, updated in place. Returns the test value
-    (0 when the path is not of mobility one with rank ``r_path``).
+    (0 when the path is not of mobility one with rank ``r_path``). :func:`tangent_and_test_in` from a cold
+    start, with work arrays of its own.
     """
+    return tangent_and_test_in(
+        jac, t_prev, basis, r_path, t_out, sigma_out, svd_work(jac.shape[0], jac.shape[1])
+    )
+
+
+@kernel()
+def tangent_and_test_in(jac, t_prev, basis, r_path, t_out, sigma_out, svd):
+    """:func:`tangent_and_test` with the SVD's work arrays ``svd = (V, W, norms, order, G)`` given (see
+    :func:`svd_work`); ``V`` holds the right singular vectors of the last call (the warm start of the next).
+
+    The SVD ``J = W V^T`` (one-sided Jacobi, :func:`~linkwork.kinematics.small_svd.jacobi_svd`) gives the
+    singular values (``W``'s column norms), the tangent (``V``'s column of the smallest, oriented so that
+    ``t . t_prev > 0``) and the range basis ``U_r`` (the largest ``r`` columns of ``W``, normalised, its
+    orientation kept continuous with ``basis``: ``det(basis^T U_r) > 0``). The test function
+    ``det([U_r^T J; t^T])`` is then, since ``U_r^T J = S_r V_r^T``, the product of the ``r`` largest singular
+    values times ``det([V_r^T; t^T]) = +-det V = +-1``: its sign from the orientations alone.
+    """
+    E, m = jac.shape
+    if m > JACOBI_UNKNOWNS:
+        return tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out)
+    V, W, norms, order, G = svd
+    perm = jacobi_svd(jac, V, W, norms, order)
+    k = min(E, m)
+    for i in range(sigma_out.shape[0]):
+        sigma_out[i] = norms[i] if i < k else 0.0
+    last = order[m - 1]
+    dot = 0.0
+    for a in range(m):
+        dot += V[a, last] * t_prev[a]
+    orient = -1.0 if dot < 0.0 else 1.0
+    for a in range(m):
+        t_out[a] = orient * V[a, last]
+    if r_path + 1 != m or r_path > E or not norms[r_path - 1] > 0.0:
+        return 0.0
+    # Keep the range basis continuous: align the new one's orientation with the previous one's.
+    for i in range(r_path):
+        for j in range(r_path):
+            c = order[j]
+            acc = 0.0
+            for e in range(E):
+                acc += basis[e, i] * W[e, c]
+            G[i, j] = acc / norms[j]
+    flip = -1.0 if det_sign_in_place(G, r_path) < 0.0 else 1.0
+    tau = orient * perm * flip
+    for j in range(r_path):
+        c = order[j]
+        scale = (flip if j == r_path - 1 else 1.0) / norms[j]
+        for e in range(E):
+            basis[e, j] = W[e, c] * scale
+        tau *= norms[j]
+    return tau
+
+
+@kernel()
+def tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out):
+    """:func:`tangent_and_test` by LAPACK's SVD (``gesdd``) and two determinants: a Jacobian of more than
+    :data:`JACOBI_UNKNOWNS` columns."""
     m = jac.shape[1]
     U, s, Vt = np.linalg.svd(jac)
     k = min(s.shape[0], sigma_out.shape[0])
@@ -358,6 +435,39 @@ def predict(u, t, h, paper, drive, target, has_target, first, u_try):
     return step, landing, held
 
 
+@kernel(inline="always")
+def extrapolate(u_prev, t_prev, u, t, drive, u_try, cap):
+    """Paper mode's predictor from the last two points: the cubic (Hermite) through ``u_prev`` and ``u`` with
+    their tangents ``t_prev`` and ``t`` (as derivatives in the drive), at the drive value of the tangent
+    predictor's ``u_try``, replaces ``u_try`` when it is within ``cap`` of it; returns whether it did.
+
+    Its error is fourth order in the step (the tangent's is second), so one Gauss-Newton iteration usually
+    closes the loop to round-off. The corrector holds the drive at ``u_try``'s value either way, and so
+    converges to the same point of the path: only the work changes. Where the two predictors disagree by more
+    than ``cap`` (high curvature, a fold or a bifurcation near) the tangent's prediction is kept.
+    """
+    m = u.shape[0]
+    d = u[drive] - u_prev[drive]
+    if d == 0.0 or abs(t[drive]) < 1e-9 or abs(t_prev[drive]) < 1e-9:
+        return False
+    s = 1.0 + (u_try[drive] - u[drive]) / d
+    s2 = s * s
+    h00 = (2.0 * s - 3.0) * s2 + 1.0  # the cubic Hermite basis at s (s = 0 at u_prev, 1 at u)
+    h10 = (s2 - 2.0 * s + 1.0) * s * d / t_prev[drive]
+    h01 = (3.0 - 2.0 * s) * s2
+    h11 = (s - 1.0) * s2 * d / t[drive]
+    gap = 0.0
+    for a in range(m):
+        x = h00 * u_prev[a] + h10 * t_prev[a] + h01 * u[a] + h11 * t[a] - u_try[a]
+        gap += x * x
+    if not gap <= cap * cap:
+        return False
+    for a in range(m):
+        if a != drive:
+            u_try[a] = h00 * u_prev[a] + h10 * t_prev[a] + h01 * u[a] + h11 * t[a]
+    return True
+
+
 @kernel()
 def march(mech, start, steps, corrector, bounds, out):
     """March from ``(u0, t0)`` for at most ``max_steps`` steps; row 0 of the outputs is the start.
@@ -402,9 +512,10 @@ def march(mech, start, steps, corrector, bounds, out):
     h = h0
     # ---- the start: row 0, its tangent oriented along t0
     matrices, vectors = work_arrays()
-    work = (q, res, jac, matrices, vectors)  # every evaluation's work arrays, allocated once per call
+    work = (q, res, jac, matrices, vectors, solve_work(m))  # every evaluation's work arrays, once per call
     r0 = evaluate_in(mech, u, work)
-    tau = tangent_and_test(jac, t, basis, r_path, t_new, sig)
+    svd = svd_work(E, m)  # the tangent's SVD work arrays; its right singular vectors carried from row to row
+    tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
     s_total = 0.0
@@ -417,6 +528,10 @@ def march(mech, start, steps, corrector, bounds, out):
         step, landing, held = predict(u, t, h, paper, drive, target, has_target, count == 1, u_try)
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
+        if (
+            paper and count >= 2
+        ):  # the last two points and their tangents predict better than the tangent alone
+            extrapolate(out[0][count - 2], out[1][count - 2], u, t, drive, u_try, 0.1 * abs(step))
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
             ok, _, r = correct_across(mech, u_try, t, corrector, work)
@@ -426,7 +541,7 @@ def march(mech, start, steps, corrector, bounds, out):
         easy = ok and correction(u, t, step, u_try) <= 0.1 * abs(step)
         if ok:
             basis_try[:, :] = basis
-            tau_new = tangent_and_test(jac, t, basis_try, r_path, t_new, sig)
+            tau_new = tangent_and_test_in(jac, t, basis_try, r_path, t_new, sig, svd)
             turn, dist, ahead = step_geometry(u, t, u_try, t_new)
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, step, cos_turn, advance)

@@ -58,6 +58,28 @@ class MarchSettings:
 FOLD_MOVING = 1e-8
 
 
+def first_joints(mech: Mechanism) -> list[int]:
+    """The first joint of each unknown, in unknown order (``mech.group_members()[g][0]`` for every ``g``, in one
+    pass over the joints)."""
+    first: list[int] = []
+    for j, g in enumerate(mech.groups.tolist()):
+        if g >= len(first):
+            first.extend([-1] * (g + 1 - len(first)))
+        if g >= 0 and first[g] < 0:
+            first[g] = j
+    return first
+
+
+def leading_sign(tangent: Array, drive: int, moving: float = 1e-6) -> int:
+    """+1 or -1: the sign of ``tangent``'s drive component, or, when that is below ``moving`` of its largest, of
+    its first component that is not (round-off cannot flip it)."""
+    size = float(np.max(np.abs(tangent)))
+    for x in (tangent[drive], *tangent):
+        if abs(x) > moving * size:
+            return 1 if x > 0.0 else -1
+    return 1
+
+
 @dataclass
 class Chunk:
     """The rows one call of the compiled march wrote (row 0 is its start), its stop code (a
@@ -72,11 +94,13 @@ class Chunk:
     count: int
     code: int
     h: float
+    rank: NDArray[np.int64] | None = None  # each row's numerical rank, once the marcher has computed it
 
 
 @dataclass
 class Rows:
-    """Growing per-point storage, one block of rows per compiled march call."""
+    """Growing per-point storage, one block of rows per compiled march call (``rank``: each row's numerical rank,
+    kept beside ``sigma`` when every block has it, else computed by the caller)."""
 
     u: list[Array] = field(default_factory=list)
     sigma: list[Array] = field(default_factory=list)
@@ -85,9 +109,11 @@ class Rows:
     s: list[Array] = field(default_factory=list)
     branch: list[NDArray[np.int64]] = field(default_factory=list)
     step: list[NDArray[np.int64]] = field(default_factory=list)
+    rank: list[NDArray[np.int64]] = field(default_factory=list)
 
-    def add_point(self, u: Array, sigma: Array, res: float, branch: int) -> None:
+    def add_point(self, u: Array, sigma: Array, res: float, branch: int, rank: int) -> None:
         """Append one point (a bifurcation point opening a branch: arclength 0, step 0, test 0)."""
+        self.rank.append(np.array([rank], dtype=np.int64))
         self.u.append(u[None, :].copy())
         self.sigma.append(sigma[None, :].copy())
         self.res.append(np.array([res]))
@@ -136,9 +162,12 @@ class BranchMarcher:
         switch_branches: bool,
         progress: Progress | None = None,
         kernels: Backend | None = None,
+        workspace: Workspace | None = None,
     ) -> None:
         self.mech = mech
-        self.ws = Workspace.of(mech, kernels)  # the kernels the whole trace runs (chosen by its caller)
+        # The kernels the whole trace runs (chosen by its caller), in the caller's workspace when it has one.
+        self.ws = workspace if workspace is not None else Workspace.of(mech, kernels)
+        self.first_joint = first_joints(mech)
         self.cfg = settings
         self.max_steps = max_steps
         self.budget = max_steps
@@ -229,8 +258,10 @@ class BranchMarcher:
         """The :class:`End` of a branch whose last point is ``u``: ``about`` is the unknown the reason is about
         (``None``: the drive), reported as its first joint and that joint's value at ``u``."""
         g = self.cfg.drive if about is None else about
-        j = self.mech.group_members()[g][0]
-        value = float(self.mech.angles_from_q(self.mech.q_from_u(u))[j])
+        j = self.first_joint[g]
+        value = float(
+            u[g] + self.mech.offsets[j]
+        )  # the joint's value (angles_from_q of q_from_u, at joint j)
         return End(kind, text, self.mech.joint_names[j], value, point)
 
     def _march_branch(
@@ -272,10 +303,12 @@ class BranchMarcher:
                         StopReason.TARGET
                     )  # the closing step passed over the target (or ends on it): land there
             limit = self._land_on_limit(chunk) if chunk.code == StopReason.LIMIT else None
-            component = self._component_entry(chunk)
+            ranks = numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)  # every row's rank, once
+            chunk.rank = ranks
+            component = self._component_entry(chunk, ranks)
             if component is not None:
                 chunk.count = component + 1
-            landed = self._landed_row(chunk, component)
+            landed = self._landed_row(chunk, component, ranks)
             if (
                 landed is not None
             ):  # a step landed on a singular point: the rows after it may be on another branch
@@ -346,20 +379,20 @@ class BranchMarcher:
         cfg, c = self.cfg, chunk.count
         u_b = chunk.u[c - 1]
         over = np.flatnonzero((u_b < cfg.lo) | (u_b > cfg.hi))
-        reason = "limit " + ", ".join(self.mech.joint_names[self.mech.group_members()[g][0]] for g in over)
+        reason = "limit " + ", ".join(self.mech.joint_names[self.first_joint[g]] for g in over)
         g = int(over[0])
         self._land(chunk, g, cfg.lo[g] if u_b[g] < cfg.lo[g] else cfg.hi[g])
         return g, reason
 
-    def _landed_row(self, chunk: Chunk, component: int | None) -> int | None:
+    def _landed_row(self, chunk: Chunk, component: int | None, ranks: NDArray[np.int64]) -> int | None:
         """The first row after the chunk's start where the Jacobian's rank has dropped below the path's, unless
         it is where the branch enters a higher-dimensional component: a step that landed on a singular point
         (equal drive steps landing on a bifurcation point), where the march's tangent is any vector of a null
-        space of dimension two and the sign of the test function means nothing."""
+        space of dimension two and the sign of the test function means nothing. ``ranks``: the rank of each row
+        of the chunk (as the march returned it)."""
         if chunk.count < 2:
             return None
-        ranks = numerical_ranks(chunk.sigma[1 : chunk.count], self.cfg.tol)
-        low = np.flatnonzero(ranks < self.cfg.r_path)
+        low = np.flatnonzero(ranks[1 : chunk.count] < self.cfg.r_path)
         if len(low) == 0:
             return None
         row = int(low[0]) + 1
@@ -516,21 +549,29 @@ class BranchMarcher:
         begin = 0 if first else 1
         rows.u.append(chunk.u[begin:count])
         rows.sigma.append(chunk.sigma[begin:count])
+        if chunk.rank is None:
+            chunk.rank = numerical_ranks(chunk.sigma[:count], self.cfg.tol)
+        rows.rank.append(chunk.rank[begin:count])
         rows.res.append(chunk.res[begin:count])
         rows.tau.append(chunk.tau[begin:count])
         rows.s.append(s_base + chunk.s[begin:count])
         rows.branch.append(np.full(count - begin, branch_id, dtype=np.int64))
-        rows.step.append(n_steps + np.arange(begin, count) - begin + (0 if first else 1))
+        rows.step.append(
+            np.arange(n_steps + (0 if first else 1), n_steps + count - begin + (0 if first else 1))
+        )
         if count > begin:
-            self.max_misfit = max(self.max_misfit, float(np.max(chunk.res[begin:count])))
+            self.max_misfit = max(self.max_misfit, float(chunk.res[begin:count].max()))
 
     # ---- what a chunk meets
-    def _component_entry(self, chunk: Chunk) -> int | None:
-        """Index of the first of ``component_points`` consecutive points of mobility >= 2, if any."""
+    def _component_entry(self, chunk: Chunk, ranks: NDArray[np.int64]) -> int | None:
+        """Index of the first of ``component_points`` consecutive points of mobility >= 2, if any (``ranks``: the
+        rank of each row of the chunk)."""
         need = self.cfg.tol.component_points
         if chunk.count < need:
             return None
-        mobility = len(chunk.u[0]) - numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)
+        mobility = len(chunk.u[0]) - ranks
+        if not np.any(mobility >= 2):
+            return None
         run = 0
         for k, mob in enumerate(mobility):
             run = run + 1 if mob >= 2 else 0
@@ -561,9 +602,9 @@ class BranchMarcher:
             return
         ratio = chunk.sigma[:count, r_path - 1] / chunk.sigma[:count, 0]
         tau = chunk.tau
-        for k in range(1, count - 1):
-            if not (ratio[k] <= ratio[k - 1] and ratio[k] < ratio[k + 1] and ratio[k] < tol.local_min):
-                continue
+        inner = ratio[1:-1]
+        minima = (inner <= ratio[:-2]) & (inner < ratio[2:]) & (inner < tol.local_min)
+        for k in (minima.nonzero()[0] + 1).tolist():
             if tau[k - 1] * tau[k] < 0.0 or tau[k] * tau[k + 1] < 0.0:
                 continue  # a sign change: located by the test function
             u_min, r_min = locate_minimum(
@@ -585,9 +626,12 @@ class BranchMarcher:
         """
         d = self.cfg.drive
         td = chunk.t[: chunk.count, d]
+        turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
+        if len(turned) == 0:
+            return
         moving = np.maximum(np.abs(td[:-1]), np.abs(td[1:])) > FOLD_MOVING
-        joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.mech.group_members()[d][0]
-        for k in np.flatnonzero((td[:-1] * td[1:] < 0.0) & moving):
+        joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.first_joint[d]
+        for k in turned[moving[turned]]:
             u_a, u_b = chunk.u[k], chunk.u[k + 1]
             u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol)
             beyond = np.sign(td[k]) * (u_f[d] - np.array([u_a[d], u_b[d]]))
@@ -635,13 +679,18 @@ class BranchMarcher:
         return None
 
     def _add_point(self, bif: Bifurcation, branch_id: int, incoming: Array) -> None:
-        """Keep a classified point and queue its new branches (both directions) when switching branches."""
+        """Keep a classified point and queue its new branches (both directions) when switching branches.
+
+        Of a branch's two directions the one along which the drive increases is queued (and so traced) first, or,
+        where the drive stays put, the one along which the first unknown that moves increases: a branch tangent's
+        sign is whatever the SVD of the point's Jacobian gave it, which round-off can flip."""
         self.found.append(bif)
         if not self.switch_branches or bif.kind != "bifurcation":
             return
         for tb in bif.tangents_u:
             if abs(tb @ incoming) < self.cfg.tol.same_branch:
-                for direction in (1, -1):
+                first = leading_sign(tb, self.cfg.drive)
+                for direction in (first, -first):
                     self.queue.append(QueuedBranch(branch_id, bif.id, bif.u, direction * tb, direction))
 
     def _end_on_known(self, chunk: Chunk, known: int) -> None:
@@ -654,6 +703,7 @@ class BranchMarcher:
         rows = self.rows
         rows.u[-1][-1] = point
         rows.sigma[-1][-1] = np.linalg.svd(j_known, compute_uv=False)[: self.cfg.n_sigma]
+        rows.rank[-1][-1] = numerical_rank(rows.sigma[-1][-1], self.cfg.tol)
         rows.res[-1][-1] = r_known
         rows.tau[-1][-1] = 0.0
         self._arrived(known, diff)
@@ -721,7 +771,7 @@ class BranchMarcher:
             # Record the bifurcation point itself as the branch's first point, then march on.
             r_star, _, jst = self.ws.evaluate(job.u)
             sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
-            self.rows.add_point(job.u, sigma_star, r_star, bid)
+            self.rows.add_point(job.u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
             s_off = float(np.linalg.norm(u1 - job.u))
             start_len = len(self.rows.u)
             basis = np.ascontiguousarray(U1[:, : cfg.r_path])

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from linkwork.errors import LinkworkError, SpecError
 from linkwork.kinematics.dyads import closed_form_rows
 from linkwork.kinematics.jit import select_backend
-from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
+from linkwork.kinematics.marcher import BranchMarcher, MarchSettings, first_joints
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
@@ -97,13 +97,14 @@ def trace(
     if t_start[d_unknown] * sign < 0:
         t_start = -t_start
     lo, hi = _limits_in_unknowns(mech, limits)
-    periodic = np.array([mech.joint_types[mech.group_members()[g][0]] == "R" for g in range(m)])
+    first = first_joints(mech)
+    periodic = np.array([mech.joint_types[j] == "R" for j in first])
     settings = MarchSettings(
         drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=float(np.cos(max_turn)),
         r_path=r_path, n_sigma=min(jac0.shape), periodic=periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
     )  # fmt: skip
     marcher = BranchMarcher(
-        mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend
+        mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend, workspace=ws
     )
     paper = steps is not None
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
@@ -212,28 +213,37 @@ def _assemble(
     """The :class:`Trace` of everything the marcher collected, with each branch's mobility and the verdict on
     the target."""
     rows = marcher.rows
-    U = np.concatenate(rows.u, axis=0)
-    q = mech.q_from_u(U)
-    sigma = np.concatenate(rows.sigma, axis=0)
-    ranks = numerical_ranks(sigma, tol)
+    U = np.concatenate(rows.u)
+    sigma = np.concatenate(rows.sigma)
+    # every row's rank, as the marcher computed it (the closed-form rows come without)
+    ranks = np.concatenate(rows.rank) if len(rows.rank) == len(rows.sigma) else numerical_ranks(sigma, tol)
     branch = np.concatenate(rows.branch)
-    angles = mech.angles_from_q(q)
+    if mech.groups.min() >= 0:  # every joint its own unknown or coupled: q_from_u is a gather
+        angles = U[:, mech.groups] + mech.offsets
+    else:
+        angles = mech.angles_from_q(mech.q_from_u(U))
+    m = mech.n_unknowns
     branch_list = [
-        replace(br, mobility=_branch_mobility(mech.n_unknowns - ranks[branch == br.id]))
+        replace(
+            br,
+            mobility=_branch_mobility(m - (ranks if len(marcher.branches) == 1 else ranks[branch == br.id])),
+        )
         for br in marcher.branches
     ]
     unmet = None
     if until is not None:
-        on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
         first = branch_list[0]
         end = End(first.end_kind or StopReason.BUDGET, first.end_reason, first.end_joint, first.end_value)
-        unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
+        if end.kind != StopReason.TARGET:  # reached: no verdict to write (target_verdict says None)
+            on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
+            unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
+    residual = np.concatenate(rows.res)
     stats = TraceStats(
         start_rank=marcher.cfg.r_path,
-        start_mobility=mech.n_unknowns - marcher.cfg.r_path,
+        start_mobility=m - marcher.cfg.r_path,
         mode="paper" if paper else "adaptive",
         closure_tol=tol.closure,
-        max_misfit=float(max(marcher.max_misfit, float(np.max(np.concatenate(rows.res))))),
+        max_misfit=float(max(marcher.max_misfit, float(np.max(residual)))),
         sign_changes_without_rank_drop=marcher.spurious,
         branches_not_retraced=marcher.retraced,
         has_target=until is not None,
@@ -246,7 +256,7 @@ def _assemble(
         drive=mech.joint_names[d_joint],
         angles=angles,
         sigma=sigma,
-        residual=np.concatenate(rows.res),
+        residual=residual,
         branch=branch,
         step=np.concatenate(rows.step),
         arclength=np.concatenate(rows.s),
@@ -262,8 +272,7 @@ def _assemble(
 def _branch_mobility(mobility: NDArray[np.int64]) -> int:
     """The mobility that holds along a branch: the most frequent value over its points (ends excluded)."""
     inner = mobility[1:-1] if len(mobility) > 2 else mobility
-    values, counts = np.unique(inner, return_counts=True)
-    return int(values[np.argmax(counts)])
+    return int(np.argmax(np.bincount(inner)))  # the smallest of equally frequent values
 
 
 def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, angles: Array) -> str | None:
