@@ -26,6 +26,7 @@ from linkwork.mechanization.options import (
     ProgressCallback,
     options_from_values,
 )
+from linkwork.mechanization.pivot_fit import fit_pivots, fits
 from linkwork.mechanization.quality import Quality, quality
 from linkwork.mechanization.search import (
     MechanizationError,
@@ -371,13 +372,28 @@ def check_names(chain: ShapeChain, options: MechanizeOptions) -> None:
     if options.root is not None and options.root not in bodies:
         raise SpecError(f"unknown body {options.root!r}; expected one of {', '.join(bodies)}", key="root")
     joints = [j.name for j in chain.joints]
-    if options.drive is not None and options.drive not in joints and not LINK_JOINT.match(options.drive):
+    if options.drive is not None and options.drive not in joints + link_joints(chain, options):
+        count = max(0, chain.mobility() - options.dof)
+        kinds = {"revolute": "a, m", "prismatic": "s, m", "both": "a, s, m"}[options.binary_links]
+        actuator = "; the linear actuator A1a, A1s, A1m" if options.actuator == "prismatic" else ""
         raise SpecError(
             f"unknown joint {options.drive!r}; expected a chain joint ({', '.join(joints) or 'none'}) or a joint "
-            "of an added link: D<k>a (an RR link's fixed pivot), D<k>m (its moving pivot), D<k>s (a slider), A1s "
-            "(the linear actuator)",
+            f"of the {count} added links D1 ... D{count} (suffix {kinds}: a an RR link's fixed pivot, m its "
+            f"moving pivot, s a slider){actuator}",
             key="drive",
         )
+
+
+def link_joints(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
+    """Every joint name an added link of a design of ``chain`` can have under ``options``: the links ``D1`` ...
+    ``D<n>`` (``n`` the chain's mobility less the DOF asked for: each binary link takes one) with the suffixes of
+    the link types allowed, and the linear actuator's ``A1a``, ``A1s``, ``A1m`` when it is asked for."""
+    count = max(0, chain.mobility() - options.dof)
+    suffixes = {"revolute": "am", "prismatic": "sm", "both": "asm"}[options.binary_links]
+    names = [f"D{k}{x}" for k in range(1, count + 1) for x in suffixes]
+    if options.actuator == "prismatic":
+        names += ["A1a", "A1s", "A1m"]
+    return names
 
 
 def _check(options: MechanizeOptions) -> None:
@@ -442,6 +458,8 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         state.traced(label_k, design, check)
         if check.defect == "order" and options.drive is None:
             design, check = _redrive(design, check, label_k, state)
+        if _fittable(design, check):
+            design, check = _fitted(design, check, label_k, options, state)
         if check.defect == "dof":
             return
         # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
@@ -461,7 +479,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
 def redrives(design: Design) -> list[str]:
     """Other joints that could drive ``design``: those whose values move one way through the profiles, the
     most evenly moving first (the smallest step between profiles over the largest), at most :data:`REDRIVES`."""
-    ideal = design.ideal_values()
+    ideal = design.expected_values()
     ranked: list[tuple[float, str]] = []
     for k, name in enumerate(design.joint_names()):
         steps = np.diff(ideal[:, k])
@@ -486,6 +504,43 @@ def _redrive(design: Design, check: Verification, label: str, state: _Search) ->
         if verdict.passed:
             return again, verdict
     return design, check
+
+
+def _fittable(design: Design, check: Verification) -> bool:
+    """A design of least-squares links (more than five profiles) that failed on its shape or on its path (a
+    defect the fitted pivots may not have) is worth fitting jointly (:mod:`pivot_fit`)."""
+    inexact = any(
+        link.kind == "RR" and link.structural_error > 1e-9 * design.chain.size for link in design.links
+    )
+    return (
+        design.chain.count > 5
+        and inexact
+        and design.fitted is None
+        and check.defect in ("circuit", "branch", "order")
+    )
+
+
+def _fitted(
+    design: Design, check: Verification, label: str, options: MechanizeOptions, state: _Search
+) -> tuple[Design, Verification]:
+    """The design with every RR link's pivots fitted jointly to the profiles (the mechanism's own shape error
+    minimised, :func:`linkwork.mechanization.pivot_fit.fit_pivots`), verified by tracing like any design. Kept
+    when it passes; else the original verdict stands."""
+    if state.done():
+        return design, check
+    chain = design.chain
+    region = options.region_of(chain.targets, chain.size)
+    longest = options.link_limit(chain.size)
+    fitted = fit_pivots(
+        design, options.structural_limit(chain.size), options.min_transmission, longest, region
+    )
+    broken = fits(fitted, longest, region)
+    if broken is not None:
+        state.rejected.append(f"{label} with its pivots fitted jointly: {broken}")
+        return design, check
+    verdict = verify(fitted)
+    state.traced(f"{label} with its pivots fitted jointly", fitted, verdict)
+    return (fitted, verdict) if verdict.passed else (design, check)
 
 
 def _weakest(design: Design) -> str | None:

@@ -522,14 +522,19 @@ def _steps(
     done = ["ground", root]
     deferred: list[str] = []  # bodies no single dyad can guide: a body placed from each takes two
     joints = {j.name: j for j in chain.joints}
+    placed_from: dict[str, str] = {}
     for body, via in order:
         anchors = ["ground"]
         if options.anchors == "any":
             adjacent = {o for _, o in _adjacent(chain, body)}
             anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
         parent = joints[via].other(body)
+        placed_from[body] = parent
         if parent in deferred:
-            # the body it is placed from had no dyad: this one takes two, and the pair is placed together
+            # the body it is placed from had no dyad: this one takes two, and the pair is placed together; not
+            # from the body the pair hangs from (two links from it and the pair's two joints make the pair rigid
+            # on it: the profiles' motion of the pair would be frozen)
+            anchors = [a for a in anchors if a != placed_from.get(parent)]
             cands = body_candidates(chain, body, None, anchors, options)
             if len(cands) >= 2:
                 steps.append(Step(body, None, tuple(cands), 2))
