@@ -157,6 +157,9 @@ def _design(
                     c.link
                     for c in step.candidates[k + 1 :]
                     if _independent(first, c.link, chain.size, options)
+                    # not both from the body the pair hangs from: with the pair's two joints that makes the
+                    # pair rigid on it, and the profiles' motion of the pair would be frozen
+                    and not (first.anchor == c.link.anchor == step.hangs_from)
                 ),
                 step.candidates[(k + 1) % len(step.candidates)].link,
             )

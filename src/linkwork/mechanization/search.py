@@ -67,12 +67,15 @@ class Candidate:
 
 @dataclass(frozen=True)
 class Step:
-    """One body to constrain: the body, the chain joint it is reached through, and its ranked candidates."""
+    """One body to constrain: the body, the chain joint it is reached through, and its ranked candidates; a body
+    that takes two links (``links``) with the body it was placed from, ``hangs_from`` names the body that pair
+    hangs from (both links anchored there would make the pair rigid on it)."""
 
     body: str
     via: str | None
     candidates: tuple[Candidate, ...]
     links: int = 1
+    hangs_from: str | None = None
 
 
 @dataclass(frozen=True)
@@ -531,13 +534,10 @@ def _steps(
         parent = joints[via].other(body)
         placed_from[body] = parent
         if parent in deferred:
-            # the body it is placed from had no dyad: this one takes two, and the pair is placed together; not
-            # from the body the pair hangs from (two links from it and the pair's two joints make the pair rigid
-            # on it: the profiles' motion of the pair would be frozen)
-            anchors = [a for a in anchors if a != placed_from.get(parent)]
+            # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)
             if len(cands) >= 2:
-                steps.append(Step(body, None, tuple(cands), 2))
+                steps.append(Step(body, None, tuple(cands), 2, placed_from.get(parent)))
                 done += [parent, body]
                 deferred.remove(parent)
                 continue
