@@ -28,6 +28,7 @@ from linkwork.mechanization.options import (
 )
 from linkwork.mechanization.pivot_fit import fit_pivots, fits
 from linkwork.mechanization.quality import Quality, quality
+from linkwork.mechanization.recut import Recut, monotone_recut
 from linkwork.mechanization.search import (
     MechanizationError,
     NoPlan,
@@ -70,6 +71,9 @@ class Mechanization:
         Up to ``options.designs`` (5) passing designs, best quality factor first (``ranked[0]`` is ``design``).
     options
         The options the search ran with (the limits it kept are reported from them).
+    recut
+        When the mechanism follows the chain re-cut with monotonic C-segment piece counts
+        (:mod:`linkwork.mechanization.recut`): the re-cut, with the synthesised segment matrix and joined errors.
     """
 
     design: Design
@@ -79,6 +83,7 @@ class Mechanization:
     seconds: float
     ranked: tuple[RankedDesign, ...] = ()
     options: MechanizeOptions | None = None
+    recut: Recut | None = None
 
 
 @dataclass
@@ -227,6 +232,44 @@ def mechanize(
     options = _options(result, options)
     chain, label = _chain(result, name)
     check_names(chain, options)
+    started = time.perf_counter()
+    recut = monotone_recut(result) if isinstance(result, SynthesisResult) else None
+    if recut is not None and _joins_as_well(recut, chain):
+        # the same design vector cut with every C-segment's piece count moving one way (recut.py): a one-DOF
+        # mechanism follows it; half the time, then the synthesised cut with what is left
+        try:
+            found = _search_chain(
+                build_chain(recut.result),
+                replace(options, time_limit=0.5 * options.time_limit),
+                label,
+                progress,
+            )
+            return replace(found, recut=recut, seconds=time.perf_counter() - started)
+        except MechanizationError as exc:
+            first = f"re-cut chain ({recut.describe()}): {str(exc).removeprefix('mechanize: ')}"
+        left = max(0.0, options.time_limit - (time.perf_counter() - started))
+        try:
+            return _search_chain(chain, replace(options, time_limit=left), label, progress)
+        except MechanizationError as exc:
+            raise MechanizationError(f"{exc}; and the {first}") from None
+    return _search_chain(chain, options, label, progress)
+
+
+#: The re-cut chain is mechanized first when its joined ``E_max`` is at most this many times the synthesised
+#: chain's plus a thousandth of the size (on the NACA camber lines it is the same).
+RECUT_ALLOWANCE = 1.5
+
+
+def _joins_as_well(recut: Recut, chain: ShapeChain) -> bool:
+    """The re-cut chain joins the profiles about as well as the synthesised one."""
+    after = max(float(np.max(prof.errors)) for prof in recut.result.joined)
+    return after <= RECUT_ALLOWANCE * float(np.max(recut.joined_before)) + 1e-3 * chain.size
+
+
+def _search_chain(
+    chain: ShapeChain, options: MechanizeOptions, label: str, progress: ProgressCallback | None
+) -> Mechanization:
+    """The search over roots and anchor choices on one chain (see :func:`mechanize`)."""
     # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
     # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
     modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
@@ -325,6 +368,10 @@ CLOSEST = 3
 #: A design with an order defect (its drive turns back) is traced again driven by at most this many other joints
 #: (those moving one way through the profiles, the most evenly first), unless the designer chose the drive.
 REDRIVES = 3
+
+#: Designs of one plan (root and anchors) whose pivots are fitted jointly when they fail (each fit costs about as
+#: much as tracing a few designs; the next designs of a plan differ from the first by one link).
+FITS = 2
 
 #: Joints of the added links a design may have: an RR dyad's ``D<k>a`` / ``D<k>m``, a slider's ``D<k>s``, the
 #: linear actuator's ``A1a`` / ``A1s`` / ``A1m``.
@@ -445,6 +492,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         for _ in range(step.links):
             count += 1
             index[f"D{count}"] = i
+    fits_left = FITS
     for attempt in range(1, options.attempts + 1):
         if state.done():
             return
@@ -461,7 +509,8 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         state.traced(label_k, design, check)
         if check.defect == "order" and options.drive is None:
             design, check = _redrive(design, check, label_k, state)
-        if _fittable(design, check):
+        if fits_left and _fittable(design, check):
+            fits_left -= 1
             design, check = _fitted(design, check, label_k, options, state)
         if check.defect == "dof":
             return
