@@ -234,30 +234,33 @@ def mechanize(
     check_names(chain, options)
     started = time.perf_counter()
     recut = monotone_recut(result) if isinstance(result, SynthesisResult) else None
-    if recut is not None and _joins_as_well(recut, chain):
-        # the same design vector cut with every C-segment's piece count moving one way (recut.py): a one-DOF
-        # mechanism follows it; half the time, then the synthesised cut with what is left
+    if recut is None:
+        return _search_chain(chain, options, label, progress)
+    # the same design vector cut with every C-segment's piece count moving one way (recut.py), which a one-DOF
+    # mechanism follows: first when it joins the profiles about as well, else after the synthesised cut; the
+    # first gets half the time, the second what is left
+    cuts: list[tuple[ShapeChain, Recut | None]] = [(build_chain(recut.result), recut), (chain, None)]
+    if not _joins_as_well(recut, chain):
+        cuts.reverse()
+    failures = []
+    for k, (cut, used) in enumerate(cuts):
+        left = options.time_limit - (time.perf_counter() - started)
+        limit = 0.5 * options.time_limit if k == 0 else max(0.0, left)
         try:
-            found = _search_chain(
-                build_chain(recut.result),
-                replace(options, time_limit=0.5 * options.time_limit),
-                label,
-                progress,
-            )
-            return replace(found, recut=recut, seconds=time.perf_counter() - started)
+            found = _search_chain(cut, replace(options, time_limit=limit), label, progress)
         except MechanizationError as exc:
-            first = f"re-cut chain ({recut.describe()}): {str(exc).removeprefix('mechanize: ')}"
-        left = max(0.0, options.time_limit - (time.perf_counter() - started))
-        try:
-            return _search_chain(chain, replace(options, time_limit=left), label, progress)
-        except MechanizationError as exc:
-            raise MechanizationError(f"{exc}; and the {first}") from None
-    return _search_chain(chain, options, label, progress)
+            what = f"the re-cut chain ({recut.describe()})" if used else "the chain as synthesised"
+            failures.append((what, str(exc).removeprefix("mechanize: ")))
+            continue
+        return replace(found, recut=used, seconds=time.perf_counter() - started)
+    (first, why), (second, why_second) = failures
+    raise MechanizationError(f"mechanize: {why} (on {first}); and on {second}: {why_second}")
 
 
 #: The re-cut chain is mechanized first when its joined ``E_max`` is at most this many times the synthesised
-#: chain's plus a thousandth of the size (on the NACA camber lines it is the same).
-RECUT_ALLOWANCE = 1.5
+#: chain's plus a thousandth of the size (on the NACA camber lines it is the same; a re-cut joining worse is
+#: tried after the synthesised cut).
+RECUT_ALLOWANCE = 1.1
 
 
 def _joins_as_well(recut: Recut, chain: ShapeChain) -> bool:
