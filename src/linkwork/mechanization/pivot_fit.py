@@ -32,8 +32,9 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.mechanization.assemble import BinaryLink, Design
+from linkwork.mechanization.assemble import Design
 from linkwork.mechanization.chain import ShapeChain, track
+from linkwork.mechanization.guidance import positions
 from linkwork.mechanization.options import GroundRegion
 
 Array = NDArray[np.float64]
@@ -82,6 +83,7 @@ class _Layout:
         self.fitted = [k for k, link in enumerate(design.links) if link.kind == "RR"]
         self.bodies = [b.name for b in chain.bodies]
         self.index = {name: i for i, name in enumerate(self.bodies)}
+        self.index["ground"] = len(self.bodies)
         self.n_pivots = 4 * len(self.fitted)
         self.per_profile = 3 * len(self.bodies)
         self.p = chain.count
@@ -112,6 +114,10 @@ class _Layout:
         out["ground"] = np.zeros(3)
         return out
 
+    def at(self, body: str) -> int:
+        """The index of ``body`` (the ground last) in the poses of :func:`_poses`."""
+        return self.index[body]
+
     def pose_columns(self, j: int, body: str) -> list[int]:
         if body == "ground" or j == 0:
             return []
@@ -119,70 +125,94 @@ class _Layout:
         return [a, a + 1, a + 2]
 
 
-def _link_lengths(link: BinaryLink, centre: Array, circle: Array, ga: Array, gb: Array) -> float:
-    return float(np.linalg.norm(_at(gb, circle) - _at(ga, centre)))
+def _poses(layout: _Layout, x: Array) -> Array:
+    """``(p, bodies + 1, 3)`` every body's pose on every profile (profile 1 the identity), the ground last."""
+    g = np.zeros((layout.p, len(layout.bodies) + 1, 3))
+    g[1:, :-1, :] = x[layout.n_pivots :].reshape(layout.p - 1, len(layout.bodies), 3)
+    return g
 
 
-def _transmission(layout: _Layout, x: Array, k: int, j: int) -> float:
-    """The signed transmission sine of RR link ``k`` on profile ``j`` in the configuration ``x`` (as
-    :func:`linkwork.mechanization.verify.signed_transmissions`: the angle at the moving pivot between the link
-    and the line to the point that, with the link, places the body)."""
+def _track(g: Array, body: int, point: Array) -> Array:
+    """``(p, 2)`` the point (profile-1 coordinates) of body ``body`` on every profile at the poses ``g``."""
+    pose = g[:, body]
+    c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+    return np.column_stack(
+        [c * point[0] - s * point[1] + pose[:, 0], s * point[0] + c * point[1] + pose[:, 1]]
+    )
+
+
+def _turn(g: Array, body: int, direction: Array) -> Array:
+    """``(p, 2)`` a direction of body ``body`` turned with it on every profile."""
+    a = g[:, body, 2]
+    c, s = np.cos(a), np.sin(a)
+    return np.column_stack([c * direction[0] - s * direction[1], s * direction[0] + c * direction[1]])
+
+
+def _normal(d: Array) -> Array:
+    return np.column_stack([-d[:, 1], d[:, 0]])
+
+
+def _transmissions(layout: _Layout, g: Array, pivots: dict[int, tuple[Array, Array]], k: int) -> Array:
+    """``(p,)`` the signed transmission sine of RR link ``k`` on every profile at the poses ``g`` with the fitted
+    ``pivots`` (as :func:`linkwork.mechanization.verify.signed_transmissions`: the angle at the moving pivot
+    between the link and the line to the point that, with the link, places the body)."""
     link = layout.links[k]
-    g = layout.poses(x, j)
-    pivots = layout.pivots(x)
     c, m = pivots.get(k, (link.centre, link.circle))
-    mw, cw = _at(g[link.body], m), _at(g[link.anchor], c)
-    u = (mw - cw) / max(float(np.linalg.norm(mw - cw)), 1e-300)
+    body = layout.at(link.body)
+    mw = _track(g, body, m)
+    u = mw - _track(g, layout.at(link.anchor), c)
+    u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
     joint = layout.joints.get(link.via or "")
     if joint is not None and joint.kind == "P":
         assert joint.direction is not None
-        return float(u @ (_rot(g[joint.other(link.body)][2]) @ joint.direction))
+        return np.sum(u * _turn(g, layout.at(joint.other(link.body)), joint.direction), axis=1)
     if joint is not None:
-        pj = _at(g[link.body], joint.point)
+        pj = _track(g, body, joint.point)
     else:
         partner = layout.names[link.via or ""]
-        pj = _at(g[link.body], pivots.get(partner, (None, layout.links[partner].circle))[1])
+        pj = _track(g, body, pivots.get(partner, (link.centre, layout.links[partner].circle))[1])
     r = mw - pj
-    nr = float(np.linalg.norm(r))
-    return float(u @ np.array([-r[1], r[0]]) / nr) if nr > 0 else 0.0
+    nr = np.maximum(np.linalg.norm(r, axis=1), 1e-300)
+    return np.sum(u * _normal(r), axis=1) / nr
 
 
 def _residual(layout: _Layout, x: Array, limit: float) -> Array:
     chain = layout.chain
     pivots = layout.pivots(x)
-    out: list[Array] = []
     w = CONSTRAINT_WEIGHT
+    g = _poses(layout, x)
+    cons: list[Array] = []  # (p, rows) the constraints on every profile
+    for jt in chain.joints:
+        a, b = layout.at(jt.bodies[0]), layout.at(jt.bodies[1])
+        if jt.kind == "R":
+            cons.append(_track(g, a, jt.point) - _track(g, b, jt.point))
+        else:
+            assert jt.direction is not None
+            gap = _track(g, b, jt.point) - _track(g, a, jt.point)
+            turn = np.remainder(g[:, b, 2] - g[:, a, 2] + math.pi, 2 * math.pi) - math.pi
+            cons.append(np.column_stack([turn, np.sum(gap * _normal(_turn(g, a, jt.direction)), axis=1)]))
+    for k, link in enumerate(layout.links):
+        a, b = layout.at(link.anchor), layout.at(link.body)
+        if k in pivots:
+            c, m = pivots[k]
+            length = np.linalg.norm(_track(g, b, m) - _track(g, a, c), axis=1) - np.linalg.norm(m - c)
+            cons.append(length[:, None])
+        elif link.kind == "PR":
+            assert link.direction is not None
+            gap = _track(g, b, link.circle) - _track(g, a, link.centre)
+            cons.append(np.sum(gap * _normal(_turn(g, a, link.direction)), axis=1)[:, None])
+    held = np.hstack(cons) if cons else np.zeros((layout.p, 0))
+    out: list[Array] = []
     for j in range(1, layout.p):
-        g = layout.poses(x, j)
-        out.append((chain.points(g, j) - chain.targets[j]).ravel())
-        cons: list[float] = []
-        for jt in chain.joints:
-            ga, gb = g[jt.bodies[0]], g[jt.bodies[1]]
-            if jt.kind == "R":
-                cons.extend(_at(ga, jt.point) - _at(gb, jt.point))
-            else:
-                assert jt.direction is not None
-                d = _rot(ga[2]) @ jt.direction
-                gap = _at(gb, jt.point) - _at(ga, jt.point)
-                cons.extend(
-                    [math.remainder(gb[2] - ga[2], 2 * math.pi), float(gap @ np.array([-d[1], d[0]]))]
-                )
-        for k, link in enumerate(layout.links):
-            ga, gb = g[link.anchor], g[link.body]
-            if k in pivots:
-                c, m = pivots[k]
-                cons.append(float(np.linalg.norm(_at(gb, m) - _at(ga, c)) - np.linalg.norm(m - c)))
-            elif link.kind == "PR":
-                assert link.direction is not None
-                d = _rot(ga[2]) @ link.direction
-                gap = _at(gb, link.circle) - _at(ga, link.centre)
-                cons.append(float(gap @ np.array([-d[1], d[0]])))
-        out.append(w * np.asarray(cons, dtype=float))
+        poses = {name: g[j, i] for i, name in enumerate(layout.bodies)}
+        poses["ground"] = g[j, -1]
+        out.append((chain.points(poses, j) - chain.targets[j]).ravel())
+        out.append(w * held[j])
     hinge: list[float] = []
     for k, link in enumerate(layout.links):
         if link.via is None or link.kind != "RR":
             continue
-        sines = np.array([_transmission(layout, x, k, j) for j in range(layout.p)])
+        sines = _transmissions(layout, g, pivots, k)
         hinge.extend(np.maximum(0.0, layout.least - sines * math.copysign(1.0, sines[0])))
     for k1, k2 in layout.twins:
         # two links between the same bodies stay apart (merged, they would be one link: a singular design)
@@ -196,7 +226,9 @@ def _residual(layout: _Layout, x: Array, limit: float) -> Array:
             hinge.extend(np.maximum(0.0, np.concatenate([lo - c, c - hi])))
     for k, (c, m) in pivots.items():
         link = layout.links[k]
-        need = np.linalg.norm(track(chain.motion(link.body), m) - track(chain.motion(link.anchor), c), axis=1)
+        need = np.linalg.norm(
+            positions(chain.motion(link.body), m) - positions(chain.motion(link.anchor), c), axis=1
+        )
         hinge.extend(np.maximum(0.0, np.abs(need[1:] - need[0]) - 0.5 * limit))
     out.append(w * np.asarray(hinge, dtype=float))
     return np.concatenate(out)
