@@ -5,12 +5,14 @@ Checked against what the verification does not compute itself: the frozen joints
 is fixed by counting (two links from ``s2a`` to ``s3`` with the arc slide ``S2`` and the joint ``J2`` leave
 ``s2b`` and ``s3`` no motion relative to ``s2a``: 6 unknowns, 6 constraints); the fitted configurations close
 the mechanism's loops by :func:`linkwork.kinematics.closure.closure_residual`, and each fitted link's
-structural error is the spread of the distance between its pivots in the chain's own poses.
+structural error is the spread of the distance between its pivots in the chain's own poses (six NACA camber
+lines).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -79,8 +81,12 @@ def test_the_search_refuses_a_drive_no_design_of_the_chain_has(wing) -> None:
 
 
 @pytest.mark.slow
-def test_fitted_pivots_give_configurations_the_mechanism_closes_and_honest_structural_errors() -> None:
-    result = synthesize(load_problem(example("wing-six", "mechanize.toml")))
+def test_fitted_pivots_give_configurations_the_mechanism_closes_and_honest_structural_errors(
+    tmp_path: Path,
+) -> None:
+    from .test_profile_families import CAMBER_LINES, _problem
+
+    result = synthesize(load_problem(_problem(tmp_path, CAMBER_LINES)))  # six NACA camber lines
     found = mechanize(result, MechanizeOptions(designs=1))
     design = found.design
     chain = design.chain
@@ -100,12 +106,21 @@ def test_fitted_pivots_give_configurations_the_mechanism_closes_and_honest_struc
         )
         assert abs(np.ptp(need) - link.structural_error) <= 1e-12
         assert link.structural_error <= limit * (1 + 1e-6) and link.length <= 1.5 * chain.size
-    # the fitted configurations are nearer the profiles than the chain of rigid unfitted links gets by tracing
-    # (largest over the profiles: the fit minimises the sum of squares, which bounds it here with margin)
+    # the fit minimises the sum of squared point errors over the later profiles: its configurations are nearer
+    # the profiles in that sense than the unfitted design as traced (pivots as found, configurations on the
+    # mechanism: a feasible point of the same problem; measured 6.7e-4 against 9.1e-4)
+    from linkwork.mechanization.verify import chain_displacements
+
     assert fitted.fitted is not None
     poses = fitted.fitted
-    fit_error = max(
-        float(np.max(chain.errors({b: g[j] for b, g in poses.items()}, j))) for j in range(chain.count)
+    fit_cost = sum(
+        float(np.sum(chain.errors({b: g[j] for b, g in poses.items()}, j) ** 2))
+        for j in range(1, chain.count)
     )
-    traced = max(state.e_max for state in found.verification.states)
-    assert fit_error <= traced
+    unfitted = design.mechanism()
+    traced_cost = sum(
+        float(np.sum(chain.errors(chain_displacements(design, unfitted, state.values), j) ** 2))
+        for j, state in enumerate(found.verification.states)
+        if j > 0
+    )
+    assert fit_cost <= traced_cost
