@@ -237,10 +237,12 @@ def mechanize(
     if recut is None:
         return _search_chain(chain, options, label, progress)
     # the same design vector cut with every C-segment's piece count moving one way (recut.py), which a one-DOF
-    # mechanism follows: first when it joins the profiles about as well, else after the synthesised cut; the
-    # first gets half the time, the second what is left
+    # mechanism follows: first when there are more than five profiles (least-squares links: a zigzag of an arc
+    # slide costs shape everywhere) and it joins the profiles about as well, else after the synthesised cut
+    # (with exact links the mechanism sits on the chain as synthesised); the first gets half the time, the
+    # second what is left
     cuts: list[tuple[ShapeChain, Recut | None]] = [(build_chain(recut.result), recut), (chain, None)]
-    if not _joins_as_well(recut, chain):
+    if chain.count <= 5 or not _joins_as_well(recut, chain):
         cuts.reverse()
     failures = []
     for k, (cut, used) in enumerate(cuts):
