@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 from linkwork.mechanization.assemble import Design
 from linkwork.mechanization.chain import ShapeChain, track
 from linkwork.mechanization.guidance import positions
+from linkwork.mechanization.inside import leaving
 from linkwork.mechanization.options import GroundRegion
 
 Array = NDArray[np.float64]
@@ -318,7 +319,8 @@ def fit_pivots(
 
 def fits(design: Design, link_limit: float, region: GroundRegion) -> str | None:
     """Why the fitted ``design`` breaks a candidate rule (a link longer than ``link_limit`` or shorter than a
-    thousandth of the size, a ground pivot outside ``region``), or ``None``. (Transmission, assembly mode and
+    thousandth of the size, a ground pivot outside ``region``; with ``ground_region = "inside"`` a pivot or the
+    link leaving a profile in the chain's pose), or ``None``. (Transmission, assembly mode and
     structural error are kept by the fit's hinges and checked again by the verification.)"""
     size = design.chain.size
     for link in design.links:
@@ -326,7 +328,16 @@ def fits(design: Design, link_limit: float, region: GroundRegion) -> str | None:
             continue
         if not link.length <= link_limit or link.length < 1e-3 * size:
             return f"the fitted link {link.name} is {link.length:.4g} long (allowed 1e-3 x {size:.4g} to {link_limit:.4g})"
-        if link.anchor == "ground" and region.kind != "inside" and not bool(region.contains(link.centre)[0]):
+        if region.kind == "inside":
+            chain = design.chain
+            out = leaving(
+                chain.targets,
+                track(chain.motion(link.anchor), link.centre),
+                track(chain.motion(link.body), link.circle),
+            )
+            if out.by > 0.0:
+                return f"the fitted link {link.name} leaves the shape by {out.by:.3g}"
+        elif link.anchor == "ground" and not bool(region.contains(link.centre)[0]):
             c = link.centre
             return (
                 f"the fitted link {link.name}'s fixed pivot ({c[0]:.4g}, {c[1]:.4g}) leaves the ground region"
