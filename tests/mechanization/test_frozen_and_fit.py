@@ -91,13 +91,13 @@ def test_fitted_pivots_give_configurations_the_mechanism_closes_and_honest_struc
     design = found.design
     chain = design.chain
     limit = MechanizeOptions().structural_limit(chain.size)
-    fitted = fit_pivots(design, limit, MechanizeOptions().min_transmission, 1.5 * chain.size)
+    fitted = fit_pivots(design, limit, MechanizeOptions().min_transmission, 1.5 * chain.size, evaluations=60)
     mech = fitted.mechanism()
     values = fitted.expected_values()
     for j in range(chain.count):
         # the fitted configuration is on the mechanism: its loops close to a thousandth of the size (the joints
-        # and lengths are weighted residuals of a fit stopped after EVALUATIONS: measured 1.5e-4; another
-        # assembly or a link off its length would leave a tenth); the verification traces it anyway
+        # and lengths are weighted residuals of a fit stopped after 60 evaluations; another assembly or a link
+        # off its length would leave a tenth); the verification traces it anyway
         assert np.linalg.norm(closure_residual(mech, values[j])) <= 1e-3 * chain.size, j
     for link in fitted.links:
         need = np.linalg.norm(

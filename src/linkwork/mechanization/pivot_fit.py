@@ -291,13 +291,15 @@ def fit_pivots(
     min_transmission: float,
     link_limit: float = math.inf,
     region: GroundRegion | None = None,
+    *,
+    evaluations: int = EVALUATIONS,
 ) -> Design:
     """``design`` with every RR link's pivots moved to bring the mechanism nearest every profile (least squares
     over the profiles, the mechanism's configurations as unknowns); each link's structural error recomputed in
     the chain's own poses and kept within ``structural_limit``, every RR link's transmission angle above
     ``min_transmission`` (radians) in its assembly mode of profile 1, no link longer than ``link_limit``, every
-    fixed pivot on the ground in the box of ``region`` (:func:`fits` checks the region itself after). Unverified:
-    trace it."""
+    fixed pivot on the ground in the box of ``region`` (:func:`fits` checks the region itself after); at most
+    ``evaluations`` evaluations of the residuals (not counting the Jacobian's). Unverified: trace it."""
     from scipy.optimize import least_squares
 
     layout = _Layout(design, math.sin(min_transmission), link_limit, region)
@@ -311,7 +313,7 @@ def fit_pivots(
         jac_sparsity=sparsity,
         method="trf",
         x_scale="jac",
-        max_nfev=EVALUATIONS,
+        max_nfev=evaluations,
     )
     fitted = {b: np.array([layout.poses(sol.x, j)[b] for j in range(layout.p)]) for b in layout.bodies}
     return replace(with_pivots(design, layout.pivots(sol.x)), fitted=fitted)
