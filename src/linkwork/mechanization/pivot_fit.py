@@ -3,8 +3,8 @@
 With six or more profiles no binary link guides its body exactly (:mod:`linkwork.mechanization.guidance`); each
 least-squares link is fitted alone, and the mechanism they make is not on any later profile: it takes the
 configuration its rigid links allow, and a link's structural error is amplified by the lever of the bodies it
-places (a design of seven links each within 0.04 missed a NACA camber line by 0.13 where the chain was within
-0.001). What the designer wants is the mechanism's shape error, so it is what is minimised here, over every
+places (links each fitted within 0.005 can leave the mechanism 0.05 off a profile the chain joins within 0.002).
+What the designer wants is the mechanism's shape error, so it is what is minimised here, over every
 link's pivots at once (S13 Sec. 7: the least-squares synthesis of Murray et al., with the mechanism's own
 configurations as unknowns):
 
@@ -50,17 +50,6 @@ APART = 0.1
 
 #: Function evaluations of one fit (each a few milliseconds; the Jacobian's grouped finite differences not counted).
 EVALUATIONS = 200
-
-
-def _rot(a: float | Array) -> Array:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s], [s, c]])
-
-
-def _at(pose: Array, point: Array) -> Array:
-    """``point`` (profile-1 coordinates) moved by ``pose`` ``(x, y, angle)``."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    return np.array([c * point[0] - s * point[1] + pose[0], s * point[0] + c * point[1] + pose[1]])
 
 
 class _Layout:
