@@ -70,6 +70,8 @@ FAMILIES = {
     "camber-moving-aft": [_outline(f"4{p}12", 1.0 + 0.03 * (p - 2)) for p in range(2, 9)],
     # a generated smooth morph: an arch growing wider and taller
     "growing-arch": [_arch(k) for k in range(6)],
+    # seven camber lines, NACA 1412 ... 7412 at chords 1.0 ... 1.3 (exit 3 before the re-cut)
+    "seven-camber-lines": [_camber_line(f"{k}412", 1.0 + 0.05 * (k - 1)) for k in range(1, 8)],
 }
 
 
