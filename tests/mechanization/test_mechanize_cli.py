@@ -91,7 +91,7 @@ def test_bad_flags_stop_before_the_synthesis_is_run_again(tmp_path: Path, monkey
 @pytest.mark.parametrize(
     ("flag", "value", "named"),
     [
-        ("--drive", "QQ", ["J1", "D<k>a", "A1s"]),
+        ("--drive", "QQ", ["J1", "D1 ... D7", "suffix a, m"]),
         ("--root", "QQ", ["s1", "s2a"]),
         ("--anchors", "QQ", ["'ground'", "'any'"]),
     ],
@@ -106,3 +106,45 @@ def test_an_unknown_drive_root_or_anchor_is_exit_2_naming_the_choices(
     for choice in named:
         assert choice.strip("'") in run.output, (choice, run.output)
     assert not (folder / "mechanization.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("flags", "named"),
+    [
+        (["--drive", "D99a"], ["D1 ... D", "J1"]),  # of the right form, but no design has 99 links
+        (["--drive", "D1s"], ["suffix a, m"]),  # a slider's joint, but only RR links are asked for
+        (["--drive", "A1s"], ["D1 ... D"]),  # the actuator's joint without `--actuator prismatic`
+        (["--root", "s9b"], ["s1", "s2a"]),  # a body's form, not a body of this chain
+    ],
+)
+def test_a_name_of_the_right_form_that_no_design_has_is_exit_2_before_any_search(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, flags: list[str], named: list[str]
+) -> None:
+    import sys
+
+    mechanize_module = sys.modules["linkwork.mechanization.mechanize"]
+    folder = _synth_folder(tmp_path)
+    searched: list[object] = []
+    monkeypatch.setattr(mechanize_module, "_search", lambda *a, **k: searched.append(a))
+    run = CliRunner().invoke(_app(), [str(folder), *flags, "--no-plots"])
+    assert run.exit_code == 2, run.output
+    for choice in named:
+        assert choice in run.output.replace("\n", " "), (choice, run.output)
+    assert searched == [] and not (folder / "mechanization.json").exists()
+
+
+def test_every_link_joint_name_offered_is_one_a_design_can_have(tmp_path: Path) -> None:
+    # the names check_names accepts are exactly the joints the designs of this chain get (the found design's
+    # link joints are among them, and the count of links is the chain's mobility less one)
+    from linkwork.mechanization import MechanizeOptions
+    from linkwork.mechanization import mechanize as run_mechanize
+    from linkwork.mechanization.chain import build_chain
+    from linkwork.mechanization.mechanize import link_joints
+
+    result = synthesize(load_problem(_synth_folder(tmp_path) / "problem" / "problem.toml"))
+    chain = build_chain(result)
+    found = run_mechanize(result, MechanizeOptions(designs=1))
+    offered = set(link_joints(chain, MechanizeOptions()))
+    made = {n for link in found.design.links for n in link.joint_names()}
+    assert made <= offered
+    assert len(found.design.links) == chain.mobility() - 1 == len(offered) // 2

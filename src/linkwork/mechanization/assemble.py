@@ -9,7 +9,7 @@ from the bodies' displacements; the verification compares the traced motion with
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -112,6 +112,10 @@ class Design:
         The degrees of freedom asked for.
     notes
         How the design was found (root body, candidates tried, ...).
+    fitted
+        With pivots fitted jointly to the profiles (:mod:`linkwork.mechanization.pivot_fit`): every chain body's
+        ``(p, 3)`` displacement on every profile where the fitted mechanism is expected to be (near, not on, the
+        chain's); ``None`` when the links are placed on the chain's own poses.
     """
 
     chain: ShapeChain
@@ -120,12 +124,16 @@ class Design:
     dof: int = 1
     name: str = "mechanized chain"
     notes: tuple[str, ...] = field(default=())
+    fitted: Mapping[str, Array] | None = field(default=None, compare=False)
 
-    def displacements(self) -> dict[str, Array]:
-        """``(p, 3)`` displacement of every body (chain bodies and link bodies) on every profile."""
+    def displacements(self, *, fitted: bool = False) -> dict[str, Array]:
+        """``(p, 3)`` displacement of every body (chain bodies and link bodies) on every profile: the chain's, or
+        with ``fitted`` where the fitted mechanism is expected (:attr:`fitted`, when there is one)."""
         p = self.chain.count
         disp: dict[str, Array] = {"ground": np.zeros((p, 3))}
         disp.update({b.name: b.displacements for b in self.chain.bodies})
+        if fitted and self.fitted is not None:
+            disp.update(self.fitted)
         for link in self.links:
             disp.update(_link_displacements(link, disp[link.anchor], disp[link.body]))
         return disp
@@ -152,8 +160,16 @@ class Design:
         return [str(j["name"]) for j in self.joint_specs()]
 
     def ideal_values(self) -> Array:
-        """``(p, n)`` every joint's displacement on every profile (radians or lengths), joints in order."""
-        disp = self.displacements()
+        """``(p, n)`` every joint's displacement on every profile (radians or lengths), joints in order, with the
+        chain on the profile as joined."""
+        return self._values(self.displacements())
+
+    def expected_values(self) -> Array:
+        """``(p, n)`` every joint's displacement on every profile where the mechanism is expected: the fitted
+        configurations (:attr:`fitted`), else :meth:`ideal_values`."""
+        return self._values(self.displacements(fitted=True))
+
+    def _values(self, disp: dict[str, Array]) -> Array:
         cols = []
         for spec in self.joint_specs():
             pair: list[str] = spec["bodies"]  # type: ignore[assignment]

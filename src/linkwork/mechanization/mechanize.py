@@ -26,7 +26,9 @@ from linkwork.mechanization.options import (
     ProgressCallback,
     options_from_values,
 )
+from linkwork.mechanization.pivot_fit import fit_pivots, fits
 from linkwork.mechanization.quality import Quality, quality
+from linkwork.mechanization.recut import Recut, monotone_recut
 from linkwork.mechanization.search import (
     MechanizationError,
     NoPlan,
@@ -69,6 +71,9 @@ class Mechanization:
         Up to ``options.designs`` (5) passing designs, best quality factor first (``ranked[0]`` is ``design``).
     options
         The options the search ran with (the limits it kept are reported from them).
+    recut
+        When the mechanism follows the chain re-cut with monotonic C-segment piece counts
+        (:mod:`linkwork.mechanization.recut`): the re-cut, with the synthesised segment matrix and joined errors.
     """
 
     design: Design
@@ -78,6 +83,7 @@ class Mechanization:
     seconds: float
     ranked: tuple[RankedDesign, ...] = ()
     options: MechanizeOptions | None = None
+    recut: Recut | None = None
 
 
 @dataclass
@@ -156,6 +162,9 @@ def _design(
                     c.link
                     for c in step.candidates[k + 1 :]
                     if _independent(first, c.link, chain.size, options)
+                    # not both from the body the pair hangs from: with the pair's two joints that makes the
+                    # pair rigid on it, and the profiles' motion of the pair would be frozen
+                    and not (first.anchor == c.link.anchor == step.hangs_from)
                 ),
                 step.candidates[(k + 1) % len(step.candidates)].link,
             )
@@ -223,6 +232,49 @@ def mechanize(
     options = _options(result, options)
     chain, label = _chain(result, name)
     check_names(chain, options)
+    started = time.perf_counter()
+    recut = monotone_recut(result) if isinstance(result, SynthesisResult) else None
+    if recut is None:
+        return _search_chain(chain, options, label, progress)
+    # the same design vector cut with every C-segment's piece count moving one way (recut.py), which a one-DOF
+    # mechanism follows: first when there are more than five profiles (least-squares links: a zigzag of an arc
+    # slide costs shape everywhere) and it joins the profiles about as well, else after the synthesised cut
+    # (with exact links the mechanism sits on the chain as synthesised); the first gets half the time, the
+    # second what is left
+    cuts: list[tuple[ShapeChain, Recut | None]] = [(build_chain(recut.result), recut), (chain, None)]
+    if chain.count <= 5 or not _joins_as_well(recut, chain):
+        cuts.reverse()
+    failures = []
+    for k, (cut, used) in enumerate(cuts):
+        left = options.time_limit - (time.perf_counter() - started)
+        limit = 0.5 * options.time_limit if k == 0 else max(0.0, left)
+        try:
+            found = _search_chain(cut, replace(options, time_limit=limit), label, progress)
+        except MechanizationError as exc:
+            what = f"the re-cut chain ({recut.describe()})" if used else "the chain as synthesised"
+            failures.append((what, str(exc).removeprefix("mechanize: ")))
+            continue
+        return replace(found, recut=used, seconds=time.perf_counter() - started)
+    (first, why), (second, why_second) = failures
+    raise MechanizationError(f"mechanize: {why} (on {first}); and on {second}: {why_second}")
+
+
+#: The re-cut chain is mechanized first when its joined ``E_max`` is at most this many times the synthesised
+#: chain's plus a thousandth of the size (on the NACA camber lines it is the same; a re-cut joining worse is
+#: tried after the synthesised cut).
+RECUT_ALLOWANCE = 1.1
+
+
+def _joins_as_well(recut: Recut, chain: ShapeChain) -> bool:
+    """The re-cut chain joins the profiles about as well as the synthesised one."""
+    after = max(float(np.max(prof.errors)) for prof in recut.result.joined)
+    return after <= RECUT_ALLOWANCE * float(np.max(recut.joined_before)) + 1e-3 * chain.size
+
+
+def _search_chain(
+    chain: ShapeChain, options: MechanizeOptions, label: str, progress: ProgressCallback | None
+) -> Mechanization:
+    """The search over roots and anchor choices on one chain (see :func:`mechanize`)."""
     # "any" first: every design that passed in the examples and the NACA sets joins two bodies by a dyad, and
     # the ground-only plans of a root, tried first, doubled the search (the nine-body wing: 37 s of CPU, now 14 s)
     modes = ("any", "ground") if options.anchors == "auto" else (options.anchors,)
@@ -322,6 +374,10 @@ CLOSEST = 3
 #: (those moving one way through the profiles, the most evenly first), unless the designer chose the drive.
 REDRIVES = 3
 
+#: Designs of one plan (root and anchors) whose pivots are fitted jointly when they fail (each fit costs about as
+#: much as tracing a few designs; the next designs of a plan differ from the first by one link).
+FITS = 2
+
 #: Joints of the added links a design may have: an RR dyad's ``D<k>a`` / ``D<k>m``, a slider's ``D<k>s``, the
 #: linear actuator's ``A1a`` / ``A1s`` / ``A1m``.
 LINK_JOINT = re.compile(r"^(D[1-9][0-9]*[ams]|A1[ams])$")
@@ -371,13 +427,28 @@ def check_names(chain: ShapeChain, options: MechanizeOptions) -> None:
     if options.root is not None and options.root not in bodies:
         raise SpecError(f"unknown body {options.root!r}; expected one of {', '.join(bodies)}", key="root")
     joints = [j.name for j in chain.joints]
-    if options.drive is not None and options.drive not in joints and not LINK_JOINT.match(options.drive):
+    if options.drive is not None and options.drive not in joints + link_joints(chain, options):
+        count = max(0, chain.mobility() - options.dof)
+        kinds = {"revolute": "a, m", "prismatic": "s, m", "both": "a, s, m"}[options.binary_links]
+        actuator = "; the linear actuator A1a, A1s, A1m" if options.actuator == "prismatic" else ""
         raise SpecError(
             f"unknown joint {options.drive!r}; expected a chain joint ({', '.join(joints) or 'none'}) or a joint "
-            "of an added link: D<k>a (an RR link's fixed pivot), D<k>m (its moving pivot), D<k>s (a slider), A1s "
-            "(the linear actuator)",
+            f"of the {count} added links D1 ... D{count} (suffix {kinds}: a an RR link's fixed pivot, m its "
+            f"moving pivot, s a slider){actuator}",
             key="drive",
         )
+
+
+def link_joints(chain: ShapeChain, options: MechanizeOptions) -> list[str]:
+    """Every joint name an added link of a design of ``chain`` can have under ``options``: the links ``D1`` ...
+    ``D<n>`` (``n`` the chain's mobility less the DOF asked for: each binary link takes one) with the suffixes of
+    the link types allowed, and the linear actuator's ``A1a``, ``A1s``, ``A1m`` when it is asked for."""
+    count = max(0, chain.mobility() - options.dof)
+    suffixes = {"revolute": "am", "prismatic": "sm", "both": "asm"}[options.binary_links]
+    names = [f"D{k}{x}" for k in range(1, count + 1) for x in suffixes]
+    if options.actuator == "prismatic":
+        names += ["A1a", "A1s", "A1m"]
+    return names
 
 
 def _check(options: MechanizeOptions) -> None:
@@ -426,6 +497,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         for _ in range(step.links):
             count += 1
             index[f"D{count}"] = i
+    fits_left = FITS
     for attempt in range(1, options.attempts + 1):
         if state.done():
             return
@@ -442,6 +514,9 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         state.traced(label_k, design, check)
         if check.defect == "order" and options.drive is None:
             design, check = _redrive(design, check, label_k, state)
+        if fits_left and _fittable(design, check):
+            fits_left -= 1
+            design, check = _fitted(design, check, label_k, options, state)
         if check.defect == "dof":
             return
         # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
@@ -461,7 +536,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
 def redrives(design: Design) -> list[str]:
     """Other joints that could drive ``design``: those whose values move one way through the profiles, the
     most evenly moving first (the smallest step between profiles over the largest), at most :data:`REDRIVES`."""
-    ideal = design.ideal_values()
+    ideal = design.expected_values()
     ranked: list[tuple[float, str]] = []
     for k, name in enumerate(design.joint_names()):
         steps = np.diff(ideal[:, k])
@@ -486,6 +561,43 @@ def _redrive(design: Design, check: Verification, label: str, state: _Search) ->
         if verdict.passed:
             return again, verdict
     return design, check
+
+
+def _fittable(design: Design, check: Verification) -> bool:
+    """A design of least-squares links (more than five profiles) that failed on its shape or on its path (a
+    defect the fitted pivots may not have) is worth fitting jointly (:mod:`pivot_fit`)."""
+    inexact = any(
+        link.kind == "RR" and link.structural_error > 1e-9 * design.chain.size for link in design.links
+    )
+    return (
+        design.chain.count > 5
+        and inexact
+        and design.fitted is None
+        and check.defect in ("circuit", "branch", "order")
+    )
+
+
+def _fitted(
+    design: Design, check: Verification, label: str, options: MechanizeOptions, state: _Search
+) -> tuple[Design, Verification]:
+    """The design with every RR link's pivots fitted jointly to the profiles (the mechanism's own shape error
+    minimised, :func:`linkwork.mechanization.pivot_fit.fit_pivots`), verified by tracing like any design. Kept
+    when it passes; else the original verdict stands."""
+    if state.done():
+        return design, check
+    chain = design.chain
+    region = options.region_of(chain.targets, chain.size)
+    longest = options.link_limit(chain.size)
+    fitted = fit_pivots(
+        design, options.structural_limit(chain.size), options.min_transmission, longest, region
+    )
+    broken = fits(fitted, longest, region)
+    if broken is not None:
+        state.rejected.append(f"{label} with its pivots fitted jointly: {broken}")
+        return design, check
+    verdict = verify(fitted)
+    state.traced(f"{label} with its pivots fitted jointly", fitted, verdict)
+    return (fitted, verdict) if verdict.passed else (design, check)
 
 
 def _weakest(design: Design) -> str | None:

@@ -60,6 +60,7 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
         "joined_e_max": float(max(design.chain.joined_errors)),
         "max_structural_error": max((link.structural_error for link in design.links), default=0.0),
         "limits": _limits(result, size),
+        "recut": _recut(result),
         "max_condition": check.max_condition,
         "verification": {
             "passed": check.passed,
@@ -85,6 +86,21 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
         "notes": list(design.notes),
         "seconds": result.seconds,
         "trace_command": f"linkwork trace mechanism.toml --drive {design.drive} --until {design.drive}=<drive_value>",
+    }
+
+
+def _recut(result: Mechanization) -> dict[str, Any] | None:
+    """The chain re-cut with monotonic C-segment piece counts, when the mechanism follows it: the segment matrix
+    followed and the synthesised one (a row per segment, a column per profile), and the synthesised chain's
+    ``E_max`` on every profile beside the re-cut chain's (``profiles[k].joined_e_max``); ``None`` otherwise."""
+    recut = result.recut
+    if recut is None:
+        return None
+    return {
+        "segment_matrix": recut.segment_matrix.tolist(),
+        "synthesised_segment_matrix": recut.before.tolist(),
+        "synthesised_joined_e_max": [float(e) for e in recut.joined_before],
+        "note": recut.describe(),
     }
 
 

@@ -67,12 +67,15 @@ class Candidate:
 
 @dataclass(frozen=True)
 class Step:
-    """One body to constrain: the body, the chain joint it is reached through, and its ranked candidates."""
+    """One body to constrain: the body, the chain joint it is reached through, and its ranked candidates; a body
+    that takes two links (``links``) with the body it was placed from, ``hangs_from`` names the body that pair
+    hangs from (both links anchored there would make the pair rigid on it)."""
 
     body: str
     via: str | None
     candidates: tuple[Candidate, ...]
     links: int = 1
+    hangs_from: str | None = None
 
 
 @dataclass(frozen=True)
@@ -522,17 +525,19 @@ def _steps(
     done = ["ground", root]
     deferred: list[str] = []  # bodies no single dyad can guide: a body placed from each takes two
     joints = {j.name: j for j in chain.joints}
+    placed_from: dict[str, str] = {}
     for body, via in order:
         anchors = ["ground"]
         if options.anchors == "any":
             adjacent = {o for _, o in _adjacent(chain, body)}
             anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
         parent = joints[via].other(body)
+        placed_from[body] = parent
         if parent in deferred:
             # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)
             if len(cands) >= 2:
-                steps.append(Step(body, None, tuple(cands), 2))
+                steps.append(Step(body, None, tuple(cands), 2, placed_from.get(parent)))
                 done += [parent, body]
                 deferred.remove(parent)
                 continue

@@ -72,7 +72,7 @@ class Verification:
     """The outcome of :func:`verify`.
 
     ``defect`` is ``None`` when the design passes, else ``"dof"``, ``"order"``, ``"branch"``, ``"circuit"``,
-    ``"closure"`` or (set by the search with ``ground_region = "inside"``) ``"inside"``, with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
+    ``"closure"``, ``"frozen"`` (a rigid group of bodies that the profiles deform) or (set by the search with ``ground_region = "inside"``) ``"inside"``, with ``reason`` one line; ``culprit`` names the body or link to change. ``traced`` is ``False``
     when the motion was not traced (more than one DOF: the tracer follows one-parameter paths); a design that
     passes untraced says so in ``reason`` (``"not traced: dof 2 ..."``).
     """
@@ -281,7 +281,8 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
     """One DOF: the drive must be monotonic over the profiles; trace it from each profile's drive value to the
     next's, and stop at the first order, branch or circuit defect."""
     design, mech, d = check.design, check.mech, check.d
-    v = check.ideal[:, d]
+    # the drive values the mechanism is expected at: the chain's, or the fitted configurations' (pivot_fit)
+    v = check.design.expected_values()[:, d]
     steps = np.diff(v)
     if not (np.all(steps > 0) or np.all(steps < 0)):
         order = ", ".join(f"{x:.4g}" for x in (np.degrees(v) if mech.joint_types[d] == "R" else v))
@@ -290,6 +291,9 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
             f"order defect: the drive {design.drive} is not monotonic over the profiles ({order})",
             culprit="drive",
         )
+    frozen = _frozen(check)
+    if frozen is not None:
+        return check.failed(*frozen[:2], culprit=frozen[2])
     states: list[ProfileState] = [check.state(np.zeros(mech.n_joints), 0)]
     paths: list[Trace] = []
     max_cond = 1.0
@@ -315,6 +319,39 @@ def _traced(check: _Checker, max_step: float, max_steps: int) -> Verification:
         states.append(st)
     return Verification(
         True, None, "", check.dof, check.rank, design.drive, tuple(states), max_cond, None, tuple(paths)
+    )
+
+
+#: A chain joint is frozen when the mechanism's motion at profile 1 moves it less than this (relative to the
+#: joint moving most) while the chain's step to profile 2 moves it by more than :data:`MOVES` (relative).
+FROZEN = 1e-7
+MOVES = 1e-3
+
+
+def _frozen(check: _Checker) -> _Defect | None:
+    """A rigid sub-assembly: chain joints that the profiles move but the mechanism's one motion at profile 1 does
+    not (links anchored so that a group of bodies is rigid among itself; the DOF is elsewhere). Such a design can
+    only follow profiles that do not change that group's shape."""
+    mech, design = check.mech, check.design
+    if mech.n_unknowns != mech.n_joints:
+        return None
+    vt = np.linalg.svd(jacobian(mech, np.zeros(mech.n_joints)))[2]
+    tangent = np.abs(vt[-1])
+    n = len(design.chain.joints)
+    step = np.abs(check.design.expected_values()[1] - check.design.expected_values()[0])[:n]
+    if not np.any(step > 0) or not np.any(tangent > 0):
+        return None
+    still = (tangent[:n] <= FROZEN * tangent.max()) & (step > MOVES * step.max())
+    if not np.any(still):
+        return None
+    names = [jt.name for jt, s in zip(design.chain.joints, still, strict=True) if s]
+    bodies = {b for jt in design.chain.joints if jt.name in names for b in jt.bodies}
+    blamed = [link.name for link in design.links if link.body in bodies or link.anchor in bodies]
+    return (
+        "frozen",
+        f"frozen: the links make a rigid group of the chain: joint{'s' if len(names) > 1 else ''} "
+        f"{', '.join(names)} cannot move, but the profiles move {'them' if len(names) > 1 else 'it'}",
+        blamed[-1] if blamed else None,
     )
 
 

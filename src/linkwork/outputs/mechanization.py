@@ -114,6 +114,12 @@ def print_mechanization(found: Mechanization) -> None:
             str(j + 1), f"{value:.6f}", f"{state.e_max:.4f}", f"{design.chain.joined_errors[j]:.4f}"
         )
     console.print(states)
+    if found.recut is not None:
+        before = ", ".join(f"{e:.4f}" for e in found.recut.joined_before)
+        console.print(
+            f"the chain followed is re-cut so that every C-segment's piece count moves one way ("
+            f"{found.recut.describe()}); the synthesised chain's E_max: {before}"
+        )
     if found.options is not None:
         size = design.chain.size
         longest = found.options.link_limit(size)
