@@ -44,3 +44,48 @@ def test_bin_counts_add_up_to_the_full_histogram() -> None:
         bands.BinCounts.of(bands.histogram(part, 0.5)).add_into(total)
     assert np.array_equal(total, full)
     assert total.sum() == values.size
+
+
+def _dense_by_definition(values: np.ndarray, length: float) -> np.ndarray:
+    """The histogram as the bands module defines it, written out case by case (zeros and negatives in bin 0,
+    NaN and infinity in the last bin, else floor((log10(v / L) - LOW) PER_DECADE) + 1 clipped)."""
+    from linkwork.studies import bands
+
+    K = values.shape[1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.log10(np.maximum(values, 0.0) / length)
+    pos = np.where(np.isfinite(x), (x - bands.LOW) * bands.PER_DECADE + 1.0, 0.0)
+    pos = np.where(np.isnan(x) | (x == np.inf), bands.N_BINS - 1.0, pos)
+    idx = np.clip(np.floor(pos), 0, bands.N_BINS - 1).astype(np.int64)
+    out = np.zeros((K, bands.N_BINS), dtype=np.int64)
+    np.add.at(out, (np.broadcast_to(np.arange(K), idx.shape), idx), 1)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_occupied_bins_counted_directly_equal_the_full_histogram(seed: int) -> None:
+    """A chunk's bins are counted without the full (K, N_BINS) array: the same bins and counts, in the same order,
+    for values spread over every decade, exactly on bin edges, zeros, negatives, NaN, infinities, tiny subnormals,
+    and a single sample."""
+    from linkwork.studies import bands
+
+    rng = np.random.default_rng(seed)
+    S, K = (1, 37) if seed == 0 else (int(rng.integers(2, 700)), int(rng.integers(1, 60)))
+    length = float(rng.choice([1.0, 0.37, 1e-3, 250.0]))
+    values = 10.0 ** rng.uniform(-20, 5, size=(S, K)) * length
+    edges = (
+        10.0 ** (bands.LOW + rng.integers(-50, bands.N_BINS + 50, size=(S, K)) / bands.PER_DECADE) * length
+    )
+    values = np.where(rng.random((S, K)) < 0.3, edges, values)
+    for bad in (0.0, -1.0, np.nan, np.inf, -np.inf, 5e-324):
+        values[rng.random((S, K)) < 0.02] = bad
+    dense = _dense_by_definition(values, length)
+    assert np.array_equal(bands.histogram(values, length), dense)
+    direct = bands.BinCounts.of_values(values, length)
+    via_dense = bands.BinCounts.of(dense)
+    assert direct.index.dtype == np.int32 and direct.counts.dtype == np.int32
+    assert np.array_equal(direct.index, via_dense.index)
+    assert np.array_equal(direct.counts, via_dense.counts)
+    total = np.zeros_like(dense)
+    direct.add_into(total)
+    assert np.array_equal(total, dense) and total.sum() == values.size

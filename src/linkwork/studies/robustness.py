@@ -149,8 +149,8 @@ def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
         at_step=at.astype(np.int64),
         mobility_kept=worst <= setup.keep_tol,
         first_order_max=predicted.max(axis=1),
-        hist=bands.BinCounts.of(bands.histogram(misfit, setup.scale.length)),
-        hist_first=bands.BinCounts.of(bands.histogram(predicted, setup.scale.length)),
+        hist=bands.BinCounts.of_values(misfit, setup.scale.length),
+        hist_first=bands.BinCounts.of_values(predicted, setup.scale.length),
         drive_max=misfit.max(axis=0),
     )
 
