@@ -8,23 +8,30 @@ import itertools
 import numpy as np
 import pytest
 
-from linkwork.studies.robustness import CHUNK, MIN_CHUNK, chunk_ranges
+from linkwork.studies.robustness import CHUNK_VALUES, MIN_CHUNK_VALUES, chunk_ranges
 
 
 @pytest.mark.parametrize(
-    ("samples", "workers"), [(1, 1), (99, 2), (1000, 2), (20_000, 1), (20_000, 2), (123_457, 7)]
-)
-def test_guided_chunks_cover_every_sample_once_and_end_small(samples: int, workers: int) -> None:
-    ranges = chunk_ranges(samples, None, workers)
+    ("samples", "workers", "points"),
+    [(1, 1, 200), (99, 2, 200), (1000, 2, 200), (20_000, 1, 200), (20_000, 2, 200), (123_457, 7, 41),
+     (5000, 2, 10_000), (300, 3, 1)],
+)  # fmt: skip
+def test_guided_chunks_cover_every_sample_once_and_end_small(samples: int, workers: int, points: int) -> None:
+    ranges = chunk_ranges(samples, None, workers, points)
     assert ranges[0][0] == 0 and ranges[-1][1] == samples
     assert all(a[1] == b[0] for a, b in itertools.pairwise(ranges))
     sizes = [b - a for a, b in ranges]
-    assert all(0 < size <= CHUNK for size in sizes)
-    assert all(size >= MIN_CHUNK for size in sizes[:-1])
+    largest = CHUNK_VALUES // points
+    smallest = min(largest, -(-MIN_CHUNK_VALUES // points))
+    assert all(0 < size <= largest for size in sizes)  # a task's arrays stay bounded however long the path
+    assert all(size >= smallest for size in sizes[:-1])
     assert all(a >= b for a, b in itertools.pairwise(sizes[:-1]))  # non-increasing, but the last
-    if samples >= 8 * MIN_CHUNK * workers:
-        # The work a worker can be left alone with at the end is one small chunk, not a tenth of its share.
-        assert sizes[-2] == MIN_CHUNK and sizes[0] >= 2 * MIN_CHUNK
+    for (start, _), size in zip(ranges, sizes, strict=True):
+        # At most half a worker's share of what is left: the rest still spreads over every worker.
+        assert size <= max(smallest, -(-(samples - start) // (2 * workers)))
+    if samples >= 8 * smallest * workers:
+        # The work a worker can be left alone with at the end is one small chunk.
+        assert sizes[-2] == smallest and sizes[0] >= 2 * smallest
 
 
 def test_a_given_chunk_size_is_kept() -> None:

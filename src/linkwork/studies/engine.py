@@ -364,7 +364,7 @@ def _run_on(
     from dask.distributed import wait
     from distributed.comm.core import CommClosedError
 
-    n_workers = max(1, _worker_count(client))
+    n_workers = max(1, worker_count(client))
     window = max(2, 3 * n_workers)
     [remote] = client.scatter([shared], broadcast=True, hash=False)
     token = uuid.uuid4().hex
@@ -445,9 +445,12 @@ def _result(
     return failed(chunk, reason)
 
 
-def _worker_count(client: Any) -> int:
-    """The workers the scheduler knows now."""
-    return len(client.scheduler_info(n_workers=-1).get("workers", {}))
+def worker_count(client: Any) -> int:
+    """The workers the scheduler knows now (their number only: the scheduler does not describe each)."""
+    info = client.scheduler_info(n_workers=0)
+    if "n_workers" in info:
+        return int(info["n_workers"])
+    return len(client.scheduler_info(n_workers=-1).get("workers", {}))  # pragma: no cover - older dask
 
 
 class _Watch:
@@ -484,6 +487,6 @@ class _Watch:
 
     def _workers(self) -> int:
         try:
-            return _worker_count(self.client)
+            return worker_count(self.client)
         except Exception:  # an unreachable scheduler has no workers we can use
             return 0
