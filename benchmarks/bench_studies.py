@@ -22,6 +22,7 @@ Run: ``python benchmarks/bench_studies.py`` (``--samples``, ``--memory-samples``
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import resource
@@ -72,6 +73,19 @@ def client_cpu() -> dict[str, float]:
     communication)."""
     total, main = time.process_time(), time.thread_time()
     return {"main": main, "loop": total - main}
+
+
+def worker_cpu() -> dict[str, float]:
+    """In a dask worker: CPU seconds of the process so far, and of its task threads (dask's executor), the rest
+    being the worker's own event loop (messages, heartbeats, monitors)."""
+    import threading
+
+    tasks = 0.0
+    for thread in threading.enumerate():
+        if "Dask-Default-Threads" in thread.name and thread.ident is not None:
+            with contextlib.suppress(OSError, AttributeError):
+                tasks += time.clock_gettime(time.pthread_getcpuclockid(thread.ident))
+    return {"process": time.process_time(), "tasks": tasks}
 
 
 def worker_timeline(
@@ -128,21 +142,22 @@ def timed_cluster_run(
     t0 = time.perf_counter()
     with dask_client(None, workers) as client:
         client.run(run_chunk, setup, 0, 2)  # numba cache load on every worker, timed with start-up
-        cpu0 = client.run(time.process_time)
+        cpu0 = client.run(worker_cpu)
         with get_task_stream(client) as stream:
             c0 = client_cpu()
             t1, s1 = time.perf_counter(), dask_time()
             res = run_study(setup, samples, ratio, client=client, chunk=chunk)
             t2, s2 = time.perf_counter(), dask_time()
             c1 = client_cpu()
-        cpu1 = client.run(time.process_time)
+        cpu1 = client.run(worker_cpu)
     n_workers = len(cpu0)
     timeline = worker_timeline(
         stream.data, chunk_ranges(samples, chunk, n_workers, setup.u_path.shape[0]), s1, s2
     )
-    cpu = {w: cpu1[w] - cpu0[w] for w in cpu0}
+    cpu = {w: cpu1[w]["process"] - cpu0[w]["process"] for w in cpu0}
     for w, line in timeline.items():
         line["cpu_s"] = cpu.get(w, float("nan"))
+        line["task_cpu_s"] = cpu1[w]["tasks"] - cpu0[w]["tasks"] if w in cpu0 else float("nan")
     return {
         "startup_s": t1 - t0,
         "study_s": t2 - t1,
@@ -214,7 +229,8 @@ def print_timelines(report: dict[str, Any]) -> None:
         )
         for k, line in enumerate(run["workers"].values()):
             print(
-                f"  worker {k}: {line['n_tasks']} tasks, {line['samples']} samples, CPU {line['cpu_s']:.3f} s, "
+                f"  worker {k}: {line['n_tasks']} tasks, {line['samples']} samples, CPU {line['cpu_s']:.3f} s "
+                f"({line['task_cpu_s']:.3f} in tasks), "
                 f"computing {line['busy_s']:.3f} s, idle {line['lead_s']:.3f} s before the first task, "
                 f"{line['gaps_s']:.3f} s between tasks, {line['tail_s']:.3f} s after the last"
             )
