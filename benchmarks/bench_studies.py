@@ -100,7 +100,10 @@ def worker_timeline(
 ) -> dict[str, dict[str, Any]]:
     """Per worker, from dask's task stream (each task's compute start and stop, stamped by the worker):
     tasks, samples, busy seconds, and the idle seconds before its first task (``lead``), between tasks
-    (``gaps``) and after its last task until the study returned (``tail``); also each task's record."""
+    (``gaps``) and after its last task until the study returned (``tail``); also each task's record. A worker
+    shifts its stamps by its estimate of its clock's offset from the scheduler's, which on one machine is only
+    latency noise, re-estimated at every heartbeat: these times are right to a few milliseconds (a loaded
+    machine's tasks may even seem to overlap)."""
     out: dict[str, dict[str, Any]] = {}
     for rec in records:
         index = int(str(rec["key"]).rsplit("-", 1)[1])

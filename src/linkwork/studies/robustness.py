@@ -43,6 +43,9 @@ MAX_ITER = 30
 #: Closure solves (samples x path points) per task at most: about 1.3 s of one worker for the hexagon of 200
 #: points, whose (S, K) arrays then take 8 MB each.
 CHUNK_VALUES = 1_000_000
+#: Samples per task at most, whatever the path (a sample's hinge errors, twists and their temporaries take a few
+#: kB: a short path's chunks would otherwise hold hundreds of MB).
+CHUNK_SAMPLES = 5000
 #: Closure solves per task at least (but for the last): the tail's chunks, about 50 ms of the same hexagon.
 MIN_CHUNK_VALUES = 40_000
 
@@ -179,15 +182,15 @@ def chunk_ranges(
 ) -> list[tuple[int, int]]:
     """``(start, stop)`` of every chunk of ``samples`` along a path of ``points`` points: ``chunk`` samples each
     when given; by default guided chunks, each half of a worker's share of the samples left, of
-    :data:`MIN_CHUNK_VALUES` to :data:`CHUNK_VALUES` closure solves: the first chunks are large and the last ones
-    small, so that the workers finish together whatever their speeds while the run has few tasks (each costs a
+    :data:`MIN_CHUNK_VALUES` to :data:`CHUNK_VALUES` closure solves and at most :data:`CHUNK_SAMPLES` samples: the
+    first chunks are large and the last ones small, so that the workers finish together whatever their speeds while the run has few tasks (each costs a
     few milliseconds of the client's, the scheduler's and a worker's CPU: on two cores, time taken from the
     workers). A sample's numbers never depend on its chunk."""
     if chunk:
         size = max(1, chunk)
         return [(a, min(a + size, samples)) for a in range(0, samples, size)]
     points = max(1, points)
-    largest = max(1, CHUNK_VALUES // points)
+    largest = max(1, min(CHUNK_SAMPLES, CHUNK_VALUES // points))
     smallest = min(largest, -(-MIN_CHUNK_VALUES // points))
     out, start, share = [], 0, 2 * max(1, workers)
     while start < samples:
