@@ -96,3 +96,20 @@ def test_occupied_bins_counted_directly_equal_the_full_histogram(seed: int) -> N
     total = np.zeros_like(dense)
     direct.add_into(total)
     assert np.array_equal(total, dense) and total.sum() == values.size
+
+
+def test_a_chunk_reports_the_bytes_it_sends_back(bennett) -> None:
+    """Dask reads a result's size with sys.getsizeof (worker memory, the benchmark's bytes per task): a chunk's
+    is the size of its arrays, what pickling it for the client takes, to within pickle's headers."""
+    import pickle
+    import sys
+
+    from linkwork.studies.imperfections import ImperfectionModel
+    from linkwork.studies.robustness import prepare, run_chunk
+
+    mech, path = bennett
+    setup = prepare(mech, path, ImperfectionModel(1e-4, np.radians(0.01)), seed=1)
+    for stop in (1, 300):
+        chunk = run_chunk(setup, 0, stop)
+        sent = len(pickle.dumps(chunk, protocol=5))
+        assert abs(sys.getsizeof(chunk) - sent) <= 3000, (stop, sys.getsizeof(chunk), sent)
