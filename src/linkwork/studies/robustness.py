@@ -183,9 +183,9 @@ def chunk_ranges(
     """``(start, stop)`` of every chunk of ``samples`` along a path of ``points`` points: ``chunk`` samples each
     when given; by default guided chunks, each half of a worker's share of the samples left, of
     :data:`MIN_CHUNK_VALUES` to :data:`CHUNK_VALUES` closure solves and at most :data:`CHUNK_SAMPLES` samples: the
-    first chunks are large and the last ones small, so that the workers finish together whatever their speeds while the run has few tasks (each costs a
-    few milliseconds of the client's, the scheduler's and a worker's CPU: on two cores, time taken from the
-    workers). A sample's numbers never depend on its chunk."""
+    first chunks are large and the last ones small, so that the workers finish together whatever their speeds,
+    while the run has few tasks (each costs a few milliseconds of the client's, the scheduler's and a worker's
+    CPU: on two cores, time taken from the workers). A sample's numbers never depend on its chunk."""
     if chunk:
         size = max(1, chunk)
         return [(a, min(a + size, samples)) for a in range(0, samples, size)]
