@@ -3,9 +3,15 @@
 Measures, for ``hedgepeth-rods`` n = 6 traced in 200 points (199 equal steps of theta_A from the bundle to the flat
 hexagon) with hinges within 1e-3 rod lengths and 0.05 deg (normal):
 
-(a) 20,000 imperfect hexagons on two local worker processes (goal: under 60 s), the cluster's start-up timed apart;
+(a) 20,000 imperfect hexagons on two local worker processes (goal: under 60 s), the cluster's start-up and the
+    numba cache load timed apart; the cluster is the engine's own (as the command line starts it);
 (b) the same study on one worker: the two-worker speed-up (goal: >= 1.8x), and the cost of one closure solve
-    (one drive value of one sample) in this process (goal: <= 2 us);
+    (one drive value of one sample) in this process (goal: <= 2 us). Where the two-worker run loses time against
+    2x, from quantities a loaded machine changes little: each worker's CPU time (in its tasks, and in all), its
+    tasks and samples, its idle time before the first task, between tasks and after the last (dask's task
+    stream); this process's CPU time (its main thread: client and merge; the rest: the local cluster's
+    scheduler and nannies, and communication), tasks and bytes sent back; and the speed-up those CPU times allow
+    on two idle cores;
 (c) the first-order prediction of all 10,000 largest misfits against the Monte Carlo, both as CPU time in one
     process (goal: >= 100x faster), and against the wall time of (a);
 (d) memory: ``--memory-samples`` samples (10^6 by default; hexagon, 20-point path) streamed to Parquet in this
@@ -16,12 +22,14 @@ Prints a table and writes ``benchmarks/results/studies.json``.
 
 Every process is single-threaded (``NUMBA_NUM_THREADS`` and the BLAS pools 1, here and in the workers).
 
-Run: ``python benchmarks/bench_studies.py`` (``--samples``, ``--memory-samples`` (0 skips (d)), ``--quick``).
+Run: ``python benchmarks/bench_studies.py`` (``--samples``, ``--memory-samples`` (0 skips (d)), ``--quick``,
+``--repeat N`` pairs of runs, two workers then one, the median pair reported).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import resource
@@ -40,7 +48,14 @@ from threads import single_threaded
 import linkwork as lw
 from linkwork.linkages.hedgepeth_rods import deployed_angles
 from linkwork.studies.imperfections import ImperfectionModel
-from linkwork.studies.robustness import first_order_only, nominal_ratio, prepare, run_chunk, run_study
+from linkwork.studies.robustness import (
+    chunk_ranges,
+    first_order_only,
+    nominal_ratio,
+    prepare,
+    run_chunk,
+    run_study,
+)
 
 POINTS = 200  # drive values per sample: one closure solve each
 
@@ -59,30 +74,132 @@ def hexagon_setup(points: int) -> tuple[Any, np.ndarray]:
     return prepare(mech, path, model, seed=0), nominal_ratio(path)
 
 
+def client_cpu() -> dict[str, float]:
+    """CPU seconds of this process so far: its main thread (the client's loop over results, the merge) and the
+    rest (the event loop thread, which runs the local cluster's scheduler and nannies and the client's
+    communication)."""
+    total, main = time.process_time(), time.thread_time()
+    return {"main": main, "loop": total - main}
+
+
+def worker_cpu() -> dict[str, float]:
+    """In a dask worker: CPU seconds of the process so far, and of its task threads (dask's executor), the rest
+    being the worker's own event loop (messages, heartbeats, monitors)."""
+    import threading
+
+    tasks = 0.0
+    for thread in threading.enumerate():
+        if "Dask-Default-Threads" in thread.name and thread.ident is not None:
+            with contextlib.suppress(OSError, AttributeError):
+                tasks += time.clock_gettime(time.pthread_getcpuclockid(thread.ident))
+    return {"process": time.process_time(), "tasks": tasks}
+
+
+def worker_timeline(
+    records: list[dict[str, Any]], ranges: list[tuple[int, int]], start: float, stop: float
+) -> dict[str, dict[str, Any]]:
+    """Per worker, from dask's task stream (each task's compute start and stop, stamped by the worker):
+    tasks, samples, busy seconds, and the idle seconds before its first task (``lead``), between tasks
+    (``gaps``) and after its last task until the study returned (``tail``); also each task's record. A worker
+    shifts its stamps by its estimate of its clock's offset from the scheduler's, which on one machine is only
+    latency noise, re-estimated at every heartbeat: these times are right to a few milliseconds (a loaded
+    machine's tasks may even seem to overlap)."""
+    out: dict[str, dict[str, Any]] = {}
+    for rec in records:
+        index = int(str(rec["key"]).rsplit("-", 1)[1])
+        for ss in rec["startstops"]:
+            if ss["action"] != "compute":
+                continue
+            w = out.setdefault(rec["worker"], {"tasks": []})
+            w["tasks"].append(
+                {
+                    "chunk": index,
+                    "samples": ranges[index][1] - ranges[index][0],
+                    "start_s": ss["start"] - start,
+                    "stop_s": ss["stop"] - start,
+                    "bytes": int(rec.get("nbytes", 0)),
+                }
+            )
+    for w in out.values():
+        tasks = sorted(w["tasks"], key=lambda t: t["start_s"])
+        busy = sum(t["stop_s"] - t["start_s"] for t in tasks)
+        w.update(
+            tasks=tasks,
+            n_tasks=len(tasks),
+            samples=sum(t["samples"] for t in tasks),
+            bytes=sum(t["bytes"] for t in tasks),
+            busy_s=busy,
+            lead_s=tasks[0]["start_s"],
+            tail_s=(stop - start) - tasks[-1]["stop_s"],
+            gaps_s=tasks[-1]["stop_s"] - tasks[0]["start_s"] - busy,
+        )
+    return out
+
+
 def timed_cluster_run(
     setup: Any, ratio: np.ndarray, samples: int, workers: int, chunk: int | None = None
-) -> dict[str, float]:
-    from dask.distributed import Client, LocalCluster
+) -> dict[str, Any]:
+    """The study on a local cluster of ``workers`` processes started as the command line starts it (the
+    engine's :func:`~linkwork.studies.engine.dask_client`), timed from the call to ``run_study`` to its return;
+    the cluster's start-up and the numba cache load in every worker are timed apart. Also: each worker's CPU
+    time and timeline (dask's task stream), this process's CPU time (client, scheduler, nannies), tasks and
+    bytes sent back."""
+    from dask.distributed import get_task_stream
+    from distributed.metrics import time as dask_time
+
+    from linkwork.studies.engine import dask_client
 
     t0 = time.perf_counter()
-    with (
-        LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=":0"
-        ) as cluster,
-        Client(cluster) as client,
-    ):
-        client.run(lambda: run_chunk(setup, 0, 2))  # numba cache load on every worker, timed with start-up
-        cpu0 = client.run(time.process_time)
-        t1 = time.perf_counter()
-        res = run_study(setup, samples, ratio, client=client, chunk=chunk)
-        t2 = time.perf_counter()
-        cpu1 = client.run(time.process_time)
-    cpu = [cpu1[w] - cpu0[w] for w in cpu0]
+    with dask_client(None, workers) as client:
+        client.run(run_chunk, setup, 0, 2)  # numba cache load on every worker, timed with start-up
+        cpu0 = client.run(worker_cpu)
+        with get_task_stream(client) as stream:
+            c0 = client_cpu()
+            t1, s1 = time.perf_counter(), dask_time()
+            res = run_study(setup, samples, ratio, client=client, chunk=chunk)
+            t2, s2 = time.perf_counter(), dask_time()
+            c1 = client_cpu()
+        cpu1 = client.run(worker_cpu)
+    n_workers = len(cpu0)
+    timeline = worker_timeline(
+        stream.data, chunk_ranges(samples, chunk, n_workers, setup.u_path.shape[0]), s1, s2
+    )
+    cpu = {w: cpu1[w]["process"] - cpu0[w]["process"] for w in cpu0}
+    for w, line in timeline.items():
+        line["cpu_s"] = cpu.get(w, float("nan"))
+        line["task_cpu_s"] = cpu1[w]["tasks"] - cpu0[w]["tasks"] if w in cpu0 else float("nan")
     return {
         "startup_s": t1 - t0,
         "study_s": t2 - t1,
-        "worker_cpu_s": cpu,
+        "worker_cpu_s": list(cpu.values()),
+        "client_main_cpu_s": c1["main"] - c0["main"],
+        "client_loop_cpu_s": c1["loop"] - c0["loop"],
+        "tasks": sum(line["n_tasks"] for line in timeline.values()),
+        "bytes_back": sum(line["bytes"] for line in timeline.values()),
+        "workers": timeline,
         "median_misfit": float(np.median(res.misfit_max)),
+    }
+
+
+def losses(one: dict[str, Any], two: dict[str, Any]) -> dict[str, float]:
+    """Where the two-worker run's wall time goes beyond half the one-worker run's (seconds), from quantities
+    that do not depend on the machine's load: the workers' extra CPU time over one worker's, shared by two
+    cores; this process's CPU time (client, scheduler, nannies), which on two cores takes from the workers;
+    the busiest worker's CPU beyond the mean; and, load-dependent, the workers' idle time (before the first
+    task, between tasks, after the last). ``estimate`` is the speed-up the CPU times allow on two idle cores:
+    one worker's CPU over all the CPU of the two-worker run (both workers and this process) spread evenly on two
+    cores (on a loaded machine the busiest worker is the one the system gave more time, so its CPU is not used
+    here; ``imbalance_s`` shows it)."""
+    w1 = sum(one["worker_cpu_s"])
+    w2 = two["worker_cpu_s"]
+    client2 = two["client_main_cpu_s"] + two["client_loop_cpu_s"]
+    idle = [line["lead_s"] + line["gaps_s"] + line["tail_s"] for line in two["workers"].values()]
+    return {
+        "extra_worker_cpu_s": (sum(w2) - w1) / 2,
+        "client_cpu_s": client2 / 2,
+        "imbalance_s": max(w2) - sum(w2) / len(w2),
+        "idle_s": sum(idle) / len(idle),
+        "estimate": w1 / ((sum(w2) + client2) / 2),
     }
 
 
@@ -110,6 +227,32 @@ def memory_run(samples: int) -> dict[str, float]:
     }
 
 
+def print_timelines(report: dict[str, Any]) -> None:
+    """Each run's tasks, bytes, CPU times and idle times, and the two-worker run's losses against 2x."""
+    for name in ("two_workers", "one_worker", "two_workers_equal_chunks"):
+        run = report.get(name)
+        if run is None:
+            continue
+        print(
+            f"{name.replace('_', ' ')}: {run['tasks']} tasks, {run['bytes_back'] / 1e6:.1f} MB back; this process "
+            f"{run['client_main_cpu_s']:.3f} s CPU in its main thread (client, merge) + "
+            f"{run['client_loop_cpu_s']:.3f} s in the rest (scheduler, nannies, communication)"
+        )
+        for k, line in enumerate(run["workers"].values()):
+            print(
+                f"  worker {k}: {line['n_tasks']} tasks, {line['samples']} samples, CPU {line['cpu_s']:.3f} s "
+                f"({line['task_cpu_s']:.3f} in tasks), "
+                f"computing {line['busy_s']:.3f} s, idle {line['lead_s']:.3f} s before the first task, "
+                f"{line['gaps_s']:.3f} s between tasks, {line['tail_s']:.3f} s after the last"
+            )
+    lost = report["losses"]
+    print(
+        f"two workers against half of one (s): workers' extra CPU {lost['extra_worker_cpu_s']:+.3f}, "
+        f"this process's CPU {lost['client_cpu_s']:.3f}, busiest worker's CPU beyond the mean "
+        f"{lost['imbalance_s']:.3f}, workers idle {lost['idle_s']:.3f} (load-dependent)"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -122,6 +265,12 @@ def main() -> None:
         type=int,
         default=0,
         help="also run two workers with equal chunks of this size (2000: the chunking before guided chunks)",
+    )
+    parser.add_argument(
+        "--repeat",
+        type=int,
+        default=1,
+        help="pairs of runs (two workers, one worker); the median pair is reported",
     )
     parser.add_argument(
         "--out", type=Path, default=Path(__file__).resolve().parent / "results" / "studies.json"
@@ -144,19 +293,26 @@ def main() -> None:
     run_chunk(setup, 0, n_cpu)
     report["mc_cpu_s_per_sample"] = (time.process_time() - t0) / n_cpu
     report["mc_us_per_closure_solve"] = report["mc_cpu_s_per_sample"] / POINTS * 1e6
-    report["two_workers"] = timed_cluster_run(setup, ratio, samples, 2)
-    report["one_worker"] = timed_cluster_run(setup, ratio, samples, 1)
-    report["speedup_two_over_one"] = report["one_worker"]["study_s"] / report["two_workers"]["study_s"]
+    pairs = []
+    for _ in range(max(1, args.repeat)):  # one worker and two, alternately, on fresh clusters
+        two = timed_cluster_run(setup, ratio, samples, 2)
+        one = timed_cluster_run(setup, ratio, samples, 1)
+        pairs.append({"two_workers": two, "one_worker": one, "speedup": one["study_s"] / two["study_s"]})
+    middle = sorted(pairs, key=lambda pair: pair["speedup"])[(len(pairs) - 1) // 2]
+    report["two_workers"], report["one_worker"] = middle["two_workers"], middle["one_worker"]
+    report["speedup_two_over_one"] = middle["speedup"]
+    report["speedups_two_over_one"] = [pair["speedup"] for pair in pairs]
     if args.equal_chunks:
         report["two_workers_equal_chunks"] = timed_cluster_run(setup, ratio, samples, 2, args.equal_chunks)
         report["speedup_equal_chunks"] = (
             report["one_worker"]["study_s"] / report["two_workers_equal_chunks"]["study_s"]
         )
-    # Load-independent estimate: one worker's CPU time over the busiest of two workers' (what the wall times
-    # would be on idle cores).
+    # Load-independent estimates: one worker's CPU time over the busiest of two workers' (what the wall times
+    # would be on idle cores if nothing else ran), and over all the CPU time of the two-worker run on two cores.
     report["speedup_cpu_estimate"] = sum(report["one_worker"]["worker_cpu_s"]) / max(
         report["two_workers"]["worker_cpu_s"]
     )
+    report["losses"] = losses(report["one_worker"], report["two_workers"])
     report["first_order_vs_mc_wall"] = report["two_workers"]["study_s"] / report["first_order_s"]
     report["first_order_vs_mc_cpu"] = report["mc_cpu_s_per_sample"] * samples / report["first_order_cpu_s"]
     report["memory"] = memory_run(memory_samples) if memory_samples > 0 else None
@@ -167,7 +323,9 @@ def main() -> None:
         ("    cluster start-up + cache load", f"{report['two_workers']['startup_s']:.1f} s", ""),
         (f"(b) {samples} hexagons, 1 worker", f"{report['one_worker']['study_s']:.1f} s", ""),
         ("    speed-up 2 workers / 1 (wall)", f"{report['speedup_two_over_one']:.2f}x", ">= 1.8x"),
-        ("    the same from worker CPU times", f"{report['speedup_cpu_estimate']:.2f}x", "(idle cores)"),
+        ("    each pair of runs (wall)", " ".join(f"{x:.2f}x" for x in report["speedups_two_over_one"]), ""),
+        ("    from worker CPU times", f"{report['speedup_cpu_estimate']:.2f}x", "(idle cores)"),
+        ("    from all CPU times, on two cores", f"{report['losses']['estimate']:.2f}x", "(idle cores)"),
         (
             "    one closure solve (CPU, this process)",
             f"{report['mc_us_per_closure_solve']:.2f} us",
@@ -195,6 +353,7 @@ def main() -> None:
         )
     for name, value, goal in rows:
         print(f"{name:40s} {value:>28s}  {goal}")
+    print_timelines(report)
     print(f"load average before {report['load_before']}, after {report['load_after']}")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")

@@ -32,8 +32,27 @@ def test_chunking_does_not_change_any_sample(bennett):
     assert not np.array_equal(other.misfit_max, whole.misfit_max)
 
 
-def test_two_worker_cluster_gives_the_local_numbers(bennett, tmp_path):
-    from dask.distributed import Client, LocalCluster
+@pytest.fixture
+def port_8787_taken():
+    """Dask's default HTTP port held (when free) by a listening socket, as another cluster or a notebook would."""
+    import socket
+
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen(1)
+    except OSError:  # already taken by something else: the same situation
+        pass
+    yield
+    holder.close()
+
+
+def test_two_worker_cluster_gives_the_local_numbers(bennett, tmp_path, port_8787_taken):
+    """The engine's own local cluster (as the command line starts it): the numbers of this process exactly, its
+    settings in every worker, and no dask warning (pytest runs with -W error) when port 8787 is taken."""
+    import dask
+
+    from linkwork.studies.engine import LOCAL_CLUSTER_CONFIG, dask_client
 
     mech, path = bennett
     model = ImperfectionModel(1e-4, np.radians(0.01))
@@ -47,12 +66,9 @@ def test_two_worker_cluster_gives_the_local_numbers(bennett, tmp_path):
     study = load_study(study_file)
     local_rows = [row for row, _ in run_sweep(study, workers=0)]
     seen: list[tuple[int, int]] = []
-    with (
-        LocalCluster(
-            n_workers=2, threads_per_worker=1, host="127.0.0.1", processes=True, dashboard_address=":0"
-        ) as cluster,
-        Client(cluster) as client,
-    ):
+    with dask_client(None, 2) as client:
+        settings = client.run(lambda: {key: dask.config.get(key) for key in LOCAL_CLUSTER_CONFIG})
+        assert list(settings.values()) == [LOCAL_CLUSTER_CONFIG] * 2
         remote = robustness(
             mech, path, model, 80, seed=3, client=client, chunk=20, progress=lambda d, t: seen.append((d, t))
         )

@@ -22,16 +22,26 @@ PER_DECADE = 100
 N_BINS = round((HIGH - LOW) * PER_DECADE) + 2
 
 
+def bin_index(values: Array, length: float) -> NDArray[np.int64]:
+    """``(S, K)`` the bin of every value of ``values (S, K)``: ``floor((log10(v / L) - LOW) PER_DECADE) + 1``,
+    clipped to ``0 .. N_BINS - 1``; zeros (and anything below ``10^LOW L``) in bin 0, NaN and infinity (failed
+    solves) in the last bin, as the largest. One temporary the size of ``values``, worked on in place."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.log10(np.maximum(values, 0.0) / length)
+    x -= LOW  # in place, the same operations in the same order as (x - LOW) * PER_DECADE + 1.0
+    x *= PER_DECADE
+    x += 1.0
+    np.nan_to_num(x, copy=False, nan=N_BINS - 1.0, posinf=N_BINS - 1.0, neginf=0.0)
+    np.floor(x, out=x)
+    np.clip(x, 0.0, N_BINS - 1.0, out=x)
+    return x.astype(np.int64)
+
+
 def histogram(values: Array, length: float) -> NDArray[np.int64]:
     """``(K, N_BINS)`` counts of ``values (S, K)`` per column."""
     K = values.shape[1]
-    with np.errstate(divide="ignore"):
-        x = np.log10(np.maximum(values, 0.0) / length)
-    pos = np.where(np.isfinite(x), (x - LOW) * PER_DECADE + 1.0, 0.0)
-    pos = np.where(np.isnan(x) | (x == np.inf), N_BINS - 1.0, pos)  # failed solves count as the largest
-    idx = np.clip(np.floor(pos), 0, N_BINS - 1).astype(np.int64)
-    flat = (np.arange(K)[None, :] * N_BINS + idx).ravel()
-    return np.bincount(flat, minlength=K * N_BINS).astype(np.int64).reshape(K, N_BINS)
+    flat = (np.arange(K)[None, :] * N_BINS + bin_index(values, length)).ravel()
+    return np.bincount(flat, minlength=K * N_BINS).reshape(K, N_BINS)
 
 
 @dataclass(frozen=True)
@@ -45,6 +55,25 @@ class BinCounts:
 
     index: NDArray[np.int32]
     counts: NDArray[np.int32]
+
+    @classmethod
+    def of_values(cls, values: Array, length: float) -> BinCounts:
+        """The occupied bins of the histogram of ``values (S, K)`` (equal to ``of(histogram(values, length))``),
+        counted without the full ``(K, N_BINS)`` array: each column's bins between its lowest and highest occupied
+        one are counted in one ``bincount`` (a chunk's fixed cost then grows with the bins its samples reach, not
+        with ``K N_BINS``, whose allocation and scans cost milliseconds a chunk)."""
+        idx = bin_index(values, length)
+        if idx.size == 0:
+            return cls(np.zeros(0, dtype=np.int32), np.zeros(0, dtype=np.int32))
+        lo = idx.min(axis=0)
+        width = idx.max(axis=0) - lo + 1
+        base = np.cumsum(width) - width  # where each column's bins start in the packed counts
+        idx -= lo - base
+        counts = np.bincount(idx.ravel(), minlength=int(width.sum()))
+        packed = np.flatnonzero(counts)
+        column = np.searchsorted(base, packed, side="right") - 1
+        index = column * N_BINS + (packed - base[column] + lo[column])
+        return cls(index.astype(np.int32), counts[packed].astype(np.int32))
 
     @classmethod
     def of(cls, full: NDArray[np.int64]) -> BinCounts:

@@ -23,7 +23,7 @@ from linkwork.kinematics.trace_result import Trace
 from linkwork.limits import MAX_PATH_POINTS
 from linkwork.progress import Progress
 from linkwork.studies import bands
-from linkwork.studies.engine import RunStatus, default_workers, map_chunks
+from linkwork.studies.engine import RunStatus, default_workers, map_chunks, worker_count
 from linkwork.studies.first_order import first_order_misfit, sensitivity_maps
 from linkwork.studies.imperfections import (
     HingeLines,
@@ -40,9 +40,14 @@ Array = NDArray[np.float64]
 
 #: Gauss-Newton iterations per drive value at most.
 MAX_ITER = 30
-#: Samples per task at most, and at least (but for the last), unless a chunk size is asked for.
-CHUNK = 2000
-MIN_CHUNK = 100
+#: Closure solves (samples x path points) per task at most: about 1.3 s of one worker for the hexagon of 200
+#: points, whose (S, K) arrays then take 8 MB each.
+CHUNK_VALUES = 1_000_000
+#: Samples per task at most, whatever the path (a sample's hinge errors, twists and their temporaries take a few
+#: kB: a short path's chunks would otherwise hold hundreds of MB).
+CHUNK_SAMPLES = 5000
+#: Closure solves per task at least (but for the last): the tail's chunks, about 50 ms of the same hexagon.
+MIN_CHUNK_VALUES = 40_000
 
 
 @dataclass(frozen=True)
@@ -84,6 +89,16 @@ class ChunkResult:
     hist: bands.BinCounts
     hist_first: bands.BinCounts
     drive_max: Array
+
+    def __sizeof__(self) -> int:
+        """Bytes of its arrays (what travels from a worker to the client): Dask reads the size of a result this
+        way (``sys.getsizeof``), to account for worker memory and report the bytes of each task."""
+        arrays = [
+            getattr(self, name) for name in ("sample", "seed", "misfit_max", "at_step", "mobility_kept")
+        ]
+        arrays += [self.first_order_max, self.drive_max, self.hist.index, self.hist.counts]
+        arrays += [self.hist_first.index, self.hist_first.counts]
+        return object.__sizeof__(self) + sum(int(a.nbytes) for a in arrays)
 
 
 @trace_keyword
@@ -149,8 +164,8 @@ def run_chunk(setup: RobustnessSetup, start: int, stop: int) -> ChunkResult:
         at_step=at.astype(np.int64),
         mobility_kept=worst <= setup.keep_tol,
         first_order_max=predicted.max(axis=1),
-        hist=bands.BinCounts.of(bands.histogram(misfit, setup.scale.length)),
-        hist_first=bands.BinCounts.of(bands.histogram(predicted, setup.scale.length)),
+        hist=bands.BinCounts.of_values(misfit, setup.scale.length),
+        hist_first=bands.BinCounts.of_values(predicted, setup.scale.length),
         drive_max=misfit.max(axis=0),
     )
 
@@ -162,18 +177,24 @@ def first_order_only(setup: RobustnessSetup, start: int, stop: int) -> Array:
     return first_order_misfit(setup.G, errors).max(axis=1)
 
 
-def chunk_ranges(samples: int, chunk: int | None = None, workers: int = 1) -> list[tuple[int, int]]:
-    """``(start, stop)`` of every chunk of ``samples``: ``chunk`` samples each when given; by default guided
-    chunks, each a quarter of the samples left per worker, between :data:`MIN_CHUNK` and :data:`CHUNK`: the first
-    chunks are large (little overhead per sample), the last ones small, so that the workers finish together
-    whatever their speeds (equal chunks of a tenth of a worker's share left one worker idle for up to a chunk at
-    the end). A sample's numbers never depend on its chunk."""
+def chunk_ranges(
+    samples: int, chunk: int | None = None, workers: int = 1, points: int = 1
+) -> list[tuple[int, int]]:
+    """``(start, stop)`` of every chunk of ``samples`` along a path of ``points`` points: ``chunk`` samples each
+    when given; by default guided chunks, each half of a worker's share of the samples left, of
+    :data:`MIN_CHUNK_VALUES` to :data:`CHUNK_VALUES` closure solves and at most :data:`CHUNK_SAMPLES` samples: the
+    first chunks are large and the last ones small, so that the workers finish together whatever their speeds,
+    while the run has few tasks (each costs a few milliseconds of the client's, the scheduler's and a worker's
+    CPU: on two cores, time taken from the workers). A sample's numbers never depend on its chunk."""
     if chunk:
         size = max(1, chunk)
         return [(a, min(a + size, samples)) for a in range(0, samples, size)]
-    out, start, share = [], 0, 4 * max(1, workers)
+    points = max(1, points)
+    largest = max(1, min(CHUNK_SAMPLES, CHUNK_VALUES // points))
+    smallest = min(largest, -(-MIN_CHUNK_VALUES // points))
+    out, start, share = [], 0, 2 * max(1, workers)
     while start < samples:
-        size = min(CHUNK, max(MIN_CHUNK, -(-(samples - start) // share)))
+        size = min(largest, max(smallest, -(-(samples - start) // share)))
         out.append((start, min(start + size, samples)))
         start += size
     return out
@@ -261,13 +282,13 @@ def run_study(
     if samples < 1:
         raise SpecError(f"samples must be at least 1, got {samples}")
     if client is not None:
-        n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+        n_workers = worker_count(client)
     else:
         n_workers = workers if workers is not None else default_workers()
     results = map_chunks(
         run_chunk,
         setup,
-        chunk_ranges(samples, chunk, n_workers),
+        chunk_ranges(samples, chunk, n_workers, setup.u_path.shape[0]),
         scheduler=scheduler,
         workers=workers,
         client=client,
