@@ -240,8 +240,8 @@ def planar_closure(flat, q, residual, jac, m, E):
     """
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
     for e in range(E):
-        for a in range(m):
-            jac[e, a] = 0.0
+        for c in range(m):
+            jac[e, c] = 0.0
     for k in range(E // 3):
         cg, sg, px, py = 1.0, 0.0, 0.0, 0.0
         for idx in range(loop_ptr[k], loop_ptr[k + 1]):
