@@ -267,10 +267,7 @@ def planar_closure(flat, q, residual, jac, m, E):
             py += sg * ex + cg * ey
             cg, sg = cg * ce - sg * se, sg * ce + cg * se
         # log of the planar motion (as kernels.log_rigid): angle, then v = p - (w x p)/2 + D w x (w x p)
-        if cg > 0.0 and abs(sg) < 1e-8 * cg:
-            t = sg / cg  # atan(x) rounds to x below 1e-8 (x^2 / 3 under half an ulp): atan2 without the call
-        else:
-            t = np.arctan2(sg, cg)
+        t = np.arctan2(sg, cg)
         a = abs(t)
         if a < 1e-2:
             t2 = a * a
@@ -440,29 +437,30 @@ def singular_values(M, W, V, sigma, E):
 
 
 @kernel(inline="always")
-def point_rows(flat, q, work, m, E):
-    """At joint values ``q``: the closure residual and Jacobian, the QR of ``J^T``, the tangent and the singular
-    values, into ``work = (res, jac, M, beta, W, V, V_prev, t, sig)``; returns ``(det(Q), det(R))``. ``m, E``
-    are the sizes (called with literal constants for one loop, where the small loops unroll).
-
-    The Jacobi rotations start from the right singular vectors extrapolated from the last two points
-    (``2 V - V_prev``, re-orthonormalised by :func:`singular_values`): along equal steps they are then off by the
-    second difference only, and one sweep fewer is needed.
-    """
-    res, jac, M, beta, W, V, V_prev, t, sig = work
+def jacobian_rows(flat, q, work, m, E):
+    """At joint values ``q``: the closure residual and Jacobian, the Householder QR of ``J^T`` and the tangent
+    (``Q``'s last column), into ``work = (res, jac, M, beta, t)``; returns ``det(Q) det(R)`` (``R`` is the
+    upper triangle of ``M[:E]``). ``m, E`` are the sizes (literal constants for one loop: the loops unroll)."""
+    res, jac, M, beta, t = work
     planar_closure(flat, q, res, jac, m, E)
-    det_q = qr_of_transpose(jac, M, beta, m, E)
+    det = qr_of_transpose(jac, M, beta, m, E)
     null_vector(M, beta, t, m, E)
+    for e in range(E):
+        det *= M[e, e]
+    return det
+
+
+@kernel(inline="always")
+def warm_singular_values(R, W, V, V_prev, sigma, E):
+    """:func:`singular_values` of the triangle ``R`` warm-started from the right singular vectors extrapolated
+    from the last two points (``2 V - V_prev``; ``singular_values`` re-orthonormalises them): along equal steps
+    they are then off by the second difference only, and one sweep fewer is needed."""
     for a in range(E):
         for c in range(E):
             x = V[a, c]
             V[a, c] = 2.0 * x - V_prev[a, c]
             V_prev[a, c] = x
-    singular_values(M, W, V, sig, E)
-    det_r = 1.0
-    for e in range(E):
-        det_r *= M[e, e]
-    return det_q, det_r
+    singular_values(R, W, V, sigma, E)
 
 
 @kernel()
@@ -476,6 +474,13 @@ def closed_form_path(flat, plan, run):
 
     Returns ``(count, status, u, sigma, res, tau, s)``: rows ``0 .. count - 1`` (row 0 the start), status
     :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
+
+    Three passes over the points, each a short loop whose points do not wait for each other (so the processor
+    overlaps them), give what one pass point by point would: the positions (dyads and joint values, up to the
+    first point where a dyad has no solution or a joint jumps); at each of those points the Jacobian, its QR and
+    the tangent; then, point by point, the singular values (warm-started from the point before), the tangent's
+    orientation, the test function and every check, in the order of the one-pass loop, so the same point ends
+    the path with the same status.
     """
     groups = flat[4]
     joint_int, joint_geo, dyads, modes, head = plan
@@ -494,72 +499,91 @@ def closed_form_path(flat, plan, run):
     out_res = np.zeros(steps + 1)
     out_tau = np.zeros(steps + 1)
     out_s = np.zeros(steps + 1)
+    # Pass 1: positions. Rows 0 .. last are placed; ``ended`` says why row last + 1 could not be (CLEAN: none).
     poses = np.zeros((head[2], 4))
     for b in range(head[2]):
         poses[b, 0] = 1.0  # the fixed body keeps the identity; every other body is placed at every point
     q = np.zeros(n)
     q_prev = np.zeros(n)
-    t = np.empty(m)
-    sig = np.empty(E)
+    last, ended = steps, CLEAN
+    for k in range(1, steps + 1):
+        drive_q = q_prev[drive] + h if k < steps else target
+        place_driven(joint_int, joint_geo, drive, driven, drive_q, poses)
+        for i in range(dyads.shape[0]):
+            status = place_dyad(joint_int, joint_geo, dyads[i], modes[i], poses, min_margin)
+            if status != CLEAN:
+                ended = status
+                break
+        if (
+            ended == CLEAN
+            and joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q) > 0.5 * np.pi
+        ):
+            ended = JUMP
+        if ended != CLEAN:
+            last = k - 1
+            break
+        for j in range(n):
+            out_u[k, groups[j]] = q[j]
+            q_prev[j] = q[j]
+    # Pass 2: at every placed point, the Jacobian's triangle R, the tangent and det(Q) det(R).
+    tri = np.empty((last + 1, E, E))
+    tangents = np.empty((last + 1, m))
+    work = (np.empty(E), np.empty((E, m)), np.empty((m, E)), np.empty(2 * E), np.empty(m))
+    M, t = work[2], work[4]
+    for k in range(last + 1):
+        for j in range(n):
+            q[j] = out_u[k, groups[j]]
+        if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
+            out_tau[k] = jacobian_rows(flat, q, work, 4, 3)
+        else:
+            out_tau[k] = jacobian_rows(flat, q, work, m, E)
+        acc = 0.0
+        for e in range(E):
+            acc += work[0][e] * work[0][e]
+            for c in range(E):
+                tri[k, e, c] = M[e, c]
+        out_res[k] = np.sqrt(acc)
+        for a in range(m):
+            tangents[k, a] = t[a]
+    # Pass 3: point by point, singular values, orientation, test function and the checks.
     V = np.eye(E)  # the right singular vectors, carried from point to point
-    work = (
-        np.empty(E),
-        np.empty((E, m)),
-        np.empty((m, E)),
-        np.empty(2 * E),
-        np.empty((E, E)),
-        V,
-        V.copy(),
-        t,
-        sig,
-    )
+    V_prev = np.eye(E)
+    W = np.empty((E, E))
+    sig = np.empty(E)
     t_prev = t0.copy()
     far = 0.0
-    for k in range(steps + 1):
-        if k > 0:
-            drive_q = q_prev[drive] + h if k < steps else target
-            place_driven(joint_int, joint_geo, drive, driven, drive_q, poses)
-            for i in range(dyads.shape[0]):
-                status = place_dyad(joint_int, joint_geo, dyads[i], modes[i], poses, min_margin)
-                if status != CLEAN:
-                    return k, status, out_u, out_sigma, out_res, out_tau, out_s
-            if joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q) > 0.5 * np.pi:
-                return k, JUMP, out_u, out_sigma, out_res, out_tau, out_s
-        if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
-            det_q, det_r = point_rows(flat, q, work, 4, 3)
+    for k in range(last + 1):
+        if E == 3:
+            warm_singular_values(tri[k], W, V, V_prev, sig, 3)
         else:
-            det_q, det_r = point_rows(flat, q, work, m, E)
+            warm_singular_values(tri[k], W, V, V_prev, sig, E)
         dot = 0.0
         for a in range(m):
-            dot += t[a] * t_prev[a]
+            dot += tangents[k, a] * t_prev[a]
         orient = -1.0 if dot < 0.0 else 1.0
-        tau = det_basis * det_r * orient * det_q
+        tau = det_basis * out_tau[k] * orient
+        t_drive = tangents[k, g_drive]
         # Where the predictor-corrector would do more than step: hand over to it.
-        if sig[E - 1] < min_ratio * sig[0] or abs(t[g_drive]) < min_drive:
+        if sig[E - 1] < min_ratio * sig[0] or abs(t_drive) < min_drive:
             return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and (orient * t[g_drive]) * h <= 0.0:
+        if k > 0 and (orient * t_drive) * h <= 0.0:
             return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
         if k > 0 and tau * out_tau[k - 1] < 0.0:
             return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
         dist = 0.0
         wrapped = 0.0
-        for j in range(n):
-            g = groups[j]
-            du = q[j] - out_u[k - 1, g] if k > 0 else 0.0
-            dist += du * du
-            out_u[k, g] = q[j]
-            x = wrap_angle(q[j]) if periodic[g] else q[j]
-            wrapped += x * x
-            if q[j] < lo[g] or q[j] > hi[g]:
+        for g in range(m):
+            x = out_u[k, g]
+            if x < lo[g] or x > hi[g]:
                 return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
+            du = x - out_u[k - 1, g] if k > 0 else 0.0
+            dist += du * du
+            x = wrap_angle(x) if periodic[g] else x
+            wrapped += x * x
         for a in range(m):
-            t_prev[a] = orient * t[a]
-        res = work[0]
-        acc = 0.0
+            t_prev[a] = orient * tangents[k, a]
         for e in range(E):
-            acc += res[e] * res[e]
             out_sigma[k, e] = sig[e]
-        out_res[k] = np.sqrt(acc)
         out_tau[k] = tau
         out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
         if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
@@ -567,6 +591,6 @@ def closed_form_path(flat, plan, run):
             far = max(far, d)
             if far > 4.0 * hmax and d < 1.5 * abs(h):
                 return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
-        for j in range(n):
-            q_prev[j] = q[j]
+    if ended != CLEAN:
+        return last + 1, ended, out_u, out_sigma, out_res, out_tau, out_s
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
