@@ -47,6 +47,8 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
     7,
 )
 N_SETTINGS = 8
+#: Points per block of the closed form's second and third passes (their scratch stays in the cache).
+BLOCK = 64
 
 
 @kernel(inline="always")
@@ -478,8 +480,8 @@ def closed_form_path(flat, plan, run):
     Returns ``(count, status, u, sigma, res, tau, s)``: rows ``0 .. count - 1`` (row 0 the start), status
     :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
 
-    Three passes over the points, each a short loop whose points do not wait for each other (so the processor
-    overlaps them), give what one pass point by point would: the positions (dyads and joint values, up to the
+    Three passes over the points (the last two a block of :data:`BLOCK` points at a time), each a short loop,
+    give what one pass point by point would: the positions (dyads and joint values, up to the
     first point where a dyad has no solution or a joint jumps); at each of those points the Jacobian, its QR and
     the tangent; then, point by point, the singular values (warm-started from the point before), the tangent's
     orientation, the test function and every check, in the order of the one-pass loop, so the same point ends
@@ -528,72 +530,77 @@ def closed_form_path(flat, plan, run):
         for j in range(n):
             out_u[k, groups[j]] = q[j]
             q_prev[j] = q[j]
-    # Pass 2: at every placed point, the Jacobian's triangle R, the tangent and det(Q) det(R).
-    tri = np.empty((last + 1, E, E))
-    tangents = np.empty((last + 1, m))
+    # Passes 2 and 3, a block of points at a time (the block's scratch stays in the cache).
+    tri = np.empty((BLOCK, E, E))
+    tangents = np.empty((BLOCK, m))
     work = (np.empty(E), np.empty((E, m)), np.empty((m, E)), np.empty(2 * E), np.empty(m))
     M, t = work[2], work[4]
-    for k in range(last + 1):
-        for j in range(n):
-            q[j] = out_u[k, groups[j]]
-        if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
-            out_tau[k] = jacobian_rows(flat, q, work, 4, 3)
-        else:
-            out_tau[k] = jacobian_rows(flat, q, work, m, E)
-        acc = 0.0
-        for e in range(E):
-            acc += work[0][e] * work[0][e]
-            for c in range(E):
-                tri[k, e, c] = M[e, c]
-        out_res[k] = np.sqrt(acc)
-        for a in range(m):
-            tangents[k, a] = t[a]
-    # Pass 3: point by point, singular values, orientation, test function and the checks.
     V = np.eye(E)  # the right singular vectors, carried from point to point
     history = (np.eye(E), np.eye(E))
     W = np.empty((E, E))
     sig = np.empty(E)
     t_prev = t0.copy()
     far = 0.0
-    for k in range(last + 1):
-        if E == 3:
-            warm_singular_values(tri[k], W, V, history, sig, 3)
-        else:
-            warm_singular_values(tri[k], W, V, history, sig, E)
-        dot = 0.0
-        for a in range(m):
-            dot += tangents[k, a] * t_prev[a]
-        orient = -1.0 if dot < 0.0 else 1.0
-        tau = det_basis * out_tau[k] * orient
-        t_drive = tangents[k, g_drive]
-        # Where the predictor-corrector would do more than step: hand over to it.
-        if sig[E - 1] < min_ratio * sig[0] or abs(t_drive) < min_drive:
-            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and (orient * t_drive) * h <= 0.0:
-            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and tau * out_tau[k - 1] < 0.0:
-            return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
-        dist = 0.0
-        wrapped = 0.0
-        for g in range(m):
-            x = out_u[k, g]
-            if x < lo[g] or x > hi[g]:
-                return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
-            du = x - out_u[k - 1, g] if k > 0 else 0.0
-            dist += du * du
-            x = wrap_angle(x) if periodic[g] else x
-            wrapped += x * x
-        for a in range(m):
-            t_prev[a] = orient * tangents[k, a]
-        for e in range(E):
-            out_sigma[k, e] = sig[e]
-        out_tau[k] = tau
-        out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
-        if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-            d = np.sqrt(wrapped)
-            far = max(far, d)
-            if far > 4.0 * hmax and d < 1.5 * abs(h):
-                return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
+    for first in range(0, last + 1, BLOCK):
+        stop = min(first + BLOCK, last + 1)
+        # Pass 2: at every point of the block, the Jacobian's triangle R, the tangent and det(Q) det(R).
+        for k in range(first, stop):
+            i = k - first
+            for j in range(n):
+                q[j] = out_u[k, groups[j]]
+            if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
+                out_tau[k] = jacobian_rows(flat, q, work, 4, 3)
+            else:
+                out_tau[k] = jacobian_rows(flat, q, work, m, E)
+            acc = 0.0
+            for e in range(E):
+                acc += work[0][e] * work[0][e]
+                for c in range(E):
+                    tri[i, e, c] = M[e, c]
+            out_res[k] = np.sqrt(acc)
+            for a in range(m):
+                tangents[i, a] = t[a]
+        # Pass 3: point by point, singular values, orientation, test function and the checks.
+        for k in range(first, stop):
+            i = k - first
+            if E == 3:
+                warm_singular_values(tri[i], W, V, history, sig, 3)
+            else:
+                warm_singular_values(tri[i], W, V, history, sig, E)
+            dot = 0.0
+            for a in range(m):
+                dot += tangents[i, a] * t_prev[a]
+            orient = -1.0 if dot < 0.0 else 1.0
+            tau = det_basis * out_tau[k] * orient
+            t_drive = tangents[i, g_drive]
+            # Where the predictor-corrector would do more than step: hand over to it.
+            if sig[E - 1] < min_ratio * sig[0] or abs(t_drive) < min_drive:
+                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
+            if k > 0 and (orient * t_drive) * h <= 0.0:
+                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
+            if k > 0 and tau * out_tau[k - 1] < 0.0:
+                return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
+            dist = 0.0
+            wrapped = 0.0
+            for g in range(m):
+                x = out_u[k, g]
+                if x < lo[g] or x > hi[g]:
+                    return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
+                du = x - out_u[k - 1, g] if k > 0 else 0.0
+                dist += du * du
+                x = wrap_angle(x) if periodic[g] else x
+                wrapped += x * x
+            for a in range(m):
+                t_prev[a] = orient * tangents[i, a]
+            for e in range(E):
+                out_sigma[k, e] = sig[e]
+            out_tau[k] = tau
+            out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
+            if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
+                d = np.sqrt(wrapped)
+                far = max(far, d)
+                if far > 4.0 * hmax and d < 1.5 * abs(h):
+                    return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
     if ended != CLEAN:
         return last + 1, ended, out_u, out_sigma, out_res, out_tau, out_s
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
