@@ -282,3 +282,26 @@ def test_plain_python_twin_of_the_closed_form_gives_the_same_rows() -> None:
         assert plain[:2] == out[:2] == (41, 0)
         for a, b in zip(plain[2:], out[2:], strict=True):
             np.testing.assert_allclose(a, b, rtol=0.0, atol=1e-13)
+
+
+def test_shared_singular_values_kernel_against_numpy() -> None:
+    """``dyad_solver.singular_values`` (the kernel another tracer may share: sizes read from its arguments, cold
+    start from the identity) on triangles of 3 and 6 columns: generic, nearly singular (1e-9 of the largest) and
+    with two equal values; to 1e-13 of the largest against numpy's SVD."""
+    from linkwork.kinematics import dyad_solver
+
+    rng = np.random.default_rng(7)
+    for E in (3, 6):
+        for kind in ("generic", "nearly singular", "equal pair"):
+            U, _ = np.linalg.qr(rng.normal(size=(E, E)))
+            Vt, _ = np.linalg.qr(rng.normal(size=(E, E)))
+            s = np.sort(rng.uniform(0.5, 3.0, E))[::-1]
+            if kind == "nearly singular":
+                s[-1] = 1e-9 * s[0]
+            elif kind == "equal pair":
+                s[1] = s[0]
+            R = np.linalg.qr(U @ np.diag(s) @ Vt, mode="r")
+            M = np.vstack([R, np.zeros((1, E))])  # a QR's (m, E) array: R on and above the diagonal of M[:E]
+            sigma = np.empty(E)
+            dyad_solver.singular_values(M, np.empty((E, E)), np.eye(E), sigma)
+            assert np.max(np.abs(sigma - np.linalg.svd(R, compute_uv=False))) < 1e-13 * s[0], (E, kind)

@@ -406,7 +406,14 @@ def jacobi_sweeps(W, V, E):
 
 
 @kernel(inline="always")
-def singular_values(M, W, V, sigma, E):
+def singular_values(M, W, V, sigma):
+    """:func:`triangle_singular_values` with the size read from ``M`` (``E = M.shape[1]``): the descending
+    singular values of the upper triangle of ``M[:E]``, warm-started from ``V`` (updated in place)."""
+    triangle_singular_values(M, W, V, sigma, M.shape[1])
+
+
+@kernel(inline="always")
+def triangle_singular_values(M, W, V, sigma, E):
     """Singular values (descending) of the triangular factor ``R`` (upper triangle of ``M[:E]``, ``E`` columns)
     by one-sided Jacobi rotations (Hestenes): the columns of ``W = R V`` are made orthogonal; their norms are the
     values.
@@ -454,9 +461,9 @@ def jacobian_rows(flat, q, work, m, E):
 
 @kernel(inline="always")
 def warm_singular_values(R, W, V, history, sigma, E):
-    """:func:`singular_values` of the triangle ``R`` warm-started from the right singular vectors extrapolated
-    from the last three points (``V``, then ``history = (V_1, V_2)`` one and two points back): ``3 V - 3 V_1 +
-    V_2`` (``singular_values`` re-orthonormalises it). Along equal steps it is off by the third difference only,
+    """:func:`triangle_singular_values` of the triangle ``R`` warm-started from the right singular vectors
+    extrapolated from the last three points (``V``, then ``history = (V_1, V_2)`` one and two points back):
+    ``3 V - 3 V_1 + V_2`` (re-orthonormalised there). Along equal steps it is off by the third difference only,
     a few 1e-9 at a thousandth of a radian a step, and one Jacobi sweep mostly finishes the values."""
     V_1, V_2 = history
     for a in range(E):
@@ -465,7 +472,7 @@ def warm_singular_values(R, W, V, history, sigma, E):
             V[a, c] = 3.0 * (x - x1) + V_2[a, c]
             V_2[a, c] = x1
             V_1[a, c] = x
-    singular_values(R, W, V, sigma, E)
+    triangle_singular_values(R, W, V, sigma, E)
 
 
 @kernel()
