@@ -134,8 +134,6 @@ def numerical_rank(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> int:
 def numerical_ranks(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> np.ndarray:
     """:func:`numerical_rank` of every row of ``sigma (N, k)``, vectorised over the rows that need no gap test."""
     s = np.atleast_2d(np.asarray(sigma, dtype=float))
-    if s.shape[1] and np.all(s[:, 0] > 0.0) and np.all(s / s[:, :1] > tol.loose):  # every value counts
-        return np.full(len(s), s.shape[1], dtype=np.int64)
     first = np.where(s[:, :1] > 0.0, s[:, :1], 1.0)
     rel = s / first
     sure = np.sum(rel > tol.loose, axis=1)

@@ -97,7 +97,7 @@ def trace(
     if t_start[d_unknown] * sign < 0:
         t_start = -t_start
     lo, hi = _limits_in_unknowns(mech, limits)
-    periodic = np.array([mech.joint_types[members[0]] == "R" for members in mech.group_members()])
+    periodic = np.array([mech.joint_types[mech.group_members()[g][0]] == "R" for g in range(m)])
     settings = MarchSettings(
         drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=float(np.cos(max_turn)),
         r_path=r_path, n_sigma=min(jac0.shape), periodic=periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
@@ -224,11 +224,10 @@ def _assemble(
     ]
     unmet = None
     if until is not None:
+        on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
         first = branch_list[0]
         end = End(first.end_kind or StopReason.BUDGET, first.end_reason, first.end_joint, first.end_value)
-        if end.kind != StopReason.TARGET:  # reached: no verdict, and no copy of the branch's rows to make
-            on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
-            unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
+        unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
     stats = TraceStats(
         start_rank=marcher.cfg.r_path,
         start_mobility=mech.n_unknowns - marcher.cfg.r_path,
@@ -263,10 +262,8 @@ def _assemble(
 def _branch_mobility(mobility: NDArray[np.int64]) -> int:
     """The mobility that holds along a branch: the most frequent value over its points (ends excluded)."""
     inner = mobility[1:-1] if len(mobility) > 2 else mobility
-    low = int(inner.min())
-    return low + int(
-        np.argmax(np.bincount(inner - low))
-    )  # the smallest of equally frequent values, as np.unique
+    values, counts = np.unique(inner, return_counts=True)
+    return int(values[np.argmax(counts)])
 
 
 def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, angles: Array) -> str | None:
