@@ -10,10 +10,11 @@ full turn of the crank in ``--positions`` equal steps is computed three ways, si
 - **pylinkage** ``Linkage.step_fast(N)`` on the same linkage built from pylinkage's ``Crank`` / ``RRRDyad`` /
   ``RRPDyad`` (positions only, no Jacobian).
 
-Printed per linkage: microseconds per crank position (best of ``--repeats``), the ratios linkwork / pylinkage
-(goal <= 1) and predictor-corrector / linkwork, and the largest distance between the joint positions both
-programs computed (an outside check of the closed form). Timings on a loaded machine are only indicative: run it on
-a quiet one. Writes ``benchmarks/results/planar.json``.
+Printed per linkage: microseconds per crank position (best of ``--repeats``; linkwork and pylinkage timed in
+alternation, round after round, in one process), of which linkwork's compiled kernel (the rest is the Python
+around it: set-up and the Trace), the ratios linkwork / pylinkage (goal <= 1) and predictor-corrector / linkwork,
+and the largest distance between the joint positions both programs computed (an outside check of the closed form).
+Timings on a loaded machine are only indicative: run it on a quiet one. Writes ``benchmarks/results/planar.json``.
 
 Run: ``python benchmarks/bench_planar.py`` (``--positions``, ``--repeats``, ``--out``); needs ``pip install
 pylinkage`` (the ``bench`` extra).
@@ -38,7 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from threads import single_threaded
 
 import linkwork as lw
-from linkwork.kinematics import tracer
+from linkwork.kinematics import dyad_solver, tracer
 from linkwork.kinematics.closure import body_poses
 from linkwork.kinematics.mechanism import Mechanism
 
@@ -129,7 +130,11 @@ def pylinkage_model(name: str, mech: Mechanism, positions: int) -> tuple[Any, li
 
 
 def bench_one(name: str, mech: Mechanism, positions: int, repeats: int) -> dict[str, Any]:
-    """One linkage: linkwork closed form, the predictor-corrector, pylinkage; per-position costs and ratios."""
+    """One linkage: linkwork closed form, the predictor-corrector, pylinkage; per-position costs and ratios.
+
+    linkwork and pylinkage are timed in alternation, round after round in this process (best of ``repeats``
+    each), so that a load that comes and goes on the machine hits both alike; the compiled kernel's own time
+    inside linkwork's call is recorded too (the rest is the Python around it: set-up, the Trace)."""
     crank = mech.index("A")
     until = ("A", float(mech.offsets[crank] + 2.0 * np.pi))
     limit = 10 * positions
@@ -139,45 +144,68 @@ def bench_one(name: str, mech: Mechanism, positions: int, repeats: int) -> dict[
 
     run()  # compile or load the kernels
     closed_form = tracer.closed_form_rows
+    kernel = dyad_solver.closed_form_path
     taken: list[bool] = []
+    kernel_seconds: list[float] = []
 
     def watched(*args: Any, **kwargs: Any) -> Any:
         rows = closed_form(*args, **kwargs)
         taken.append(rows is not None)
         return rows
 
+    def timed_kernel(*args: Any) -> Any:
+        t0 = time.perf_counter()
+        out = kernel(*args)
+        kernel_seconds.append(time.perf_counter() - t0)
+        return out
+
     try:
         tracer.closed_form_rows = lambda *args, **kwargs: None  # the general predictor-corrector
         run()
         t_pc, path_pc = best_of(run, max(1, repeats // 4))
         tracer.closed_form_rows = watched
-        t_lw, path = best_of(run, repeats)
+        dyad_solver.closed_form_path = timed_kernel
+        path = run()
+        model: Any = None
+        try:
+            model, joints = pylinkage_model(name, mech, positions)
+        except ImportError:
+            pass
+        t_lw = t_pl = np.inf
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            if model is not None:
+                model.step_fast(positions)  # compile
+            for _ in range(repeats):  # alternate: the same load for both
+                t0 = time.perf_counter()
+                path = run()
+                t_lw = min(t_lw, time.perf_counter() - t0)
+                if model is not None:
+                    t0 = time.perf_counter()
+                    model.step_fast(positions)
+                    t_pl = min(t_pl, time.perf_counter() - t0)
+            if model is not None:  # the positions check on a fresh model's first turn (each call goes on from
+                # where the last ended, and pylinkage's crank angle drifts by round-off from turn to turn)
+                traj = pylinkage_model(name, mech, positions)[0].step_fast(positions)
     finally:
         tracer.closed_form_rows = closed_form
+        dyad_solver.closed_form_path = kernel
     if not all(taken):
         print(f"  note: {name}: the closed form handed this path over to the predictor-corrector")
     row: dict[str, Any] = {
         "positions": positions,
         "linkwork_us_per_position": t_lw / positions * 1e6,
+        "linkwork_kernel_us_per_position": min(kernel_seconds) / positions * 1e6,
         "predictor_corrector_us_per_position": t_pc / positions * 1e6,
         "predictor_corrector_over_linkwork": t_pc / t_lw,
         "max_difference_from_predictor_corrector_rad": float(np.max(np.abs(path.angles - path_pc.angles))),
     }
-    try:
-        model, joints = pylinkage_model(name, mech, positions)
-    except ImportError:
+    if model is None:
         row["pylinkage"] = "not installed (pip install pylinkage, or the bench extra)"
         return row
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        model.step_fast(positions)  # compile
-        t_pl = np.inf
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            traj = model.step_fast(positions)
-            t_pl = min(t_pl, time.perf_counter() - t0)
     row["pylinkage_us_per_position"] = t_pl / positions * 1e6
     row["linkwork_over_pylinkage"] = t_lw / t_pl
+    row["linkwork_kernel_over_pylinkage"] = min(kernel_seconds) / t_pl
     ours = joint_points(mech, path.angles[1:], joints)
     theirs = _pylinkage_joints(traj, model, joints)
     shift = _best_alignment(ours, theirs)
@@ -222,15 +250,17 @@ def main(argv: list[str] | None = None) -> None:
         report[name] = bench_one(name, mech, args.positions, args.repeats)
     report["load_after"] = os.getloadavg()
     print(
-        f"{'linkage':14s} {'linkwork':>10s} {'pylinkage':>10s} {'lw/pyl':>8s} {'pred-corr':>10s} {'pc/lw':>7s}"
+        f"{'linkage':14s} {'linkwork':>10s} {'(kernel)':>10s} {'pylinkage':>10s} {'lw/pyl':>8s} {'pred-corr':>10s}"
+        f" {'pc/lw':>7s}"
     )
-    print(f"{'':14s} {'us/pos':>10s} {'us/pos':>10s} {'(<=1)':>8s} {'us/pos':>10s} {'':>7s}")
+    print(f"{'':14s} {'us/pos':>10s} {'us/pos':>10s} {'us/pos':>10s} {'(<=1)':>8s} {'us/pos':>10s} {'':>7s}")
     for name in cases:
         r = report[name]
         pyl = r.get("pylinkage_us_per_position", float("nan"))
         ratio = r.get("linkwork_over_pylinkage", float("nan"))
         print(
-            f"{name:14s} {r['linkwork_us_per_position']:10.3f} {pyl:10.3f} {ratio:8.2f} "
+            f"{name:14s} {r['linkwork_us_per_position']:10.3f} {r['linkwork_kernel_us_per_position']:10.3f} "
+            f"{pyl:10.3f} {ratio:8.2f} "
             f"{r['predictor_corrector_us_per_position']:10.3f} {r['predictor_corrector_over_linkwork']:7.1f}"
         )
         print(

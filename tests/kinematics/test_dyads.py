@@ -209,3 +209,99 @@ def test_stephenson_six_bar_driven_by_its_crank_or_through_a_triad() -> None:
         fast, general, taken = traced_both_ways(mech, (drive, np.radians(turn)), 60)
         assert taken == expect
         assert_same_trace(fast, general)
+
+
+def kernel_rows(
+    mech: Mechanism, until: tuple[str, float], steps: int
+) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+    """``(arguments, outputs)`` of the compiled closed-form kernel on one paper-mode trace, whatever its status
+    (rows ``0 .. count - 1`` are the closed form's, also where it then handed the path over)."""
+    from linkwork.kinematics import dyad_solver
+
+    original = dyad_solver.closed_form_path
+    seen: list[tuple[tuple[Any, ...], tuple[Any, ...]]] = []
+
+    def watched(*args: Any) -> Any:
+        out = original(*args)
+        seen.append((args, out))
+        return out
+
+    try:
+        dyad_solver.closed_form_path = watched  # type: ignore[assignment]
+        lw.trace(mech, until=until, steps=steps)
+    finally:
+        dyad_solver.closed_form_path = original
+    assert seen, "the closed form was not tried"
+    return seen[-1]
+
+
+NEAR_SINGULAR = {
+    # a parallelogram driven towards its change point at 180 deg (sigma_min -> 0 there)
+    "change point": (
+        dict(ground=2.0, crank=1.0, coupler=2.0, rocker=1.0, theta=np.radians(60.0)),
+        179.9,
+        1199,
+    ),
+    # a four-bar next to the change-point condition (ground + coupler = crank + rocker + 0.01)
+    "near change point": (
+        dict(ground=2.0, crank=1.0, coupler=2.01, rocker=1.0, theta=np.radians(60.0)),
+        420.0,
+        3600,
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(NEAR_SINGULAR))
+def test_singular_values_next_to_singular_points_equal_fresh_svds(case: str) -> None:
+    """Every row the closed form computes on its way into a singular point of the Jacobian (until it hands over):
+    the singular values equal a fresh SVD of the Jacobian at the row's joint values to 1e-12 of the largest, with
+    the Jacobi sweeps stopped after a sweep with every cosine below 1e-8 and warm-started by extrapolation."""
+    params, target, steps = NEAR_SINGULAR[case]
+    mech = lw.load("four-bar", **params)
+    _, (count, _status, u, sigma, res, _tau, _s) = kernel_rows(mech, ("A", np.radians(target)), steps)
+    assert count > 10
+    ratios = []
+    for k in range(count):
+        fresh = np.linalg.svd(jacobian(mech, mech.q_from_u(u[k])), compute_uv=False)
+        assert np.max(np.abs(fresh - sigma[k])) < 1e-12 * fresh[0], (case, k)
+        assert res[k] < 1e-13
+        ratios.append(fresh[-1] / fresh[0])
+    assert min(ratios) < 0.05  # the rows do come close to the singular point (the hand-over is at 1e-2)
+
+
+def test_plain_python_twin_of_the_closed_form_gives_the_same_rows() -> None:
+    """The kernel's plain-Python twin (numba's py_func, as LINKWORK_JIT=python would run it) and the compiled
+    kernel: same status and rows, on a four-bar (one loop: the literal-size branch) and the Watt six-bar."""
+    from linkwork.kinematics import dyad_solver
+    from linkwork.kinematics.jit import python_twin
+
+    twin = python_twin({"closed_form_path": dyad_solver.closed_form_path}).closed_form_path
+    for mech in (lw.load("four-bar"), lw.load(str(WATT))):
+        args, out = kernel_rows(mech, ("A", float(mech.offsets[0] + np.radians(40.0))), 40)
+        plain = twin(*args)
+        assert plain[:2] == out[:2] == (41, 0)
+        for a, b in zip(plain[2:], out[2:], strict=True):
+            np.testing.assert_allclose(a, b, rtol=0.0, atol=1e-13)
+
+
+def test_shared_singular_values_kernel_against_numpy() -> None:
+    """``dyad_solver.singular_values`` (the kernel another tracer may share: sizes read from its arguments, cold
+    start from the identity) on triangles of 3 and 6 columns: generic, nearly singular (1e-9 of the largest) and
+    with two equal values; to 1e-13 of the largest against numpy's SVD."""
+    from linkwork.kinematics import dyad_solver
+
+    rng = np.random.default_rng(7)
+    for E in (3, 6):
+        for kind in ("generic", "nearly singular", "equal pair"):
+            U, _ = np.linalg.qr(rng.normal(size=(E, E)))
+            Vt, _ = np.linalg.qr(rng.normal(size=(E, E)))
+            s = np.sort(rng.uniform(0.5, 3.0, E))[::-1]
+            if kind == "nearly singular":
+                s[-1] = 1e-9 * s[0]
+            elif kind == "equal pair":
+                s[1] = s[0]
+            R = np.linalg.qr(U @ np.diag(s) @ Vt, mode="r")
+            M = np.vstack([R, np.zeros((1, E))])  # a QR's (m, E) array: R on and above the diagonal of M[:E]
+            sigma = np.empty(E)
+            dyad_solver.singular_values(M, np.empty((E, E)), np.eye(E), sigma)
+            assert np.max(np.abs(sigma - np.linalg.svd(R, compute_uv=False))) < 1e-13 * s[0], (E, kind)

@@ -30,7 +30,6 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
-from linkwork.kinematics.small_svd import orthogonalize_columns, orthonormalize_columns
 
 #: Joint kinds in ``joint_int[:, 0]``.
 REVOLUTE, PRISMATIC = 0, 1
@@ -48,11 +47,16 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
     7,
 )
 N_SETTINGS = 8
+#: Points per block of the closed form's second and third passes (their scratch stays in the cache).
+BLOCK = 64
 
 
 @kernel(inline="always")
 def wrap_angle(x: float) -> float:
-    """``x`` wrapped onto ``[-pi, pi)`` (compiled copy of :func:`linkwork.geometry.angles.wrap`)."""
+    """``x`` wrapped onto ``[-pi, pi)`` (compiled copy of :func:`linkwork.geometry.angles.wrap`); a value already
+    in the range is returned as it is (exactly, and without the floating-point modulo's cost)."""
+    if -np.pi <= x < np.pi:
+        return x
     return (x + np.pi) % (2.0 * np.pi) - np.pi
 
 
@@ -202,11 +206,17 @@ def place_dyad(joint_int, joint_geo, dyad, mode, poses, min_margin):
 
 
 @kernel(inline="always")
-def joint_values(joint_int, joint_geo, poses, q_prev, q):
-    """Every joint's displacement from its bodies' poses (revolute ones continued from ``q_prev``); returns the
-    largest change of a joint."""
+def joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q):
+    """Every joint's displacement from its bodies' poses (revolute ones continued from ``q_prev``), the drive's
+    set to ``drive_q``; returns the largest change of a joint (the drive's wrapped for a revolute drive, as its
+    value read back from the poses would be)."""
     jump = 0.0
     for j in range(joint_int.shape[0]):
+        if j == drive:
+            q[j] = drive_q
+            step = drive_q - q_prev[j]
+            jump = max(jump, abs(wrap_angle(step) if joint_int[j, 0] == REVOLUTE else step))
+            continue
         a, b = joint_int[j, 1], joint_int[j, 2]
         ca, sa = poses[a, 0], poses[a, 1]
         if joint_int[j, 0] == REVOLUTE:  # R_a^T R_b = Rz(omega_z q)
@@ -222,14 +232,19 @@ def joint_values(joint_int, joint_geo, poses, q_prev, q):
 
 
 @kernel(inline="always")
-def planar_closure(twists, loop_joint, loop_sign, loop_ptr, groups, q, residual, jac):
-    """Planar closure residual ``(omega_z, v_x, v_y)`` of ``log(P)`` per loop and its Jacobian in the unknowns.
+def planar_closure(flat, q, residual, jac, m, E):
+    """Planar closure residual ``(omega_z, v_x, v_y)`` of ``log(P)`` per loop and its ``(E, m)`` Jacobian in the
+    unknowns, for ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``.
 
     :func:`linkwork.kinematics.kernels.closure_pass` with rows ``(2, 3, 4)`` for twists in the plane, in SE(2):
     columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)).
+    ``m`` and ``E`` are the Jacobian's sizes (literal constants at a call site for one loop: the loops unroll).
     """
-    jac[:, :] = 0.0
-    for k in range(loop_ptr.shape[0] - 1):
+    twists, loop_joint, loop_sign, loop_ptr, groups = flat
+    for e in range(E):
+        for c in range(m):
+            jac[e, c] = 0.0
+    for k in range(E // 3):
         cg, sg, px, py = 1.0, 0.0, 0.0, 0.0
         for idx in range(loop_ptr[k], loop_ptr[k + 1]):
             j = loop_joint[idx]
@@ -269,10 +284,10 @@ def planar_closure(twists, loop_joint, loop_sign, loop_ptr, groups, q, residual,
 
 
 @kernel(inline="always")
-def qr_of_transpose(jac, M, beta):
+def qr_of_transpose(jac, M, beta, m, E):
     """Householder QR of ``J^T (m, E)`` in place in ``M`` (reflectors below the diagonal and in ``beta``, ``R``
-    on and above it); returns ``det(Q)`` (``-1`` per reflection applied)."""
-    m, E = M.shape
+    on and above it); returns ``det(Q)`` (``-1`` per reflection applied). ``m, E``: the sizes (literal
+    constants at a call site for one loop, so that the loops unroll)."""
     for a in range(m):
         for e in range(E):
             M[a, e] = jac[e, a]
@@ -298,8 +313,7 @@ def qr_of_transpose(jac, M, beta):
             dot *= beta[k]
             for a in range(k, m):
                 M[a, c] -= dot * M[a, k]
-        # Swap the reflector into the lower part and alpha onto the diagonal: the reflector's first entry is
-        # kept in ``beta``'s companion (recomputed below from the diagonal) - store it in a spare row instead.
+        # alpha onto the diagonal (R), the reflector's first entry into beta's second half.
         M[k, k], alpha = alpha, M[k, k]
         beta[E + k] = alpha
         det_q = -det_q
@@ -307,9 +321,8 @@ def qr_of_transpose(jac, M, beta):
 
 
 @kernel(inline="always")
-def null_vector(M, beta, t):
+def null_vector(M, beta, t, m, E):
     """``t = Q e_m``: the last column of the QR's ``Q`` (the null vector of ``J`` when it has full row rank)."""
-    m, E = M.shape
     for a in range(m):
         t[a] = 0.0
     t[m - 1] = 1.0
@@ -326,24 +339,98 @@ def null_vector(M, beta, t):
 
 
 @kernel(inline="always")
+def orthonormalise(V, E):
+    """Modified Gram-Schmidt on the columns of ``V (E, E)`` in place."""
+    for c in range(E):
+        for b in range(c):
+            dot = 0.0
+            for a in range(E):
+                dot += V[a, b] * V[a, c]
+            for a in range(E):
+                V[a, c] -= dot * V[a, b]
+        norm = 0.0
+        for a in range(E):
+            norm += V[a, c] * V[a, c]
+        norm = 1.0 / np.sqrt(norm)
+        for a in range(E):
+            V[a, c] *= norm
+
+
+@kernel(inline="always")
+def jacobi_sweeps(W, V, E):
+    """One-sided Jacobi rotations (Hestenes) on the columns of ``W (E, E)``, applied to ``V`` too; returns the
+    number of sweeps.
+
+    Each pair whose cosine exceeds 1e-15 is rotated to orthogonality. The sweeps stop after one in which no
+    pair's cosine exceeded 1e-8: Jacobi converges quadratically, so after such a sweep the columns are
+    orthogonal to about 1e-16 (a rotation of one pair moves another pair's cosine by at most the product of
+    two cosines of that sweep), and the column norms are the singular values to round-off; without a warm start
+    (or on a hard case) it goes on to at most 60 sweeps.
+
+    The rotation of a pair with squared norms ``alpha``, ``beta`` and inner product ``gamma`` is the classical
+    one (``tan = sign(zeta) / (|zeta| + sqrt(1 + zeta^2))``, ``zeta = (beta - alpha) / (2 gamma)``), written
+    with ``d = beta - alpha``, ``r = sqrt(d^2 + 4 gamma^2)``, ``D = |d| + r`` as ``cos = D / sqrt(2 r D)``,
+    ``sin = 2 gamma sign(d) / sqrt(2 r D)``: two square roots and one division in a row instead of five slow
+    operations (the rotations of a sweep depend on each other, so their latency is the cost).
+    """
+    for sweep in range(60):
+        wide = False
+        for p in range(E - 1):
+            for r in range(p + 1, E):
+                alpha, beta, gamma = 0.0, 0.0, 0.0
+                for a in range(E):
+                    alpha += W[a, p] * W[a, p]
+                    beta += W[a, r] * W[a, r]
+                    gamma += W[a, p] * W[a, r]
+                gg, ab = gamma * gamma, alpha * beta
+                if gg > 1e-16 * ab:
+                    wide = True
+                if gg <= 1e-30 * ab:
+                    continue
+                d = beta - alpha
+                root = np.sqrt(d * d + 4.0 * gg)
+                big = abs(d) + root
+                inv = 1.0 / np.sqrt(2.0 * root * big)
+                cos = big * inv
+                sin = (2.0 * gamma if d >= 0.0 else -2.0 * gamma) * inv
+                for a in range(E):
+                    wp, wr = W[a, p], W[a, r]
+                    W[a, p] = cos * wp - sin * wr
+                    W[a, r] = sin * wp + cos * wr
+                    vp, vr = V[a, p], V[a, r]
+                    V[a, p] = cos * vp - sin * vr
+                    V[a, r] = sin * vp + cos * vr
+        if not wide:
+            return sweep + 1
+    return 60
+
+
+@kernel(inline="always")
 def singular_values(M, W, V, sigma):
-    """Singular values (descending) of the triangular factor ``R`` (upper triangle of ``M[:E]``) by one-sided
-    Jacobi rotations (Hestenes): the columns of ``W = R V`` are made orthogonal; their norms are the values.
+    """:func:`triangle_singular_values` with the size read from ``M`` (``E = M.shape[1]``): the descending
+    singular values of the upper triangle of ``M[:E]``, warm-started from ``V`` (updated in place)."""
+    triangle_singular_values(M, W, V, sigma, M.shape[1])
+
+
+@kernel(inline="always")
+def triangle_singular_values(M, W, V, sigma, E):
+    """Singular values (descending) of the triangular factor ``R`` (upper triangle of ``M[:E]``, ``E`` columns)
+    by one-sided Jacobi rotations (Hestenes): the columns of ``W = R V`` are made orthogonal; their norms are the
+    values.
 
     ``V`` (orthogonal, updated in place) is the previous point's right singular vectors: along a path they change
     little, so ``R V`` starts nearly orthogonal and one sweep or two finish it. It is re-orthonormalised first
-    (Gram-Schmidt), so that rounding does not build up over a long path. The rotations are the shared kernels of
-    :mod:`linkwork.kinematics.small_svd`.
+    (Gram-Schmidt), so that rounding does not build up over a long path. ``E`` is a literal constant at a call
+    site for one loop (the loops unroll).
     """
-    E = M.shape[1]
-    orthonormalize_columns(V)
+    orthonormalise(V, E)
     for a in range(E):
         for c in range(E):
             acc = 0.0
             for b in range(a, E):
                 acc += M[a, b] * V[b, c]
             W[a, c] = acc
-    orthogonalize_columns(W, V, sigma)  # sigma: work space until the norms below
+    jacobi_sweeps(W, V, E)
     for c in range(E):
         acc = 0.0
         for a in range(E):
@@ -358,6 +445,36 @@ def singular_values(M, W, V, sigma):
         sigma[a + 1] = x
 
 
+@kernel(inline="always")
+def jacobian_rows(flat, q, work, m, E):
+    """At joint values ``q``: the closure residual and Jacobian, the Householder QR of ``J^T`` and the tangent
+    (``Q``'s last column), into ``work = (res, jac, M, beta, t)``; returns ``det(Q) det(R)`` (``R`` is the
+    upper triangle of ``M[:E]``). ``m, E`` are the sizes (literal constants for one loop: the loops unroll)."""
+    res, jac, M, beta, t = work
+    planar_closure(flat, q, res, jac, m, E)
+    det = qr_of_transpose(jac, M, beta, m, E)
+    null_vector(M, beta, t, m, E)
+    for e in range(E):
+        det *= M[e, e]
+    return det
+
+
+@kernel(inline="always")
+def warm_singular_values(R, W, V, history, sigma, E):
+    """:func:`triangle_singular_values` of the triangle ``R`` warm-started from the right singular vectors
+    extrapolated from the last three points (``V``, then ``history = (V_1, V_2)`` one and two points back):
+    ``3 V - 3 V_1 + V_2`` (re-orthonormalised there). Along equal steps it is off by the third difference only,
+    a few 1e-9 at a thousandth of a radian a step, and one Jacobi sweep mostly finishes the values."""
+    V_1, V_2 = history
+    for a in range(E):
+        for c in range(E):
+            x, x1 = V[a, c], V_1[a, c]
+            V[a, c] = 3.0 * (x - x1) + V_2[a, c]
+            V_2[a, c] = x1
+            V_1[a, c] = x
+    triangle_singular_values(R, W, V, sigma, E)
+
+
 @kernel()
 def closed_form_path(flat, plan, run):
     """The paper-mode path of a driver-and-dyads mechanism from its reference, in closed form, with its rows.
@@ -369,91 +486,128 @@ def closed_form_path(flat, plan, run):
 
     Returns ``(count, status, u, sigma, res, tau, s)``: rows ``0 .. count - 1`` (row 0 the start), status
     :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
+
+    Three passes over the points (the last two a block of :data:`BLOCK` points at a time), each a short loop,
+    give what one pass point by point would: the positions (dyads and joint values, up to the
+    first point where a dyad has no solution or a joint jumps); at each of those points the Jacobian, its QR and
+    the tangent; then, point by point, the singular values (warm-started from the point before), the tangent's
+    orientation, the test function and every check, in the order of the one-pass loop, so the same point ends
+    the path with the same status.
     """
-    twists, loop_joint, loop_sign, loop_ptr, groups = flat
+    groups = flat[4]
     joint_int, joint_geo, dyads, modes, head = plan
     settings, t0, lo, hi, periodic = run
     n = joint_int.shape[0]
     m = t0.shape[0]
-    E = 3 * (loop_ptr.shape[0] - 1)
+    E = 3 * (flat[3].shape[0] - 1)
     steps = int(settings[S_STEPS])
     h, target, hmax = settings[S_STEP], settings[S_TARGET], settings[S_HMAX]
+    min_ratio, min_drive, min_margin = settings[S_MIN_RATIO], settings[S_MIN_DRIVE], settings[S_MIN_MARGIN]
+    det_basis = settings[S_DET_BASIS]
     drive, driven = head[0], head[1]
+    g_drive = groups[drive]
     out_u = np.zeros((steps + 1, m))
     out_sigma = np.zeros((steps + 1, E))
     out_res = np.zeros(steps + 1)
     out_tau = np.zeros(steps + 1)
     out_s = np.zeros(steps + 1)
+    # Pass 1: positions. Rows 0 .. last are placed; ``ended`` says why row last + 1 could not be (CLEAN: none).
     poses = np.zeros((head[2], 4))
+    for b in range(head[2]):
+        poses[b, 0] = 1.0  # the fixed body keeps the identity; every other body is placed at every point
     q = np.zeros(n)
     q_prev = np.zeros(n)
-    res = np.empty(E)
-    jac = np.empty((E, m))
-    M = np.empty((m, E))
-    beta = np.empty(2 * E)
-    W = np.empty((E, E))
-    V = np.eye(E)  # the right singular vectors, carried from point to point
-    t = np.empty(m)
-    t_prev = t0.copy()
-    sig = np.empty(E)
-    far = 0.0
-    for k in range(steps + 1):
-        if k > 0:
-            drive_q = q_prev[drive] + h if k < steps else target
-            for b in range(poses.shape[0]):
-                poses[b, 0], poses[b, 1], poses[b, 2], poses[b, 3] = 1.0, 0.0, 0.0, 0.0
-            place_driven(joint_int, joint_geo, drive, driven, drive_q, poses)
-            for i in range(dyads.shape[0]):
-                status = place_dyad(joint_int, joint_geo, dyads[i], modes[i], poses, settings[S_MIN_MARGIN])
-                if status != CLEAN:
-                    return k, status, out_u, out_sigma, out_res, out_tau, out_s
-            if joint_values(joint_int, joint_geo, poses, q_prev, q) > 0.5 * np.pi:
-                return k, JUMP, out_u, out_sigma, out_res, out_tau, out_s
-            q[drive] = drive_q
-        planar_closure(twists, loop_joint, loop_sign, loop_ptr, groups, q, res, jac)
-        det_q = qr_of_transpose(jac, M, beta)
-        null_vector(M, beta, t)
-        singular_values(M, W, V, sig)
-        dot = 0.0
-        for a in range(m):
-            dot += t[a] * t_prev[a]
-        orient = -1.0 if dot < 0.0 else 1.0
-        det_r = 1.0
-        for e in range(E):
-            det_r *= M[e, e]
-        tau = settings[S_DET_BASIS] * det_r * orient * det_q
-        # Where the predictor-corrector would do more than step: hand over to it.
-        if sig[E - 1] < settings[S_MIN_RATIO] * sig[0] or abs(t[groups[drive]]) < settings[S_MIN_DRIVE]:
-            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and (orient * t[groups[drive]]) * h <= 0.0:
-            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and tau * out_tau[k - 1] < 0.0:
-            return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
-        dist = 0.0
-        wrapped = 0.0
+    last, ended = steps, CLEAN
+    for k in range(1, steps + 1):
+        drive_q = q_prev[drive] + h if k < steps else target
+        place_driven(joint_int, joint_geo, drive, driven, drive_q, poses)
+        for i in range(dyads.shape[0]):
+            status = place_dyad(joint_int, joint_geo, dyads[i], modes[i], poses, min_margin)
+            if status != CLEAN:
+                ended = status
+                break
+        if (
+            ended == CLEAN
+            and joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q) > 0.5 * np.pi
+        ):
+            ended = JUMP
+        if ended != CLEAN:
+            last = k - 1
+            break
         for j in range(n):
-            g = groups[j]
-            du = q[j] - out_u[k - 1, g] if k > 0 else 0.0
-            dist += du * du
-            out_u[k, g] = q[j]
-            x = wrap_angle(q[j]) if periodic[g] else q[j]
-            wrapped += x * x
-            if q[j] < lo[g] or q[j] > hi[g]:
-                return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
-        for a in range(m):
-            t_prev[a] = orient * t[a]
-        acc = 0.0
-        for e in range(E):
-            acc += res[e] * res[e]
-            out_sigma[k, e] = sig[e]
-        out_res[k] = np.sqrt(acc)
-        out_tau[k] = tau
-        out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
-        if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-            d = np.sqrt(wrapped)
-            far = max(far, d)
-            if far > 4.0 * hmax and d < 1.5 * abs(h):
-                return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
-        for j in range(n):
+            out_u[k, groups[j]] = q[j]
             q_prev[j] = q[j]
+    # Passes 2 and 3, a block of points at a time (the block's scratch stays in the cache).
+    tri = np.empty((BLOCK, E, E))
+    tangents = np.empty((BLOCK, m))
+    work = (np.empty(E), np.empty((E, m)), np.empty((m, E)), np.empty(2 * E), np.empty(m))
+    M, t = work[2], work[4]
+    V = np.eye(E)  # the right singular vectors, carried from point to point
+    history = (np.eye(E), np.eye(E))
+    W = np.empty((E, E))
+    sig = np.empty(E)
+    t_prev = t0.copy()
+    far = 0.0
+    for first in range(0, last + 1, BLOCK):
+        stop = min(first + BLOCK, last + 1)
+        # Pass 2: at every point of the block, the Jacobian's triangle R, the tangent and det(Q) det(R).
+        for k in range(first, stop):
+            i = k - first
+            for j in range(n):
+                q[j] = out_u[k, groups[j]]
+            if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
+                out_tau[k] = jacobian_rows(flat, q, work, 4, 3)
+            else:
+                out_tau[k] = jacobian_rows(flat, q, work, m, E)
+            acc = 0.0
+            for e in range(E):
+                acc += work[0][e] * work[0][e]
+                for c in range(E):
+                    tri[i, e, c] = M[e, c]
+            out_res[k] = np.sqrt(acc)
+            for a in range(m):
+                tangents[i, a] = t[a]
+        # Pass 3: point by point, singular values, orientation, test function and the checks.
+        for k in range(first, stop):
+            i = k - first
+            if E == 3:
+                warm_singular_values(tri[i], W, V, history, sig, 3)
+            else:
+                warm_singular_values(tri[i], W, V, history, sig, E)
+            dot = 0.0
+            for a in range(m):
+                dot += tangents[i, a] * t_prev[a]
+            orient = -1.0 if dot < 0.0 else 1.0
+            tau = det_basis * out_tau[k] * orient
+            t_drive = tangents[i, g_drive]
+            # Where the predictor-corrector would do more than step: hand over to it.
+            if sig[E - 1] < min_ratio * sig[0] or abs(t_drive) < min_drive:
+                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
+            if k > 0 and (orient * t_drive) * h <= 0.0:
+                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
+            if k > 0 and tau * out_tau[k - 1] < 0.0:
+                return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
+            dist = 0.0
+            wrapped = 0.0
+            for g in range(m):
+                x = out_u[k, g]
+                if x < lo[g] or x > hi[g]:
+                    return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
+                du = x - out_u[k - 1, g] if k > 0 else 0.0
+                dist += du * du
+                x = wrap_angle(x) if periodic[g] else x
+                wrapped += x * x
+            for a in range(m):
+                t_prev[a] = orient * tangents[i, a]
+            for e in range(E):
+                out_sigma[k, e] = sig[e]
+            out_tau[k] = tau
+            out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
+            if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
+                d = np.sqrt(wrapped)
+                far = max(far, d)
+                if far > 4.0 * hmax and d < 1.5 * abs(h):
+                    return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
+    if ended != CLEAN:
+        return last + 1, ended, out_u, out_sigma, out_res, out_tau, out_s
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s

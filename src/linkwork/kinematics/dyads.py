@@ -12,6 +12,7 @@ a mechanism that is not of this kind), and the tracer then runs the predictor-co
 
 from __future__ import annotations
 
+import math
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -77,22 +78,22 @@ class DyadPlan:
 def joint_geometry(mech: Mechanism) -> tuple[IntArray, Array] | None:
     """``(kinds, geometry)`` of every joint of a mechanism whose twists lie in the plane (``None`` otherwise):
     a revolute joint's point ``(x, y)`` and ``omega_z``, a prismatic joint's direction ``(x, y)`` and 0."""
-    kinds = np.empty(mech.n_joints, dtype=np.int64)
-    geo = np.zeros((mech.n_joints, 3))
-    for j, (w, v) in enumerate(zip(mech.twists[:, :3], mech.twists[:, 3:], strict=True)):
-        if abs(v[2]) > PLANAR_TOL or abs(w[0]) > PLANAR_TOL or abs(w[1]) > PLANAR_TOL:
+    kinds: list[int] = []
+    geo: list[tuple[float, float, float]] = []
+    for kind, (w0, w1, w2, v0, v1, v2) in zip(mech.joint_types, mech.twists.tolist(), strict=True):
+        if abs(v2) > PLANAR_TOL or abs(w0) > PLANAR_TOL or abs(w1) > PLANAR_TOL:
             return None
-        if mech.joint_types[j] == "R":
-            if abs(abs(w[2]) - 1.0) > PLANAR_TOL:
+        if kind == "R":
+            if abs(abs(w2) - 1.0) > PLANAR_TOL:
                 return None
-            kinds[j] = REVOLUTE
-            geo[j] = (-v[1] / w[2], v[0] / w[2], w[2])  # v = p x omega for a hinge through p
+            kinds.append(REVOLUTE)
+            geo.append((-v1 / w2, v0 / w2, w2))  # v = p x omega for a hinge through p
         else:
-            if abs(w[2]) > PLANAR_TOL or abs(np.hypot(v[0], v[1]) - 1.0) > PLANAR_TOL:
+            if abs(w2) > PLANAR_TOL or abs(math.hypot(v0, v1) - 1.0) > PLANAR_TOL:
                 return None
-            kinds[j] = PRISMATIC
-            geo[j] = (v[0], v[1], 0.0)
-    return kinds, geo
+            kinds.append(PRISMATIC)
+            geo.append((v0, v1, 0.0))
+    return np.array(kinds, dtype=np.int64), np.array(geo, dtype=float).reshape(len(geo), 3)
 
 
 def dyad_plan(mech: Mechanism, drive: int) -> DyadPlan | None:
