@@ -39,6 +39,7 @@ from linkwork.mechanization.inside import distance_to_outline
 from linkwork.mechanization.options import MechanizeOptions
 
 Array = NDArray[np.float64]
+Mask = NDArray[np.bool_]
 
 #: Grid points over profile 1 sampled for a body's admissible pivots (about this many inside profile 1).
 GRID_POINTS = 3000
@@ -86,7 +87,7 @@ def moved(poses: ArrayLike, points: ArrayLike) -> Array:
 
 def inside_all(
     targets: tuple[Array, ...], poses: ArrayLike, points: ArrayLike, clearance: float = 0.0
-) -> Array:
+) -> Mask:
     """``(k,)`` True where a body point ``(k, 2)`` lies inside every profile in that profile's pose (``poses``
     ``(p, 3)`` the body's displacements), at least ``clearance`` from every outline."""
     pts = np.atleast_2d(np.asarray(points, dtype=float))
@@ -124,7 +125,7 @@ def _area(polygon: Array) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
-def segments_inside(polygon: ArrayLike, p: ArrayLike, q: ArrayLike) -> Array:
+def segments_inside(polygon: ArrayLike, p: ArrayLike, q: ArrayLike) -> Mask:
     """``(k,)`` True where the segment from ``p[i]`` to ``q[i]`` (``(k, 2)`` each) lies inside the closed
     polygon: both ends inside, and no edge of the polygon crossed, nor touched at a vertex, between them."""
     poly = np.asarray(polygon, dtype=float)
@@ -151,7 +152,7 @@ def segments_inside(polygon: ArrayLike, p: ArrayLike, q: ArrayLike) -> Array:
 
 def links_inside(
     targets: tuple[Array, ...], anchor_poses: Array, body_poses: Array, centres: Array, circles: Array
-) -> Array:
+) -> Mask:
     """``(k,)`` True where the link from anchor pivot ``centres[i]`` (anchor's profile-1 frame) to moving pivot
     ``circles[i]`` (body's) lies inside every profile in its pose, ends included."""
     ca, mb = moved(anchor_poses, centres), moved(body_poses, circles)
@@ -162,7 +163,7 @@ def links_inside(
     return ok
 
 
-def _clear(targets: tuple[Array, ...], poses: Array, points: Array, clearance: Array) -> Array:
+def _clear(targets: tuple[Array, ...], poses: Array, points: Array, clearance: Array) -> Mask:
     """``(k,)`` True where each point lies inside every profile in its pose at least its own ``clearance``
     ``(k,)`` from every outline."""
     world = moved(poses, points)
