@@ -163,16 +163,15 @@ def links_inside(
     return ok
 
 
-def _clear(targets: tuple[Array, ...], poses: Array, points: Array, clearance: Array) -> Mask:
-    """``(k,)`` True where each point lies inside every profile in its pose at least its own ``clearance``
-    ``(k,)`` from every outline."""
+def depths(targets: tuple[Array, ...], poses: Array, points: Array) -> Array:
+    """``(k,)`` how deep each body point lies inside the profiles: the smallest distance to an outline over the
+    profiles, each in its pose (negative when it is outside one)."""
     world = moved(poses, points)
-    ok = np.ones(len(points), dtype=bool)
+    out = np.full(len(points), np.inf)
     for poly, w in zip(targets, world, strict=True):
-        ok[ok] = contains(poly, w[ok])
-        if np.any(ok):
-            ok[ok] = distance_to_outline(poly, w[ok]) >= clearance[ok]
-    return ok
+        d = distance_to_outline(poly, w)
+        out = np.minimum(out, np.where(contains(poly, w), d, -d))
+    return out
 
 
 def circumcentres(points: Array) -> Array:
@@ -212,6 +211,19 @@ def centres(rel: Array, circles: Array) -> Array:
     return out
 
 
+def transmissions(
+    anchor_poses: Array, body_poses: Array, centres_: Array, circles: Array, joint: Array
+) -> Array:
+    """``(k, p)`` the signed sine of the transmission angle of every link ``centres_[i]`` (anchor) -
+    ``circles[i]`` (body) placing the body with the revolute chain joint at ``joint`` (body's profile-1 frame):
+    the angle at the moving pivot between the link and the arm to the joint, on every profile."""
+    link = moved(body_poses, circles) - moved(anchor_poses, centres_)  # (p, k, 2)
+    arm = moved(body_poses, circles) - moved(body_poses, np.asarray(joint, dtype=float))
+    cross = link[..., 0] * arm[..., 1] - link[..., 1] * arm[..., 0]
+    norms = np.maximum(np.linalg.norm(link, axis=2) * np.linalg.norm(arm, axis=2), 1e-300)
+    return np.asarray((cross / norms).T)
+
+
 def inverse(rel: Array) -> Array:
     """The poses of the anchor seen from the body (kinematic inversion), ``(p, 3)``."""
     c, s = np.cos(rel[:, 2]), np.sin(rel[:, 2])
@@ -247,6 +259,9 @@ def inside_links(
     longest: float,
     structural: float,
     exact_only: bool = False,
+    regions: tuple[Admissible, Admissible] | None = None,
+    placing: Array | None = None,
+    min_sine: float = 0.0,
 ) -> Placement:
     """RR links from ``anchor`` to ``body`` with both pivots admissible and the link inside every profile in its
     pose (the module docstring).
@@ -268,8 +283,17 @@ def inside_links(
     exact_only
         Only links exact to rounding: a closed or fixed-end chain closes its own loop, and an inexact link there
         does not follow the chain's profiles.
+    regions
+        The admissible pivots of the body and of the anchor when already known (:func:`admissible`).
+    placing
+        ``(2,)`` the revolute chain joint (body's profile-1 frame) that with the link places the body, if any:
+        links are kept only where they transmit through it, the sine of the angle between the link and the arm
+        from the joint to the moving pivot at least ``min_sine`` and of one sign (one assembly mode) on every
+        profile (:func:`transmissions`).
     """
-    body, anchor = admissible(targets, body_poses, size), admissible(targets, anchor_poses, size)
+    if regions is None:
+        regions = (admissible(targets, body_poses, size), admissible(targets, anchor_poses, size))
+    body, anchor = regions
     empty = Placement([], body, anchor)
     if len(body.points) == 0 or len(anchor.points) == 0:
         return empty
@@ -293,17 +317,22 @@ def inside_links(
     ok = (spread <= tol) & (length <= longest) & (length >= SHORTEST * size)
     circle, centre, length, spread = circle[ok], centre[ok], length[ok], spread[ok]
     # both pivots admissible (a centre or circle point computed from the other may not be) and the link inside
-    ok = _clear(targets, body_poses, circle, CLEARANCE * size + SLACK * spread)
-    ok &= _clear(targets, anchor_poses, centre, CLEARANCE * size + SLACK * spread)
-    ok[ok] = links_inside(targets, anchor_poses, body_poses, centre[ok], circle[ok])
+    if placing is not None:
+        sines = transmissions(anchor_poses, body_poses, centre, circle, placing)
+        ok = np.all(np.abs(sines) >= min_sine, axis=1) & (
+            np.all(sines > 0, axis=1) | np.all(sines < 0, axis=1)
+        )
+        circle, centre, length, spread = circle[ok], centre[ok], length[ok], spread[ok]
+    # the link inside every profile (the crossing test, cheap), then its pivots clear of every outline
+    ok = links_inside(targets, anchor_poses, body_poses, centre, circle)
     circle, centre, length, spread = circle[ok], centre[ok], length[ok], spread[ok]
-    exact = spread <= EXACT * size
-    order = np.concatenate(
-        [
-            np.flatnonzero(exact)[_spread_out(circle[exact], centre[exact], LINKS)],
-            np.flatnonzero(~exact)[np.argsort(spread[~exact], kind="stable")],
-        ]
-    )
+    margin = np.minimum(depths(targets, body_poses, circle), depths(targets, anchor_poses, centre))
+    margin -= SLACK * spread
+    ok = margin >= CLEARANCE * size
+    circle, centre, length, spread, margin = circle[ok], centre[ok], length[ok], spread[ok], margin[ok]
+    # exact links first, then the rest; the deepest inside first in each (the traced mechanism reaches the
+    # profiles a little off the chain's poses when any link is inexact)
+    order = np.lexsort((-margin, spread > EXACT * size))
     kept = _thinned(circle[order], centre[order], TWIN * size, LINKS)
     links = [
         (
@@ -342,23 +371,6 @@ def _near_pairs(rel: Array, circles: Array, anchors: Array, tol: float) -> tuple
     return m[i[ok]], c[n[ok]]
 
 
-def _spread_out(circles: Array, centres_: Array, most: int) -> Array:
-    """Indices of at most ``most`` links, each the farthest (both pivots together) from those picked before it,
-    starting from the longest (greedy farthest-point sampling: exact links differ only in where they are)."""
-    if len(circles) == 0:
-        return np.zeros(0, dtype=int)
-    pts = np.hstack([circles, centres_])
-    picked = [int(np.argmax(np.linalg.norm(circles - centres_, axis=1)))]
-    nearest = np.linalg.norm(pts - pts[picked[0]], axis=1)
-    while len(picked) < min(most, len(pts)):
-        i = int(np.argmax(nearest))
-        if nearest[i] == 0.0:
-            break
-        picked.append(i)
-        nearest = np.minimum(nearest, np.linalg.norm(pts - pts[i], axis=1))
-    return np.array(picked, dtype=int)
-
-
 def _thinned(circles: Array, centres_: Array, twin: float, most: int) -> list[int]:
     """Indices of at most ``most`` links in the given order, skipping any whose pivots are both within ``twin``
     of a kept link's."""
@@ -376,12 +388,17 @@ def _thinned(circles: Array, centres_: Array, twin: float, most: int) -> list[in
 
 
 def chain_links(
-    chain: ShapeChain, body: str, anchor: str, options: MechanizeOptions
+    chain: ShapeChain, body: str, anchor: str, options: MechanizeOptions, via: str | None = None
 ) -> list[tuple[Array, Dyad]]:
     """:func:`inside_links` for ``body`` of ``chain`` guided from ``anchor`` (``"ground"`` or a body), within the
     options' link-length and structural-error limits; exact links only unless the chain is open (a closed or
-    fixed-end chain closes its own loop)."""
+    fixed-end chain closes its own loop). With ``via``, the chain joint that with the link places the body, only
+    links transmitting through it above ``options.min_transmission`` (a revolute joint; a slide is not screened
+    here)."""
     g_body, g_anchor = chain.motion(body), chain.motion(anchor)
+    joint = next((j for j in chain.joints if j.name == via), None)
+    placing = joint.point if joint is not None and joint.kind == "R" else None
+    regions = (_admissible_of(chain, body), _admissible_of(chain, anchor))
     found = inside_links(
         chain.targets,
         g_body,
@@ -391,5 +408,26 @@ def chain_links(
         longest=options.link_limit(chain.size),
         structural=options.structural_limit(chain.size),
         exact_only=chain.kind != "open",
+        regions=regions,
+        placing=placing,
+        min_sine=math.sin(options.min_transmission),
     )
     return found.links
+
+
+#: The admissible pivots of the bodies of the chains searched last, by ``(id(chain), body)`` with the chain kept
+#: (an id is only unique while its object lives): a body's region does not depend on the anchor it is guided from.
+_REGIONS: dict[tuple[int, str], tuple[ShapeChain, Admissible]] = {}
+
+
+def _admissible_of(chain: ShapeChain, body: str) -> Admissible:
+    """:func:`admissible` for ``body`` of ``chain`` (``"ground"`` too), computed once per chain and body."""
+    key = (id(chain), body)
+    hit = _REGIONS.get(key)
+    if hit is not None and hit[0] is chain:
+        return hit[1]
+    if len(_REGIONS) > 64:
+        _REGIONS.clear()
+    region = admissible(chain.targets, chain.motion(body), chain.size)
+    _REGIONS[key] = (chain, region)
+    return region

@@ -196,7 +196,7 @@ def body_candidates(
             if anchor == "ground":
                 pivots += _pivots_from_region(chain, rel, region)
             if region.kind == "inside":  # links sought where their pivots and the link may be
-                pivots += placement.chain_links(chain, body, anchor, options)
+                pivots += placement.chain_links(chain, body, anchor, options, via)
             out += _rr_candidates(chain, body, via, anchor, pivots, options, region, name, keep_outside)
         if options.binary_links in ("prismatic", "both"):
             out += _slider_candidates(chain, body, via, anchor, rel, options, region, name, keep_outside)
