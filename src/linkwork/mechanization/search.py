@@ -212,8 +212,8 @@ def least_leaving(
     if options.region_of(chain.targets, chain.size).kind != "inside":
         return ""
     cands = [c for c in body_candidates(chain, body, via, anchors, options, keep_outside=True) if c.leaves]
-    if not cands:
-        return ""
+    if not cands or any(c.leaves is not None and c.leaves.by == 0.0 for c in cands):
+        return ""  # some link stays inside: it failed on other counts, which the message names
     best = min(cands, key=lambda c: c.leaves.by if c.leaves is not None else math.inf)
     assert best.leaves is not None
     link = best.link
@@ -518,6 +518,13 @@ def _steps(
             done.append(body)
         else:
             deferred.append(body)
+    while len(deferred) >= 2 and options.anchors == "any":  # two such bodies may hold each other by two links
+        pair = body_candidates(chain, deferred[0], None, [deferred[1]], options)
+        if len(pair) < 2:
+            break
+        steps.append(Step(deferred[0], None, tuple(pair), 2))
+        done += deferred[:2]
+        del deferred[:2]
     if deferred:
         leaves = least_leaving(chain, deferred[0], None, ["ground"], options)
         raise NoPlan(
