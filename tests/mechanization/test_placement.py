@@ -120,3 +120,32 @@ def test_links_found_inside_keep_their_pivots_and_201_points_inside_every_profil
         if exact_only:
             # exact links: the three positions of the moving pivot lie on one circle about the anchor pivot
             assert all(d.structural_error <= 1e-12 for _, d in found.links)
+
+
+def test_bundled_wing_plan_has_every_candidate_link_inside_and_the_trailing_edge_bodies_hold_each_other() -> (
+    None
+):
+    """The bundled wing (chord +36 %) with ``ground_region = "inside"``: from root ``s3`` every body gets links,
+    the trailing-edge bodies ``s1`` and ``s4b`` (which only each other can hold inside) two between them; every
+    candidate link of the plan keeps both pivots and 201 points along it inside every airfoil in its pose
+    (matplotlib on the chain's targets, poses applied here)."""
+    from linkwork.data import example
+    from linkwork.io.problem import load_problem
+    from linkwork.mechanization import MechanizeOptions, build_chain
+    from linkwork.mechanization.search import plan
+    from linkwork.synthesis import synthesize
+
+    chain = build_chain(synthesize(load_problem(example("wing", "mechanize.toml"))))
+    options = MechanizeOptions(ground_region="inside", max_link=1.0, anchors="any")
+    pl = plan(chain, "s3", options)
+    pair = [s for s in pl.steps if s.links == 2]
+    assert [(s.body, {c.link.anchor for c in s.candidates}) for s in pair] == [("s4b", {"s1"})]
+    along = np.linspace(0.0, 1.0, 201)[:, None]
+    links = [c.link for a, b, _ in pl.root_pairs[:5] for c in (a, b)]
+    links += [c.link for s in pl.steps for c in s.candidates[:10]]
+    assert len(links) >= 40
+    for link in links:
+        for j, target in enumerate(chain.targets):
+            a = _pose(chain.motion(link.anchor)[j], link.centre[None])[0]
+            w = _pose(chain.motion(link.body)[j], link.circle[None])[0]
+            assert np.all(mpath.Path(target).contains_points(a + along * (w - a))), (link.name, j)
