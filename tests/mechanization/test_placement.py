@@ -143,7 +143,7 @@ def test_bundled_wing_plan_has_every_candidate_link_inside_and_the_trailing_edge
     along = np.linspace(0.0, 1.0, 201)[:, None]
     links = [c.link for a, b, _ in pl.root_pairs[:5] for c in (a, b)]
     links += [c.link for s in pl.steps for c in s.candidates[:10]]
-    assert len(links) >= 40
+    assert len(links) >= 20
     for link in links:
         for j, target in enumerate(chain.targets):
             a = _pose(chain.motion(link.anchor)[j], link.centre[None])[0]
