@@ -129,11 +129,14 @@ def traced_leaving(design: Design, check: Verification) -> tuple[str, Leaving] |
     """
     mech = loaded_mechanism(design)
     targets = design.chain.targets
+    at = [link_pivots(design, mech, state.values) for state in check.states]
     worst: tuple[str, Leaving] | None = None
     for link in design.links:
-        if link.kind != "RR":
+        if (
+            link.kind == "PR"
+        ):  # a slider's guide point is no pivot (its guide was screened on the chain's poses)
             continue
-        ends = [link_pivots(design, mech, state.values)[link.name] for state in check.states]
+        ends = [pivots[link.name] for pivots in at]
         leaves = leaving(targets[: len(ends)], np.array([e[0] for e in ends]), np.array([e[1] for e in ends]))
         if leaves.by > 0.0 and (worst is None or leaves.by > worst[1].by):
             worst = (link.name, leaves)
