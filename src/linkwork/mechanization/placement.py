@@ -17,10 +17,12 @@ links are sought where they are allowed:
   the length it would need). Besides these, pairs of samples whose length spreads by at most the structural
   error limit are tried (open chains only: see :func:`inside_links`).
 * the link itself must lie inside every profile in its pose: its two ends inside (admissible pivots) and the
-  segment between them crossing no edge of the outline (:func:`segments_inside`).
+  segment between them crossing no edge of the outline (:func:`segments_inside`); when the body is placed through
+  a revolute chain joint, the link must transmit through it as the search requires (:func:`transmissions`).
 
-What is found is thinned so that no two links are nearly the same (the search varies one link at a time: twins
-waste its attempts), exact ones first, then the smallest structural error.
+What is found is ranked exact links first, the deepest inside first (an inexact link's pivots also keep
+:data:`SLACK` times its structural error from every outline), and thinned so that no two links are nearly the
+same (the search varies one link at a time: twins waste its attempts).
 """
 
 from __future__ import annotations
