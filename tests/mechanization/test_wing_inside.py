@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ from linkwork.io.problem import load_problem
 from linkwork.io.spec import load_spec
 from linkwork.kinematics.tracer import trace
 from linkwork.mechanization import MechanizeOptions, mechanize, write_mechanization
+from linkwork.mechanization.inside import traced_leaving
 from linkwork.mechanization.verify import SHAPE_ALLOWANCE
 from linkwork.synthesis import synthesize
 
@@ -43,7 +45,7 @@ def inside(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object, tupl
     calls: list[tuple[int, int | None]] = []
     found = mechanize(result, options, progress=lambda done, total: calls.append((done, total)))
     write_mechanization(found, profiles)
-    return profiles, result, (calls, found.attempts)
+    return profiles, result, (calls, found.attempts, found)
 
 
 def _outline(folder: Path, name: str) -> np.ndarray:
@@ -128,6 +130,35 @@ def test_quality_factor_is_the_documented_product(inside: tuple) -> None:
 
 
 def test_the_search_reports_progress_after_every_design(inside: tuple) -> None:
-    _, _, (calls, attempts) = inside
+    _, _, (calls, attempts, _) = inside
     assert [done for done, _ in calls] == list(range(1, attempts + 1))  # one call per design traced
     assert all(total is not None and done <= total for done, total in calls)
+
+
+def test_a_pivot_that_leaves_on_the_traced_poses_is_named_with_how_far(inside: tuple) -> None:
+    """The check on the traced poses: nothing leaves the airfoils as they are; with every airfoil moved up by
+    0.05 (of a 0.12-thick section) pivots leave, and the worst is the largest distance outside found here, from
+    ``mechanization.json``'s pivots with matplotlib's point-in-polygon and the distance to the moved outlines."""
+    mpath = pytest.importorskip("matplotlib.path")
+    folder, _, (_, _, found) = inside
+    assert traced_leaving(found.design, found.verification) is None
+    chain = found.design.chain
+    moved = tuple(t + np.array([0.0, 0.05]) for t in chain.targets)
+    worst = traced_leaving(replace(found.design, chain=replace(chain, targets=moved)), found.verification)
+    assert worst is not None
+    report = json.loads((folder / "mechanization.json").read_text())
+    deepest = 0.0
+    for j, profile in enumerate(report["profiles"]):
+        a, b = moved[j], np.roll(moved[j], -1, axis=0)
+        for link, pair in profile["pivots"].items():
+            if next(d for d in report["dyads"] if d["name"] == link)["type"] != "RR":
+                continue
+            for point in np.array(pair):
+                if mpath.Path(moved[j]).contains_points([point])[0]:
+                    continue
+                t = np.clip(np.sum((point - a) * (b - a), axis=1) / np.sum((b - a) ** 2, axis=1), 0.0, 1.0)
+                deepest = max(
+                    deepest, float(np.min(np.linalg.norm(a + t[:, None] * (b - a) - point, axis=1)))
+                )
+    assert deepest > 0.0
+    assert worst[1].by == pytest.approx(deepest, abs=1e-9)

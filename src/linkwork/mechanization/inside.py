@@ -13,12 +13,15 @@ least a rounding-sized amount, so it is never taken for inside).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.geometry.polygon import contains
+from linkwork.mechanization.assemble import Design
+from linkwork.mechanization.options import MechanizeOptions
+from linkwork.mechanization.verify import Verification, link_pivots, loaded_mechanism, verify
 
 Array = NDArray[np.float64]
 
@@ -115,3 +118,46 @@ def is_inside(targets: tuple[Array, ...], anchor: Array, moving: Array) -> bool:
         if link_outside_by(poly, anchor[j], moving[j]) > 0.0:
             return False
     return True
+
+
+def traced_leaving(design: Design, check: Verification) -> tuple[str, Leaving] | None:
+    """The link of ``design`` that leaves the shape furthest on the poses its traced mechanism takes on the
+    profiles (``check.states``), and how: ``None`` when every pivot and link lies inside every profile there.
+
+    The candidates were screened on the chain's poses; with a least-squares link the traced mechanism reaches a
+    profile a little off them, and ``mechanization.json``'s ``profiles[k].pivots`` are where it is then.
+    """
+    mech = loaded_mechanism(design)
+    targets = design.chain.targets
+    at = [link_pivots(design, mech, state.values) for state in check.states]
+    worst: tuple[str, Leaving] | None = None
+    for link in design.links:
+        if (
+            link.kind == "PR"
+        ):  # a slider's guide point is no pivot (its guide was screened on the chain's poses)
+            continue
+        ends = [pivots[link.name] for pivots in at]
+        leaves = leaving(targets[: len(ends)], np.array([e[0] for e in ends]), np.array([e[1] for e in ends]))
+        if leaves.by > 0.0 and (worst is None or leaves.by > worst[1].by):
+            worst = (link.name, leaves)
+    return worst
+
+
+def verified(design: Design, options: MechanizeOptions) -> Verification:
+    """:func:`linkwork.mechanization.verify.verify`, and with ``ground_region = "inside"`` a design that passes
+    is rejected (defect ``"inside"``, the link to replace as its culprit) when a pivot or link leaves a profile on
+    the traced poses (:func:`traced_leaving`)."""
+    check = verify(design)
+    if not check.passed or options.region_of(design.chain.targets, design.chain.size).kind != "inside":
+        return check
+    worst = traced_leaving(design, check)
+    if worst is None:
+        return check
+    name, leaves = worst
+    return replace(
+        check,
+        passed=False,
+        defect="inside",
+        reason=f"outside the shape: {leaves.describe(name)}",
+        culprit=name,
+    )

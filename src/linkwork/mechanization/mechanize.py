@@ -18,6 +18,7 @@ import numpy as np
 from linkwork.errors import SpecError
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
+from linkwork.mechanization.inside import verified
 from linkwork.mechanization.options import (
     ACTUATORS,
     ANCHORS,
@@ -37,7 +38,7 @@ from linkwork.mechanization.search import (
     prismatic_actuator,
     roots,
 )
-from linkwork.mechanization.verify import Verification, verify
+from linkwork.mechanization.verify import Verification
 from linkwork.messages import show
 from linkwork.synthesis.result import SynthesisResult
 
@@ -510,7 +511,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
             )
             return
         label_k = f"root {pl.root}, anchors {options.anchors}, design {attempt}"
-        check = verify(design)
+        check = verified(design, options)  # with the inside check on the traced poses
         state.traced(label_k, design, check)
         if check.defect == "order" and options.drive is None:
             design, check = _redrive(design, check, label_k, state)
@@ -556,7 +557,7 @@ def _redrive(design: Design, check: Verification, label: str, state: _Search) ->
         if state.done():
             break
         again = replace(design, drive=other)
-        verdict = verify(again)
+        verdict = verified(again, state.options)
         state.traced(f"{label} re-driven from {other}", again, verdict)
         if verdict.passed:
             return again, verdict

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, MechanizationError, SpecError
 from linkwork.geometry.se2 import relative
-from linkwork.mechanization import guidance, sliders
+from linkwork.mechanization import guidance, placement, sliders
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, track, track_direction
 from linkwork.mechanization.inside import Leaving, leaving
@@ -198,10 +198,8 @@ def body_candidates(
             pivots = _pivot_candidates(chain, body, rel, options, region)
             if anchor == "ground":
                 pivots += _pivots_from_region(chain, rel, region)
-            if region.kind == "inside" and chain.kind == "open":
-                # a closed or fixed-end chain closes its own loop only where every link is exact: an inexact
-                # link there makes the mechanism rigid
-                pivots += _inside_pairs(chain, body, anchor, rel, region, options)
+            if region.kind == "inside":  # links sought where their pivots and the link may be
+                pivots += placement.chain_links(chain, body, anchor, options, via)
             out += _rr_candidates(chain, body, via, anchor, pivots, options, region, name, keep_outside)
         if options.binary_links in ("prismatic", "both"):
             out += _slider_candidates(chain, body, via, anchor, rel, options, region, name, keep_outside)
@@ -217,8 +215,8 @@ def least_leaving(
     if options.region_of(chain.targets, chain.size).kind != "inside":
         return ""
     cands = [c for c in body_candidates(chain, body, via, anchors, options, keep_outside=True) if c.leaves]
-    if not cands:
-        return ""
+    if not cands or any(c.leaves is not None and c.leaves.by == 0.0 for c in cands):
+        return ""  # some link stays inside: it failed on other counts, which the message names
     best = min(cands, key=lambda c: c.leaves.by if c.leaves is not None else math.inf)
     assert best.leaves is not None
     link = best.link
@@ -362,39 +360,6 @@ def _pivot_candidates(
             d = guidance.fit_circle_point(rel, m)
             out.append((d.circle_point, d))
     return out
-
-
-#: Pivot pairs inside the shape kept per body and anchor (the smallest structural errors).
-INSIDE_PAIRS = 60
-
-
-def _inside_pairs(
-    chain: ShapeChain, body: str, anchor: str, rel: Array, region: GroundRegion, options: MechanizeOptions
-) -> list[tuple[Array, guidance.Dyad]]:
-    """With ``ground_region = "inside"``: links whose both pivots are sampled inside the shape, a moving pivot
-    inside the first profile near ``body`` and an anchor pivot in the ground region (or inside the first profile
-    near the anchor body), kept when the length they would need varies across the profiles by at most the
-    structural-error limit (least squares: a link of the length on profile 1, its spread reported).
-
-    Exact guidance puts the centre of a body point's circle where the body's motion says, which for a slender
-    shape morphing by small motions is far outside it; a short link inside accepts a small structural error."""
-    movings = _interior(chain, body)
-    anchors = region.samples(REGION_SAMPLES) if anchor == "ground" else _interior(chain, anchor)
-    if len(movings) == 0 or len(anchors) == 0:
-        return []
-    w = np.array([guidance.positions(rel, m) for m in movings])  # (k, p, 2) in the anchor's profile-1 frame
-    dist = np.linalg.norm(w[:, None, :, :] - anchors[None, :, None, :], axis=3)  # (k, n, p)
-    spread = np.ptp(dist, axis=2)
-    limit = options.structural_limit(chain.size)
-    ok = np.argwhere(spread <= limit + 1e-9 * chain.size)
-    ok = ok[np.argsort(spread[ok[:, 0], ok[:, 1]])][:INSIDE_PAIRS]
-    return [
-        (
-            movings[i],
-            guidance.Dyad(movings[i], anchors[n].copy(), float(dist[i, n, 0]), float(spread[i, n])),
-        )
-        for i, n in ok
-    ]
 
 
 def _pivots_from_region(
@@ -558,6 +523,13 @@ def _steps(
             done.append(body)
         else:
             deferred.append(body)
+    while len(deferred) >= 2 and options.anchors == "any":  # two such bodies may hold each other by two links
+        pair = body_candidates(chain, deferred[0], None, [deferred[1]], options)
+        if len(pair) < 2:
+            break
+        steps.append(Step(deferred[0], None, tuple(pair), 2))
+        done += deferred[:2]
+        del deferred[:2]
     if deferred:
         leaves = least_leaving(chain, deferred[0], None, ["ground"], options)
         raise NoPlan(
