@@ -596,7 +596,7 @@ def _fitted(
     if broken is not None:
         state.rejected.append(f"{label} with its pivots fitted jointly: {broken}")
         return design, check
-    verdict = verify(fitted)
+    verdict = verified(fitted, options)
     state.traced(f"{label} with its pivots fitted jointly", fitted, verdict)
     return (fitted, verdict) if verdict.passed else (design, check)
 
