@@ -481,9 +481,19 @@ class _Watch:
         status = getattr(self.client, "status", "running")
         if status != "running":
             return f"lost the Dask scheduler (client {status}); the work in hand was cancelled"
+        if not self._scheduler_answers():  # the client's status lags behind a scheduler that just died
+            return "lost the Dask scheduler (it does not answer); the work in hand was cancelled"
         if self._workers() == 0:
             return "lost every Dask worker; the work in hand was cancelled"
         return "the Dask scheduler cancelled the work in hand (was it restarted?)"
+
+    def _scheduler_answers(self) -> bool:
+        """Whether the scheduler answers a request now (``scheduler_info`` would return a cached answer)."""
+        try:
+            self.client.sync(self.client.scheduler.identity, n_workers=0, callback_timeout=5)
+        except Exception:  # refused, reset or timed out: no scheduler to talk to
+            return False
+        return True
 
     def _workers(self) -> int:
         try:
