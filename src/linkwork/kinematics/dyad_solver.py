@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
+from linkwork.kinematics.small_svd import orthonormalise
 
 #: Joint kinds in ``joint_int[:, 0]``.
 REVOLUTE, PRISMATIC = 0, 1
@@ -336,24 +337,6 @@ def null_vector(M, beta, t, m, E):
         t[k] -= dot * beta[E + k]
         for a in range(k + 1, m):
             t[a] -= dot * M[a, k]
-
-
-@kernel(inline="always")
-def orthonormalise(V, E):
-    """Modified Gram-Schmidt on the columns of ``V (E, E)`` in place."""
-    for c in range(E):
-        for b in range(c):
-            dot = 0.0
-            for a in range(E):
-                dot += V[a, b] * V[a, c]
-            for a in range(E):
-                V[a, c] -= dot * V[a, b]
-        norm = 0.0
-        for a in range(E):
-            norm += V[a, c] * V[a, c]
-        norm = 1.0 / np.sqrt(norm)
-        for a in range(E):
-            V[a, c] *= norm
 
 
 @kernel(inline="always")

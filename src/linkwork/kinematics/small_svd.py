@@ -41,20 +41,25 @@ columns by less than their rounding: not made."""
 def orthonormalize_columns(V: np.ndarray) -> None:
     """Gram-Schmidt on the columns of the square ``V``, in place (keeps its orientation): a warm start's rounding
     does not build up over a long path."""
-    n = V.shape[1]
-    rows = V.shape[0]
-    for c in range(n):
+    orthonormalise(V, V.shape[1])
+
+
+@kernel(inline="always")
+def orthonormalise(V: np.ndarray, E: int) -> None:
+    """Modified Gram-Schmidt on the columns of ``V (E, E)`` in place; ``E`` given, so that a caller passing a
+    literal size gets the loops unrolled (the planar dyad solver's 3x3)."""
+    for c in range(E):
         for b in range(c):
             dot = 0.0
-            for a in range(rows):
+            for a in range(E):
                 dot += V[a, b] * V[a, c]
-            for a in range(rows):
+            for a in range(E):
                 V[a, c] -= dot * V[a, b]
         norm = 0.0
-        for a in range(rows):
+        for a in range(E):
             norm += V[a, c] * V[a, c]
         norm = 1.0 / np.sqrt(norm)
-        for a in range(rows):
+        for a in range(E):
             V[a, c] *= norm
 
 
