@@ -537,7 +537,8 @@ def _steps(
       link: with the closing body and the chain joints they form an Assur group (an RRR dyad, or a triad when a
       link joins two of its bodies);
     * a skipped body is retried once later bodies are placed, with links from them too (``anchors = "any"``; a
-      body placed after it, or a skipped body, may hold it: the group they form has the DOF count of a dyad's);
+      body placed after it, or with slack a skipped body, may hold it: the group they form has the DOF count of
+      a dyad's);
     * without slack, a body placed from a skipped one may take two links (the pair is placed together), and two
       skipped bodies may hold each other by two links.
 
@@ -575,7 +576,10 @@ def _steps(
         for body in list(state.deferred):
             if len(state.deferred) <= slack:
                 break
-            known = [*state.done, *paired, *state.deferred]
+            # not a body it holds already (the two would take the same links twice); the other skipped bodies
+            # only with slack (else two skipped bodies hold each other by a pair of links, below)
+            held = {s.body for s in state.steps if any(c.link.anchor == body for c in s.candidates)}
+            known = [b for b in (*state.done, *paired, *(state.deferred if slack else ())) if b not in held]
             cands = body_candidates(chain, body, via_of[body], _anchors(chain, body, known, options), options)
             if cands:
                 state.place(Step(body, via_of[body], tuple(cands)), body)
