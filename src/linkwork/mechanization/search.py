@@ -580,14 +580,17 @@ def _steps(
             # only with slack (else two skipped bodies hold each other by a pair of links, below)
             held = {s.body for s in state.steps if any(c.link.anchor == body for c in s.candidates)}
             known = [b for b in (*state.done, *paired, *(state.deferred if slack else ())) if b not in held]
-            cands = body_candidates(chain, body, via_of[body], _anchors(chain, body, known, options), options)
+            cands = _retried(chain, body, via_of[body], _anchors(chain, body, known, options), state, options)
             if cands:
                 state.place(Step(body, via_of[body], tuple(cands)), body)
                 retried = True
     while (
         len(state.deferred) - slack >= 2 and options.anchors == "any"
     ):  # two may hold each other by two links
-        pair = body_candidates(chain, state.deferred[0], None, [state.deferred[1]], options)
+        first, second = state.deferred[:2]
+        if second in {o for _, o in _adjacent(chain, first)}:
+            break  # joined already: two links beside the joint would make them one
+        pair = body_candidates(chain, first, None, [second], options)
         if len(pair) < 2:
             break
         state.place(Step(state.deferred[0], None, tuple(pair), 2), *state.deferred[:2])
@@ -611,6 +614,25 @@ def _steps(
         state.steps.remove(freed)
         closing.append(freed.body)
     return state.steps, tuple(closing)
+
+
+def _retried(
+    chain: ShapeChain, body: str, via: str, anchors: Sequence[str], state: _BuildUp, options: MechanizeOptions
+) -> list[Candidate]:
+    """The candidates of a skipped ``body`` retried: from the bodies placed before it (the ground too) screened for
+    their transmission through its chain joint ``via`` as in the build-up; from the others (placed after it, or
+    not placed by a dyad: skipped, or a closing body), and from any when the body it is reached from is not placed
+    by a dyad, unscreened: the body is then one of a group of more than two bodies solved together (a triad), whose
+    motion no dyad's transmission angle describes, and the tracing judges it."""
+    parent = next(j for j in chain.joints if j.name == via).other(body)
+    placed = [a for a in anchors if a in state.done]
+    if parent not in state.done:
+        placed = []
+    later = [a for a in anchors if a not in placed]
+    cands = body_candidates(chain, body, via, placed, options) if placed else []
+    cands += body_candidates(chain, body, None, later, options) if later else []
+    cands.sort(key=lambda cand: -cand.score)
+    return cands
 
 
 def _beside_closing(chain: ShapeChain, steps: Sequence[Step], paired: Sequence[str]) -> Step | None:
