@@ -145,9 +145,9 @@ def test_closed_naca_contours_mechanize_with_every_pivot_and_link_inside_every_p
 def test_closed_naca_contours_from_a_root_with_no_link_inside_say_which_pivot_leaves_which_profile(
     closed_naca: tuple,
 ) -> None:
-    """Asked to build up from ``s1a`` (the leading-edge body), whose every ground link leaves the contours, the
-    error names the link that came closest and how far its pivot is outside, checked against matplotlib's
-    point-in-polygon and the distance to the contour computed here."""
+    """Asked to build up from ``s1a`` (the rear of the upper surface), whose every ground link leaves the
+    contours, the error names the link that came closest and how far its pivot is outside, checked against
+    matplotlib's point-in-polygon and the distance to the contour computed here."""
     mpath = pytest.importorskip("matplotlib.path")
     _, contours, result = closed_naca
     options = replace(options_from_values(result.problem.mechanize_options), root="s1a")
