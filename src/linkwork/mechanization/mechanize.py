@@ -34,6 +34,7 @@ from linkwork.mechanization.search import (
     MechanizationError,
     NoPlan,
     Plan,
+    Step,
     plan,
     prismatic_actuator,
     roots,
@@ -188,6 +189,7 @@ def _design(
         f"root body {pl.root}",
         f"bodies closed by two chain joints: {', '.join(pl.paired) or 'none'}",
         f"bodies left free (extra inputs): {', '.join(pl.free) or 'none'}",
+        f"bodies the closing body frees from a link: {', '.join(pl.closing) or 'none'}",
     )
     return Design(chain, tuple(links), drive, options.dof, name, notes)
 
@@ -499,6 +501,8 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
             count += 1
             index[f"D{count}"] = i
     fits_left = FITS
+    failed: dict[int, list[int]] = {}  # step -> the candidates that failed when blamed
+    blamed: tuple[int, str | None] | None = None  # the step blamed last, and for what
     for attempt in range(1, options.attempts + 1):
         if state.done():
             return
@@ -523,7 +527,16 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         # after a pass, replace the weakest link (smallest transmission angle) to look for a better design
         culprit = _weakest(state.passed[-1].design) if check.passed else check.culprit
         if culprit in index and choice[index[culprit]] + 1 < len(pl.steps[index[culprit]].candidates) - 1:
-            choice[index[culprit]] += 1
+            i = index[culprit]
+            following = choice[i] + 1
+            if not check.passed:
+                failed.setdefault(i, []).append(choice[i])
+                if blamed == (i, check.defect):
+                    # blamed again for the same defect: its next candidates are likely its near twins, which
+                    # share the defect (a dead centre of the same group between the same profiles)
+                    following = _apart(pl.steps[i], failed[i], following, chain.size)
+                blamed = (i, check.defect)
+            choice[i] = following
             continue
         if pl.pinned_root is None and root_pair + 1 < len(pl.root_pairs):
             root_pair += 1
@@ -532,6 +545,27 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
         if not movable:
             return
         choice[movable[attempt % len(movable)]] += 1
+
+
+#: After a step is blamed twice running for the same defect, its next candidate is one whose pivots are not both
+#: within this fraction of the size of a candidate of that step that failed.
+APART = 0.2
+
+
+def _apart(step: Step, failed: list[int], start: int, size: float) -> int:
+    """The first candidate of ``step`` from ``start`` (leaving the last, as the search does) whose anchor and
+    moving pivots are not both within :data:`APART` times ``size`` of a ``failed`` candidate's; ``start`` when
+    every one is."""
+    links = [c.link for c in step.candidates]
+    for k in range(start, len(links) - 1):
+        near = any(
+            float(np.linalg.norm(links[k].centre - links[f].centre)) < APART * size
+            and float(np.linalg.norm(links[k].circle - links[f].circle)) < APART * size
+            for f in failed
+        )
+        if not near:
+            return k
+    return start
 
 
 def redrives(design: Design) -> list[str]:

@@ -80,7 +80,12 @@ class Step:
 
 @dataclass(frozen=True)
 class Plan:
-    """The build-up order and the candidates of every step; ``root_pairs`` rank the root's four-bars."""
+    """The build-up order and the candidates of every step; ``root_pairs`` rank the root's four-bars.
+
+    ``paired`` are the bodies joined to two placed bodies (a loop's closing body), ``free`` the bodies left
+    without a link as extra inputs (DOF above one), ``closing`` the bodies a closing body frees from needing a
+    link of their own (:func:`link_slack`): with their chain joints they form an Assur group (an RRR dyad with
+    the closing body, or a triad)."""
 
     root: str
     pinned_root: str | None
@@ -88,6 +93,7 @@ class Plan:
     steps: tuple[Step, ...]
     free: tuple[str, ...]
     paired: tuple[str, ...]
+    closing: tuple[str, ...] = ()
 
 
 def _moving_pivots(chain: ShapeChain, body: str, count: int, offset: float) -> Array:
@@ -434,7 +440,8 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
     extra = max(0, options.dof - 1)
     free = tuple(b for b, _ in order[len(order) - extra :]) if extra else ()
     order = order[: len(order) - extra] if extra else order
-    steps = _steps(chain, root, order, options)
+    slack = link_slack(chain, order, pinned_root, options.dof)
+    steps, closing = _steps(chain, root, order, paired, slack, options)
     pairs: list[tuple[Candidate, Candidate, float]] = []
     if pinned_root is None:
         pairs = _root_pairs(chain, root, options)
@@ -449,7 +456,20 @@ def _plan_from(chain: ShapeChain, root: str, pinned_root: str | None, options: M
                 "offset or max_link)",
                 near_inside=bool(leaves),
             )
-    return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired))
+    return Plan(root, pinned_root, tuple(pairs), tuple(steps), free, tuple(paired), closing)
+
+
+def link_slack(chain: ShapeChain, order: Sequence[tuple[str, str]], pinned_root: str | None, dof: int) -> int:
+    """How many bodies of the build-up ``order`` need no link of their own.
+
+    A build-up gives the root two links (none when it is pinned to the ground) and every body of ``order`` one;
+    the mechanism needs ``M - dof`` (``M`` the chain's Grübler mobility, :meth:`ShapeChain.mobility`: each
+    binary link takes one DOF). A loop's closing body, joined to two placed bodies, takes one more DOF than an
+    RRR dyad would (``3 - 2 * 2``): a closed chain's or a fixed-end chain's build-up is over-constrained by one,
+    and one body of the loop is freed from its link (a generic over-constrained design does not move: the
+    verification finds 0 DOF, or rigid but for a hair)."""
+    planned = (0 if pinned_root is not None else 2) + len(order)
+    return max(0, planned - (chain.mobility() - dof))
 
 
 def _build_up(chain: ShapeChain, root: str) -> tuple[list[tuple[str, str]], list[str]]:
@@ -475,73 +495,153 @@ def _build_up(chain: ShapeChain, root: str) -> tuple[list[tuple[str, str]], list
     return order, paired
 
 
+def _anchors(chain: ShapeChain, body: str, among: Sequence[str], options: MechanizeOptions) -> list[str]:
+    """The ground, and with ``options.anchors == "any"`` the bodies of ``among`` not joined to ``body`` (a link
+    beside a chain joint between the same two bodies would make them one)."""
+    if options.anchors != "any":
+        return ["ground"]
+    adjacent = {o for _, o in _adjacent(chain, body)}
+    return ["ground"] + [b for b in among if b not in ("ground", body) and b not in adjacent]
+
+
+@dataclass
+class _BuildUp:
+    """The state of one build-up (:func:`_steps`): the steps so far, the bodies placed, those skipped."""
+
+    steps: list[Step]
+    done: list[str]
+    deferred: list[str] = field(default_factory=list)
+
+    def place(self, step: Step, *bodies: str) -> None:
+        """Record ``step`` placing ``bodies``."""
+        self.steps.append(step)
+        self.done += list(bodies)
+        for b in bodies:
+            if b in self.deferred:
+                self.deferred.remove(b)
+
+
 def _steps(
-    chain: ShapeChain, root: str, order: list[tuple[str, str]], options: MechanizeOptions
-) -> list[Step]:
-    """Every body's ranked candidates in build-up order; a body no single dyad can guide is placed together
-    with the next body placed from it, which then takes two links.
+    chain: ShapeChain,
+    root: str,
+    order: list[tuple[str, str]],
+    paired: Sequence[str],
+    slack: int,
+    options: MechanizeOptions,
+) -> tuple[list[Step], tuple[str, ...]]:
+    """Every body's ranked candidates in build-up order, and the bodies a loop's closing body frees from a link.
+
+    A body no dyad from the placed bodies can guide is skipped, then:
+
+    * with ``slack`` (:func:`link_slack`, a closed or fixed-end chain) up to that many skipped bodies need no
+      link: with the closing body and the chain joints they form an Assur group (an RRR dyad, or a triad when a
+      link joins two of its bodies);
+    * a skipped body is retried once later bodies are placed, with links from them too (``anchors = "any"``; a
+      body placed after it, or with slack a skipped body, may hold it: the group they form has the DOF count of
+      a dyad's);
+    * without slack, a body placed from a skipped one may take two links (the pair is placed together), and two
+      skipped bodies may hold each other by two links.
+
+    When the closing body frees no skipped body, it frees the last body placed beside it (their chain joints
+    make an RRR dyad).
 
     Raises
     ------
     MechanizationError
-        When a body has no acceptable dyad, nor the body placed from it two.
+        When a body has no acceptable dyad by any of these.
     """
-    steps = []
-    done = ["ground", root]
-    deferred: list[str] = []  # bodies no single dyad can guide: a body placed from each takes two
+    state = _BuildUp([], ["ground", root])
     joints = {j.name: j for j in chain.joints}
+    via_of = dict(order)
     placed_from: dict[str, str] = {}
     for body, via in order:
-        anchors = ["ground"]
-        if options.anchors == "any":
-            adjacent = {o for _, o in _adjacent(chain, body)}
-            anchors += [b for b in done if b not in ("ground", body) and b not in adjacent]
+        anchors = _anchors(chain, body, state.done, options)
         parent = joints[via].other(body)
         placed_from[body] = parent
-        if parent in deferred:
+        if parent in state.deferred and not slack:
             # the body it is placed from had no dyad: this one takes two, and the pair is placed together
             cands = body_candidates(chain, body, None, anchors, options)
             if len(cands) >= 2:
-                steps.append(Step(body, None, tuple(cands), 2, placed_from.get(parent)))
-                done += [parent, body]
-                deferred.remove(parent)
+                state.place(Step(body, None, tuple(cands), 2, placed_from.get(parent)), parent, body)
                 continue
-            leaves = least_leaving(chain, body, None, anchors, options)
-            raise NoPlan(
-                f"mechanize: no dyad can guide body {parent} (root {root}), nor two guide {body} placed from it"
-                + leaves
-                + ": "
-                f"every candidate pivot leaves the ground region, is longer than {_limits(chain, options)}, has a "
-                "transmission angle below "
-                f"{math.degrees(options.min_transmission):.0f} deg or changes assembly mode between profiles "
-                "(try a larger ground region or link offset)",
-                near_inside=bool(leaves),
-            )
         cands = body_candidates(chain, body, via, anchors, options)
         if cands:
-            steps.append(Step(body, via, tuple(cands)))
-            done.append(body)
+            state.place(Step(body, via, tuple(cands)), body)
         else:
-            deferred.append(body)
-    while len(deferred) >= 2 and options.anchors == "any":  # two such bodies may hold each other by two links
-        pair = body_candidates(chain, deferred[0], None, [deferred[1]], options)
+            state.deferred.append(body)
+    # retried with the bodies placed after them (and the other skipped ones) as anchors
+    retried = True
+    while retried and len(state.deferred) > slack and options.anchors == "any":
+        retried = False
+        for body in list(state.deferred):
+            if len(state.deferred) <= slack:
+                break
+            # not a body it holds already (the two would take the same links twice); the other skipped bodies
+            # only with slack (else two skipped bodies hold each other by a pair of links, below)
+            held = {s.body for s in state.steps if any(c.link.anchor == body for c in s.candidates)}
+            known = [b for b in (*state.done, *paired, *(state.deferred if slack else ())) if b not in held]
+            cands = _retried(chain, body, via_of[body], _anchors(chain, body, known, options), state, options)
+            if cands:
+                state.place(Step(body, via_of[body], tuple(cands)), body)
+                retried = True
+    while (
+        len(state.deferred) - slack >= 2 and options.anchors == "any"
+    ):  # two may hold each other by two links
+        first, second = state.deferred[:2]
+        if second in {o for _, o in _adjacent(chain, first)}:
+            break  # joined already: two links beside the joint would make them one
+        pair = body_candidates(chain, first, None, [second], options)
         if len(pair) < 2:
             break
-        steps.append(Step(deferred[0], None, tuple(pair), 2))
-        done += deferred[:2]
-        del deferred[:2]
-    if deferred:
-        leaves = least_leaving(chain, deferred[0], None, ["ground"], options)
+        state.place(Step(state.deferred[0], None, tuple(pair), 2), *state.deferred[:2])
+    if len(state.deferred) > slack:
+        body = state.deferred[slack]
+        leaves = least_leaving(chain, body, None, ["ground"], options)
         raise NoPlan(
-            f"mechanize: no dyad can guide body {deferred[0]} (root {root})"
+            f"mechanize: no dyad can guide body {body} (root {root})"
             + leaves
-            + "; it is the last body placed from it "
+            + "; not from the bodies placed before it, nor after "
             f"(outside the ground region, longer than {_limits(chain, options)}, a transmission angle below "
             f"{math.degrees(options.min_transmission):.0f} deg or a change of assembly mode between profiles; try "
             "a larger ground region, link offset or max_link)",
             near_inside=bool(leaves),
         )
-    return steps
+    closing = list(state.deferred)
+    for _ in range(slack - len(closing)):
+        freed = _beside_closing(chain, state.steps, paired)
+        if freed is None:
+            break
+        state.steps.remove(freed)
+        closing.append(freed.body)
+    return state.steps, tuple(closing)
+
+
+def _retried(
+    chain: ShapeChain, body: str, via: str, anchors: Sequence[str], state: _BuildUp, options: MechanizeOptions
+) -> list[Candidate]:
+    """The candidates of a skipped ``body`` retried: from the bodies placed before it (the ground too) screened for
+    their transmission through its chain joint ``via`` as in the build-up; from the others (placed after it, or
+    not placed by a dyad: skipped, or a closing body), and from any when the body it is reached from is not placed
+    by a dyad, unscreened: the body is then one of a group of more than two bodies solved together (a triad), whose
+    motion no dyad's transmission angle describes, and the tracing judges it."""
+    parent = next(j for j in chain.joints if j.name == via).other(body)
+    placed = [a for a in anchors if a in state.done]
+    if parent not in state.done:
+        placed = []
+    later = [a for a in anchors if a not in placed]
+    cands = body_candidates(chain, body, via, placed, options) if placed else []
+    cands += body_candidates(chain, body, None, later, options) if later else []
+    cands.sort(key=lambda cand: -cand.score)
+    return cands
+
+
+def _beside_closing(chain: ShapeChain, steps: Sequence[Step], paired: Sequence[str]) -> Step | None:
+    """The step of the last single-link body placed beside a closing body (freed from its link, it makes an RRR
+    dyad with it), else the last single-link step."""
+    single = [s for s in steps if s.links == 1]
+    beside = {o for p in paired for _, o in _adjacent(chain, p)}
+    near = [s for s in single if s.body in beside]
+    return near[-1] if near else (single[-1] if single else None)
 
 
 def _root_pairs(

@@ -571,14 +571,41 @@ def signed_transmissions(design: Design, mech: Mechanism, values: Array) -> dict
 
 
 def _culprit(design: Design, mech: Mechanism, trace: Trace) -> str | None:
-    """The RR link nearest a dead centre on the path (at the drive's turning point when there is one)."""
+    """The RR link nearest a dead centre on the path (at the drive's turning point when there is one, among the
+    links that move there with the drive held: :func:`moving_links`)."""
     d = mech.index(design.drive)
     drive = trace.angles[:, d]
     turn = np.flatnonzero(np.diff(np.sign(np.diff(drive))) != 0)
     rows = [int(turn[0]) + 1] if turn.size else range(0, len(drive), max(1, len(drive) // 40))
+    moving = moving_links(design, mech, trace.angles[rows[0]]) if turn.size else set()
     worst, name = math.inf, None
     for k in rows:
         for link, s in link_transmissions(design, mech, trace.angles[k]).items():
-            if s < worst:
+            if (not moving or link in moving) and s < worst:
                 worst, name = s, link
     return name
+
+
+#: A joint moves in the motion with the drive held when its rate is above this fraction of the fastest.
+MOVING = 1e-3
+
+
+def moving_links(design: Design, mech: Mechanism, values: Array) -> set[str]:
+    """The binary links that move at a dead centre of the drive (``values``) with the drive held: the motion
+    (the right singular vector of the closure Jacobian without the drive's column, G&P Eq. (21), for its
+    smallest singular value) moves only the group that is singular there and what it carries. The links placed
+    before that group stand still; a dead centre inside an Assur group of more than two bodies (a triad), which
+    no dyad's transmission angle shows, is found by this."""
+    d = mech.index(design.drive)
+    j = np.delete(jacobian(mech, values), d, axis=1)
+    if j.shape[1] == 0:
+        return set()
+    v = np.insert(np.linalg.svd(j)[2][-1], d, 0.0)
+    rate = np.abs(v) / max(float(np.max(np.abs(v))), 1e-300)
+    names = design.joint_names()
+    index = {n: k for k, n in enumerate(names)}
+    return {
+        link.name
+        for link in design.links
+        if any(rate[index[n]] > MOVING for n in link.joint_names() if n in index)
+    }
