@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
+from linkwork.kinematics.kernels import log_coefficient
 from linkwork.kinematics.small_svd import orthonormalise
 
 #: Joint kinds in ``joint_int[:, 0]``.
@@ -271,14 +272,7 @@ def planar_closure(flat, q, residual, jac, m, E):
             cg, sg = cg * ce - sg * se, sg * ce + cg * se
         # log of the planar motion (as kernels.log_rigid): angle, then v = p - (w x p)/2 + D w x (w x p)
         t = np.arctan2(sg, cg)
-        a = abs(t)
-        if a < 1e-2:
-            t2 = a * a
-            D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
-        else:
-            A = np.sin(a) / a
-            B = (1.0 - np.cos(a)) / (a * a)
-            D = (1.0 - A / (2.0 * B)) / (a * a)
+        D = log_coefficient(abs(t))
         residual[3 * k] = t
         residual[3 * k + 1] = px + 0.5 * t * py - D * t * t * px
         residual[3 * k + 2] = py - 0.5 * t * px - D * t * t * py

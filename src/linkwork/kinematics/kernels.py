@@ -20,6 +20,19 @@ from linkwork.kernel_cache import kernel
 
 
 @kernel(inline="always")
+def log_coefficient(t: float) -> float:
+    """``D(t) = (1 - A / (2 B)) / t^2`` with ``A = sin t / t``, ``B = (1 - cos t) / t^2``: the coefficient of
+    ``K^2`` in ``V^-1 = I - K/2 + D K^2``, the inverse of the translation part of a rotation by ``t >= 0`` (the
+    logarithm of a rigid motion); its Taylor series where the closed form cancels (truncation < 1e-20)."""
+    if t < 1e-2:
+        t2 = t * t
+        return 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
+    A = np.sin(t) / t
+    B = (1.0 - np.cos(t)) / (t * t)
+    return (1.0 - A / (2.0 * B)) / (t * t)
+
+
+@kernel(inline="always")
 def exp_unit_twist(w: np.ndarray, v: np.ndarray, theta: float, R: np.ndarray, p: np.ndarray) -> None:
     """Write ``exp(xi theta)`` for a unit twist (``|w| = 1`` or ``w = 0``) into ``R (3,3)`` and ``p (3,)``."""
     wx, wy, wz = w[0], w[1], w[2]
@@ -91,13 +104,7 @@ def log_rigid(R: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
         wx, wy, wz = f * sx, f * sy, f * sz
     out[0], out[1], out[2] = wx, wy, wz
     # v = V^-1 p with V^-1 = I - K/2 + D K^2
-    if t < 1e-2:  # Taylor series where the closed form cancels (truncation < 1e-20)
-        t2 = t * t
-        D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
-    else:
-        A = np.sin(t) / t
-        B = (1.0 - np.cos(t)) / (t * t)
-        D = (1.0 - A / (2.0 * B)) / (t * t)
+    D = log_coefficient(t)
     # K p = w x p, K^2 p = w x (w x p)
     kx = wy * p[2] - wz * p[1]
     ky = wz * p[0] - wx * p[2]
