@@ -143,6 +143,15 @@ def dyad_plan(mech: Mechanism, drive: int) -> DyadPlan | None:
     )
 
 
+def _frozen_plan(mech: Mechanism, drive: int) -> DyadPlan | None:
+    """:func:`dyad_plan` with read-only arrays (kept on the mechanism by :func:`closed_form_rows`)."""
+    plan = dyad_plan(mech, drive)
+    if plan is not None:
+        for a in plan.arrays():
+            a.flags.writeable = False
+    return plan
+
+
 def _next_dyad(ends: Sequence[tuple[int, int]], placed: set[int], used: set[int]) -> tuple[int, ...] | None:
     """A dyad ``(j1, j2, j3, K1, B1, B2, K2)`` attached to ``placed`` bodies through unused joints, if any."""
     for j2, (b1, b2) in enumerate(ends):
@@ -206,7 +215,7 @@ def closed_form_rows(
         return None  # plain-Python kernels while numba's cache is cold: the tracer as before
     if settings.r_path != mech.n_equations or m != mech.n_equations + 1:
         return None
-    plan = dyad_plan(mech, drive)
+    plan = mech.derived(("dyad plan", drive), lambda: _frozen_plan(mech, drive))
     if plan is None:
         return None
     run = np.zeros(N_SETTINGS)
@@ -218,8 +227,8 @@ def closed_form_rows(
     run[S_MIN_RATIO] = settings.tol.local_min
     run[S_MIN_DRIVE] = MIN_DRIVE
     run[S_MIN_MARGIN] = MIN_MARGIN
-    lj, ls, lp = mech.loop_arrays()
-    flat = (np.ascontiguousarray(mech.twists), lj, ls, lp, np.ascontiguousarray(mech.groups))
+    twists, lj, ls, lp, _, groups = mech.kernel_arrays
+    flat = (twists, lj, ls, lp, groups)
     periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)
     count, status, u, sigma, res, tau, s = dyad_solver.closed_form_path(
         flat,

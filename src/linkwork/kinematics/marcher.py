@@ -58,18 +58,6 @@ class MarchSettings:
 FOLD_MOVING = 1e-8
 
 
-def first_joints(mech: Mechanism) -> list[int]:
-    """The first joint of each unknown, in unknown order (``mech.group_members()[g][0]`` for every ``g``, in one
-    pass over the joints)."""
-    first: list[int] = []
-    for j, g in enumerate(mech.groups.tolist()):
-        if g >= len(first):
-            first.extend([-1] * (g + 1 - len(first)))
-        if g >= 0 and first[g] < 0:
-            first[g] = j
-    return first
-
-
 def leading_sign(tangent: Array, drive: int, moving: float = 1e-6) -> int:
     """+1 or -1: the sign of ``tangent``'s drive component, or, when that is below ``moving`` of its largest, of
     its first component that is not (round-off cannot flip it)."""
@@ -167,7 +155,7 @@ class BranchMarcher:
         self.mech = mech
         # The kernels the whole trace runs (chosen by its caller), in the caller's workspace when it has one.
         self.ws = workspace if workspace is not None else Workspace.of(mech, kernels)
-        self.first_joint = first_joints(mech)
+        self.first_joint = mech.first_joints
         self.cfg = settings
         self.max_steps = max_steps
         self.budget = max_steps

@@ -10,9 +10,10 @@ hoop, Guest's frame and a multi-loop mechanized chain are the same object.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
-from typing import Any
+from collections.abc import Callable, Hashable, Mapping, Sequence
+from dataclasses import dataclass, field, fields, replace
+from functools import cached_property
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -25,6 +26,8 @@ IntArray = NDArray[np.int64]
 
 #: Rows of a twist kept for a planar mechanism (rotation about z, translation in x and y).
 PLANAR_ROWS = (2, 3, 4)
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -70,6 +73,13 @@ class Mechanism:
         carries no position along itself; manufacturing errors tilt a hinge about this point
         (:mod:`linkwork.studies.imperfections`). A point that no longer lies on its line (the twists replaced,
         moved or re-referenced) is not used.
+
+    A mechanism is a value: its fields cannot be reassigned and its arrays are read-only copies (the arrays a
+    caller passed in are not kept), and a changed mechanism is a new one (:func:`dataclasses.replace`,
+    :meth:`with_couplings`, :meth:`with_reference`). What is derived from it alone (the number of unknowns, the
+    flattened loops the compiled kernels read, a tracer's plan of it) is therefore computed once, on first use,
+    and kept on it (:meth:`derived`); a copy or an unpickled mechanism starts without those and freezes its
+    arrays again.
     """
 
     name: str
@@ -106,6 +116,33 @@ class Mechanism:
         if len(set(self.joint_names)) != n:
             raise SpecError(f"joint names must be unique, got {list(self.joint_names)}")
 
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields only (for pickle and :mod:`copy`): the derived values are rebuilt where it is used."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def __setstate__(self, state: Mapping[str, Any]) -> None:
+        """The fields of :meth:`__getstate__`, checked and frozen again as by the constructor (numpy unpickles
+        arrays writable)."""
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
+        self.__post_init__()
+
+    def derived(self, key: Hashable, build: Callable[[], T]) -> T:
+        """A value that depends on this mechanism alone, ``build()`` on the first request for ``key`` and kept
+        for the next ones (the mechanism cannot change: see the class's docstring).
+
+        ``key`` names what is kept, including whatever besides the mechanism it depends on (a joint, the kernels'
+        backend). The value is shared by every caller: it must not be changed (arrays in it read-only).
+        """
+        store: dict[Hashable, Any] | None = self.__dict__.get("_derived")
+        if store is None:
+            store = self.__dict__["_derived"] = {}
+        try:
+            return store[key]
+        except KeyError:
+            value = store[key] = build()
+            return value
+
     def __repr__(self) -> str:
         """One line: name, joints by type and name, bodies, loops, planar or spatial (not the arrays)."""
         from linkwork.viz.mechanism_card import summary
@@ -125,7 +162,7 @@ class Mechanism:
         """Number of joints ``n``."""
         return len(self.joint_names)
 
-    @property
+    @cached_property
     def n_unknowns(self) -> int:
         """Number of independent unknowns ``m`` after couplings and fixed joints."""
         return int(self.groups.max()) + 1 if np.any(self.groups >= 0) else 0
@@ -135,7 +172,7 @@ class Mechanism:
         """Closure equations kept per loop: all six, or the three planar ones."""
         return PLANAR_ROWS if self.planar else (0, 1, 2, 3, 4, 5)
 
-    @property
+    @cached_property
     def n_equations(self) -> int:
         """Number of scalar closure equations (loops x rows)."""
         return len(self.loops) * len(self.rows)
@@ -196,6 +233,26 @@ class Mechanism:
         signs = np.array([s for loop in self.loops for s in loop.signs], dtype=np.int64)
         ptr = np.cumsum([0] + [len(loop.joints) for loop in self.loops]).astype(np.int64)
         return joints, signs, ptr
+
+    @cached_property
+    def kernel_arrays(self) -> tuple[Array, IntArray, IntArray, IntArray, IntArray, IntArray]:
+        """The mechanism tuple every tracing kernel takes, read-only and built once: ``(twists, loop_joint,
+        loop_sign, loop_ptr, rows, groups)`` (:meth:`loop_arrays`, :attr:`rows` as an array; the layout of
+        :data:`linkwork.kinematics.march.MECHANISM`)."""
+        joints, signs, ptr = (_frozen(a, np.int64) for a in self.loop_arrays())
+        rows = _frozen(self.rows, np.int64)
+        return self.twists, joints, signs, ptr, rows, self.groups
+
+    @cached_property
+    def first_joints(self) -> tuple[int, ...]:
+        """The first joint of each unknown, in unknown order (``group_members()[g][0]`` for every ``g``)."""
+        first: list[int] = []
+        for j, g in enumerate(self.groups.tolist()):
+            if g >= len(first):
+                first.extend([-1] * (g + 1 - len(first)))
+            if g >= 0 and first[g] < 0:
+                first[g] = j
+        return tuple(first)
 
     # ----------------------------------------------------------------------------------------------------
     # coordinates

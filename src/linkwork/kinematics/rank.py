@@ -134,6 +134,8 @@ def numerical_rank(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> int:
 def numerical_ranks(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> np.ndarray:
     """:func:`numerical_rank` of every row of ``sigma (N, k)``, vectorised over the rows that need no gap test."""
     s = np.atleast_2d(np.asarray(sigma, dtype=float))
+    if all_full_rank(s, tol):
+        return np.full(len(s), s.shape[1], dtype=np.int64)
     positive = s[:, 0] > 0.0
     rel = s / np.where(positive, s[:, 0], 1.0)[:, None]
     ones = np.ones(
@@ -145,3 +147,25 @@ def numerical_ranks(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> np.ndarray:
     for i in ((candidates != sure) & positive).nonzero()[0]:
         out[i] = numerical_rank(s[i], tol)
     return out
+
+
+#: Columns up to which :func:`all_full_rank` takes the smallest value a column at a time (numpy's reduction along a
+#: short last axis is many times slower than a few column operations).
+FEW_COLUMNS = 8
+
+
+def all_full_rank(s: np.ndarray, tol: Tolerances = DEFAULT) -> bool:
+    """Whether every row of ``s (N, k)`` has rank ``k`` by :func:`numerical_rank`: ``s_1 > 0`` and every value
+    above ``loose * s_1`` (so above ``floor * s_1`` too). The smallest value of a row over its first is the
+    smallest of the row's ratios (division by a positive number is monotone, also once rounded), so the test is
+    exact; NaN and infinite values fail it."""
+    if s.shape[1] == 0 or len(s) == 0 or not tol.floor <= tol.loose:
+        return False
+    first = s[:, 0]
+    if s.shape[1] <= FEW_COLUMNS:
+        low = first
+        for j in range(1, s.shape[1]):
+            low = np.minimum(low, s[:, j])
+    else:
+        low = np.min(s, axis=1)
+    return bool(np.all(first > 0.0) and np.all(low / first > tol.loose))

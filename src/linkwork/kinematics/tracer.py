@@ -13,16 +13,17 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
 from linkwork.kinematics.dyads import closed_form_rows
-from linkwork.kinematics.jit import select_backend
-from linkwork.kinematics.marcher import BranchMarcher, MarchSettings, first_joints
+from linkwork.kinematics.jit import Backend, select_backend
+from linkwork.kinematics.marcher import BranchMarcher, MarchSettings, Rows
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
+from linkwork.kinematics.rank import DEFAULT, Tolerances, all_full_rank, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_result import Branch, Trace
 from linkwork.kinematics.trace_stats import TraceStats
@@ -83,12 +84,10 @@ def trace(
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
     backend = select_backend(warm_up=warm_up)
-    ws = Workspace.of(mech, backend)
     started = time.perf_counter()
-    r0, _, jac0 = ws.evaluate(np.zeros(m))
+    r0, U0, s0, Vt0 = start_point(mech, backend)
     if r0 > tol.start_slack * tol.closure:
         raise LinkworkError(f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first")
-    U0, s0, Vt0 = np.linalg.svd(jac0)
     r_path = _path_rank(mech, s0, m, tol)
     t_start = Vt0[-1].copy()
     sign = 1.0
@@ -97,28 +96,24 @@ def trace(
     if t_start[d_unknown] * sign < 0:
         t_start = -t_start
     lo, hi = _limits_in_unknowns(mech, limits)
-    first = first_joints(mech)
-    periodic = np.array([mech.joint_types[j] == "R" for j in first])
     settings = MarchSettings(
         drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=float(np.cos(max_turn)),
-        r_path=r_path, n_sigma=min(jac0.shape), periodic=periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
+        r_path=r_path, n_sigma=len(s0), periodic=_periodic(mech), lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
     )  # fmt: skip
-    marcher = BranchMarcher(
-        mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend, workspace=ws
-    )
     paper = steps is not None
-    h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
-    basis0 = np.ascontiguousarray(U0[:, :r_path])
+    basis0 = np.ascontiguousarray(U0[:, :r_path])  # read-only (the start's, shared): the marches get copies
     if paper and steps is not None and steps <= max_steps:
         # A planar driver-and-dyads mechanism: the same rows in closed form, unless a singular point is near.
         rows = closed_form_rows(mech, backend, d_joint, settings, steps, t_start, basis0)
         if rows is not None:
-            marcher.rows, marcher.budget = rows, max_steps - steps
-            end = marcher.end(StopReason.TARGET, StopReason.TARGET.text, rows.u[-1][-1])
-            marcher.branches.append(Branch.ended(0, None, None, 1, steps, end))
             if progress is not None:
                 progress(steps, max_steps)
-            return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+            return _closed_form_trace(mech, d_joint, rows, steps, settings, started, until)
+    marcher = BranchMarcher(
+        mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend,
+        workspace=Workspace.of(mech, backend),
+    )  # fmt: skip
+    h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
     # Paper mode keeps the sign: equal drive steps towards a target below the start value are negative.
     n0, end0 = marcher.run_branch(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
@@ -132,6 +127,31 @@ def trace(
         marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
     marcher.follow_queue()
     return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+
+
+def start_point(mech: Mechanism, backend: Backend) -> tuple[float, Array, Array, Array]:
+    """The closure residual at ``mech``'s start (its reference, ``u = 0``) and the SVD ``U, sigma, V^T`` of its
+    Jacobian there, evaluated by ``backend``'s kernels: once per mechanism and backend (read-only arrays)."""
+
+    def evaluate() -> tuple[float, Array, Array, Array]:
+        r0, _, jac0 = Workspace.of(mech, backend).evaluate(np.zeros(mech.n_unknowns))
+        U0, s0, Vt0 = np.linalg.svd(jac0)
+        for a in (U0, s0, Vt0):
+            a.flags.writeable = False
+        return r0, U0, s0, Vt0
+
+    return mech.derived(("trace start", backend.compiled), evaluate)
+
+
+def _periodic(mech: Mechanism) -> NDArray[np.bool_]:
+    """Which unknowns are revolute (compared modulo a turn), read-only, once per mechanism."""
+
+    def build() -> NDArray[np.bool_]:
+        periodic = np.array([mech.joint_types[j] == "R" for j in mech.first_joints], dtype=np.bool_)
+        periodic.flags.writeable = False
+        return periodic
+
+    return mech.derived("periodic unknowns", build)
 
 
 def _drive_and_target(
@@ -218,10 +238,7 @@ def _assemble(
     # every row's rank, as the marcher computed it (the closed-form rows come without)
     ranks = np.concatenate(rows.rank) if len(rows.rank) == len(rows.sigma) else numerical_ranks(sigma, tol)
     branch = np.concatenate(rows.branch)
-    if mech.groups.min() >= 0:  # every joint its own unknown or coupled: q_from_u is a gather
-        angles = U[:, mech.groups] + mech.offsets
-    else:
-        angles = mech.angles_from_q(mech.q_from_u(U))
+    angles = _angles(mech, U)
     m = mech.n_unknowns
     branch_list = [
         replace(
@@ -267,6 +284,90 @@ def _assemble(
         stats=stats,
         folds=tuple(marcher.folds),
     )
+
+
+def _closed_form_trace(
+    mech: Mechanism,
+    d_joint: int,
+    rows: Rows,
+    steps: int,
+    settings: MarchSettings,
+    started: float,
+    until: tuple[str | int, float] | None,
+) -> Trace:
+    """The :class:`Trace` of a paper-mode path the closed form gave: what :func:`_assemble` makes of one branch
+    of ``steps`` steps ending on the target, with no point, fold or misfit besides its rows, built without a
+    marcher and without copying the rows (each is one block, the closed form's own arrays)."""
+    tol = settings.tol
+    U, sigma, residual = _joined(rows.u), _joined(rows.sigma), _joined(rows.res)
+    m = mech.n_unknowns
+    if len(rows.rank) == len(rows.sigma):
+        ranks = _joined(rows.rank)
+        mobility = _branch_mobility(m - ranks)
+    elif all_full_rank(
+        sigma, tol
+    ):  # the usual case: every row of full rank (the closed form keeps off the rest)
+        ranks = np.full(len(sigma), sigma.shape[1], dtype=np.int64)
+        mobility = m - sigma.shape[1]  # _branch_mobility of a constant
+    else:
+        ranks = numerical_ranks(sigma, tol)
+        mobility = _branch_mobility(m - ranks)
+    g = settings.drive
+    j = mech.first_joints[g]  # as BranchMarcher.end reports the drive at the last point
+    end_value = float(U[-1][g] + mech.offsets[j])
+    branch = Branch(
+        0, None, None, 1, steps, StopReason.TARGET.text, mobility=mobility,
+        end_kind=StopReason.TARGET, end_joint=mech.joint_names[j], end_value=end_value,
+    )  # fmt: skip
+    stats = TraceStats(
+        start_rank=settings.r_path,
+        start_mobility=m - settings.r_path,
+        mode="paper",
+        closure_tol=tol.closure,
+        max_misfit=float(max(0.0, float(np.max(residual)))),
+        has_target=until is not None,
+        points=len(U),
+        seconds=time.perf_counter() - started,
+    )
+    return Trace(
+        mechanism=mech,
+        drive=mech.joint_names[d_joint],
+        angles=_angles(mech, U),
+        sigma=sigma,
+        residual=residual,
+        branch=_joined(rows.branch),
+        step=_joined(rows.step),
+        arclength=_joined(rows.s),
+        test=_joined(rows.tau),
+        rank=ranks,
+        bifurcations=(),
+        branches=(branch,),
+        stats=stats,
+    )
+
+
+def _joined(blocks: list[Array] | list[NDArray[np.int64]]) -> Any:
+    """The rows of ``blocks`` as one array: the block itself when there is one."""
+    return blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+
+
+#: Joints up to which :func:`_angles` adds the offsets a column at a time (numpy's broadcasting along a short
+#: last axis is slower than a few column operations).
+FEW_JOINTS = 8
+
+
+def _angles(mech: Mechanism, U: Array) -> Array:
+    """``(N, n)`` joint values of the unknowns ``U (N, m)``: ``angles_from_q(q_from_u(U))``."""
+    groups = mech.groups
+    if not mech.derived("every joint free", lambda: bool(groups.min() >= 0)):
+        return mech.angles_from_q(mech.q_from_u(U))
+    n = mech.n_joints
+    if n > FEW_JOINTS:
+        return U[:, groups] + mech.offsets  # q_from_u is a gather
+    out = np.empty((len(U), n))
+    for j, (g, offset) in enumerate(zip(groups.tolist(), mech.offsets.tolist(), strict=True)):
+        np.add(U[:, g], offset, out=out[:, j])
+    return out
 
 
 def _branch_mobility(mobility: NDArray[np.int64]) -> int:

@@ -18,8 +18,9 @@ Array = NDArray[np.float64]
 class Workspace:
     """The flattened mechanism and scratch arrays the compiled kernels need.
 
-    ``twists``, ``loop_joint``, ``loop_sign``, ``loop_ptr``, ``rows`` and ``groups`` are the arrays of
-    :meth:`Mechanism.loop_arrays` and friends, in the layout :func:`linkwork.kinematics.march.march` takes;
+    ``twists``, ``loop_joint``, ``loop_sign``, ``loop_ptr``, ``rows`` and ``groups`` are the read-only arrays of
+    :attr:`Mechanism.kernel_arrays` (built once per mechanism), in the layout
+    :func:`linkwork.kinematics.march.march` takes;
     ``q``, ``res`` and ``jac`` are overwritten by every :meth:`evaluate`. ``kernels`` is the implementation of
     the :mod:`~linkwork.kinematics.march` kernels to call (compiled, or the same functions as plain Python while
     the cache is cold), chosen once per trace by :func:`linkwork.kinematics.jit.select_backend`.
@@ -40,14 +41,14 @@ class Workspace:
     def of(cls, mech: Mechanism, kernels: Backend | None = None) -> Workspace:
         """Scratch space for ``mech``, calling ``kernels`` (default: chosen now by
         :func:`~linkwork.kinematics.jit.select_backend`)."""
-        lj, ls, lp = mech.loop_arrays()
+        twists, lj, ls, lp, rows, groups = mech.kernel_arrays
         return cls(
-            twists=mech.twists,
+            twists=twists,
             loop_joint=lj,
             loop_sign=ls,
             loop_ptr=lp,
-            rows=np.array(mech.rows, dtype=np.int64),
-            groups=mech.groups,
+            rows=rows,
+            groups=groups,
             q=np.empty(mech.n_joints),
             res=np.empty(mech.n_equations),
             jac=np.empty((mech.n_equations, mech.n_unknowns)),
