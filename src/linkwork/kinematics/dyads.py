@@ -218,15 +218,16 @@ def closed_form_rows(
     plan = mech.derived(("dyad plan", drive), lambda: _frozen_plan(mech, drive))
     if plan is None:
         return None
-    run = np.zeros(N_SETTINGS)
-    run[S_STEP] = settings.target / steps
-    run[S_TARGET] = settings.target
-    run[S_STEPS] = steps
-    run[S_HMAX] = settings.max_step
-    run[S_DET_BASIS] = 1.0 if np.linalg.det(basis) >= 0.0 else -1.0
-    run[S_MIN_RATIO] = settings.tol.local_min
-    run[S_MIN_DRIVE] = MIN_DRIVE
-    run[S_MIN_MARGIN] = MIN_MARGIN
+    values = [0.0] * N_SETTINGS
+    values[S_STEP] = settings.target / steps
+    values[S_TARGET] = settings.target
+    values[S_STEPS] = steps
+    values[S_HMAX] = settings.max_step
+    values[S_DET_BASIS] = 1.0 if np.linalg.det(basis) >= 0.0 else -1.0
+    values[S_MIN_RATIO] = settings.tol.local_min
+    values[S_MIN_DRIVE] = MIN_DRIVE
+    values[S_MIN_MARGIN] = MIN_MARGIN
+    run = np.array(values, dtype=float)
     twists, lj, ls, lp, _, groups = mech.kernel_arrays
     flat = (twists, lj, ls, lp, groups)
     periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)

@@ -269,3 +269,42 @@ def cholesky_solve(L: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
         for k in range(a + 1, n):
             acc -= L[k, a] * x[k]
         x[a] = acc / L[a, a]
+
+
+@kernel()
+def joint_values(u: np.ndarray, groups: np.ndarray, offsets: np.ndarray, out: np.ndarray) -> None:
+    """Joint values ``out (N, n)`` of the unknowns ``u (N, m)`` at every row, every joint free (``groups >= 0``):
+    ``out[k, j] = u[k, groups[j]] + offsets[j]``, what numpy's ``u[:, groups] + offsets`` gives, in one pass
+    (without the gather when every joint is its own unknown)."""
+    n = groups.shape[0]
+    own = u.shape[1] == n
+    for j in range(n):
+        own = own and groups[j] == j
+    if own:
+        for k in range(u.shape[0]):
+            for j in range(n):
+                out[k, j] = u[k, j] + offsets[j]
+        return
+    for k in range(u.shape[0]):
+        for j in range(n):
+            out[k, j] = u[k, groups[j]] + offsets[j]
+
+
+@kernel()
+def every_row_full_rank(sigma: np.ndarray, loose: float) -> bool:
+    """Whether every row of singular values ``sigma (N, r)`` has ``sigma_1 > 0`` and every ratio
+    ``sigma_i / sigma_1`` above ``loose``: then every row's numerical rank is ``r``
+    (:func:`linkwork.kinematics.rank.numerical_rank`, with a floor at or below ``loose``). A row's smallest value
+    over its first is its smallest ratio (division by a positive number is monotone, also once rounded), so one
+    division a row decides it exactly; NaN fails."""
+    ok = sigma.shape[1] > 0
+    for k in range(sigma.shape[0]):
+        first = sigma[k, 0]
+        low = first
+        for i in range(1, sigma.shape[1]):
+            x = sigma[k, i]
+            ok &= x == x
+            low = x if x < low else low
+        ok &= first > 0.0
+        ok &= low / first > loose
+    return ok

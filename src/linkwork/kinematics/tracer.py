@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.kinematics import kernels
 from linkwork.kinematics.dyads import closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings, Rows
@@ -88,7 +89,7 @@ def trace(
     r0, U0, s0, Vt0 = start_point(mech, backend)
     if r0 > tol.start_slack * tol.closure:
         raise LinkworkError(f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first")
-    r_path = _path_rank(mech, s0, m, tol)
+    r_path = _path_rank(mech, s0, m, tol, backend.compiled)
     t_start = Vt0[-1].copy()
     sign = 1.0
     if target is not None:
@@ -108,7 +109,7 @@ def trace(
         if rows is not None:
             if progress is not None:
                 progress(steps, max_steps)
-            return _closed_form_trace(mech, d_joint, rows, steps, settings, started, until)
+            return _closed_form_trace(mech, d_joint, rows, steps, settings, started, until, backend)
     marcher = BranchMarcher(
         mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend,
         workspace=Workspace.of(mech, backend),
@@ -180,9 +181,10 @@ def _drive_and_target(
     return d_joint, d_unknown, target
 
 
-def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances) -> int:
-    """Rank of the Jacobian at the start; refuses a rigid start or one of mobility above one."""
-    r_path = numerical_rank(sigma, tol)
+def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, compiled: bool) -> int:
+    """Rank of the Jacobian at the start (its singular values ``sigma``, by the ``compiled`` kernels or not: once
+    per mechanism, backend and tolerances); refuses a rigid start or one of mobility above one."""
+    r_path = mech.derived(("start rank", compiled, tol), lambda: numerical_rank(sigma, tol))
     mobility = m - r_path
     if mobility == 0:
         raise LinkworkError(
@@ -202,10 +204,13 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances) -> int:
 def _limits_in_unknowns(
     mech: Mechanism, limits: Mapping[str, tuple[float, float]] | None
 ) -> tuple[Array, Array]:
-    """Joint limits ``{name: (low, high)}`` (joint values) as bounds on the unknowns (from the start)."""
-    m = mech.n_unknowns
-    lo, hi = np.full(m, -np.inf), np.full(m, np.inf)
-    for name, (a, b) in (limits or {}).items():
+    """Joint limits ``{name: (low, high)}`` (joint values) as bounds on the unknowns (from the start), read-only
+    (the same arrays for every trace without limits)."""
+    if not limits:
+        return mech.derived("no limits", lambda: _unbounded(mech.n_unknowns))
+    lo, hi = _unbounded(mech.n_unknowns)
+    lo.flags.writeable = hi.flags.writeable = True
+    for name, (a, b) in limits.items():
         j = mech.index(name)
         if not a < b:
             raise SpecError(
@@ -218,6 +223,14 @@ def _limits_in_unknowns(
         if not a <= value <= b:
             raise SpecError(f"limit {mech.joint_names[j]}: the start value is outside [{a:g}, {b:g}]")
         lo[g], hi[g] = max(lo[g], a - value), min(hi[g], b - value)
+    lo.flags.writeable = hi.flags.writeable = False
+    return lo, hi
+
+
+def _unbounded(m: int) -> tuple[Array, Array]:
+    """Read-only bounds ``(-inf, inf)`` on ``m`` unknowns."""
+    lo, hi = np.full(m, -np.inf), np.full(m, np.inf)
+    lo.flags.writeable = hi.flags.writeable = False
     return lo, hi
 
 
@@ -238,7 +251,7 @@ def _assemble(
     # every row's rank, as the marcher computed it (the closed-form rows come without)
     ranks = np.concatenate(rows.rank) if len(rows.rank) == len(rows.sigma) else numerical_ranks(sigma, tol)
     branch = np.concatenate(rows.branch)
-    angles = _angles(mech, U)
+    angles = _angles(mech, U, marcher.ws.kernels.compiled)
     m = mech.n_unknowns
     branch_list = [
         replace(
@@ -294,19 +307,22 @@ def _closed_form_trace(
     settings: MarchSettings,
     started: float,
     until: tuple[str | int, float] | None,
+    backend: Backend,
 ) -> Trace:
     """The :class:`Trace` of a paper-mode path the closed form gave: what :func:`_assemble` makes of one branch
     of ``steps`` steps ending on the target, with no point, fold or misfit besides its rows, built without a
-    marcher and without copying the rows (each is one block, the closed form's own arrays)."""
+    marcher and without copying the rows (each is one block, the closed form's own arrays). With the compiled
+    ``backend``, the joint values and the rank check are one compiled pass each over the rows."""
+    compiled = backend.compiled
     tol = settings.tol
     U, sigma, residual = _joined(rows.u), _joined(rows.sigma), _joined(rows.res)
     m = mech.n_unknowns
     if len(rows.rank) == len(rows.sigma):
         ranks = _joined(rows.rank)
         mobility = _branch_mobility(m - ranks)
-    elif all_full_rank(
-        sigma, tol
-    ):  # the usual case: every row of full rank (the closed form keeps off the rest)
+    elif _every_row_full_rank(
+        sigma, tol, compiled
+    ):  # the usual case: the closed form keeps off singular points
         ranks = np.full(len(sigma), sigma.shape[1], dtype=np.int64)
         mobility = m - sigma.shape[1]  # _branch_mobility of a constant
     else:
@@ -332,7 +348,7 @@ def _closed_form_trace(
     return Trace(
         mechanism=mech,
         drive=mech.joint_names[d_joint],
-        angles=_angles(mech, U),
+        angles=_angles(mech, U, compiled),
         sigma=sigma,
         residual=residual,
         branch=_joined(rows.branch),
@@ -351,22 +367,24 @@ def _joined(blocks: list[Array] | list[NDArray[np.int64]]) -> Any:
     return blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
 
 
-#: Joints up to which :func:`_angles` adds the offsets a column at a time (numpy's broadcasting along a short
-#: last axis is slower than a few column operations).
-FEW_JOINTS = 8
+def _every_row_full_rank(sigma: Array, tol: Tolerances, compiled: bool) -> bool:
+    """Whether :func:`numerical_ranks` gives every row of ``sigma`` its full rank (``compiled``: in one compiled
+    pass)."""
+    if compiled:
+        return tol.floor <= tol.loose and bool(kernels.every_row_full_rank(sigma, tol.loose))
+    return all_full_rank(sigma, tol)
 
 
-def _angles(mech: Mechanism, U: Array) -> Array:
-    """``(N, n)`` joint values of the unknowns ``U (N, m)``: ``angles_from_q(q_from_u(U))``."""
+def _angles(mech: Mechanism, U: Array, compiled: bool = False) -> Array:
+    """``(N, n)`` joint values of the unknowns ``U (N, m)``: ``angles_from_q(q_from_u(U))`` (``compiled``: by
+    the compiled kernel, the same sums in one pass)."""
     groups = mech.groups
     if not mech.derived("every joint free", lambda: bool(groups.min() >= 0)):
         return mech.angles_from_q(mech.q_from_u(U))
-    n = mech.n_joints
-    if n > FEW_JOINTS:
+    if not compiled:
         return U[:, groups] + mech.offsets  # q_from_u is a gather
-    out = np.empty((len(U), n))
-    for j, (g, offset) in enumerate(zip(groups.tolist(), mech.offsets.tolist(), strict=True)):
-        np.add(U[:, g], offset, out=out[:, j])
+    out = np.empty((len(U), mech.n_joints))
+    kernels.joint_values(np.ascontiguousarray(U), groups, mech.offsets, out)
     return out
 
 
