@@ -155,10 +155,11 @@ FEW_COLUMNS = 8
 
 
 def all_full_rank(s: np.ndarray, tol: Tolerances = DEFAULT) -> bool:
-    """Whether every row of ``s (N, k)`` has rank ``k`` by :func:`numerical_rank`: ``s_1 > 0`` and every value
-    above ``loose * s_1`` (so above ``floor * s_1`` too). The smallest value of a row over its first is the
-    smallest of the row's ratios (division by a positive number is monotone, also once rounded), so the test is
-    exact; NaN and infinite values fail it."""
+    """Whether every row of ``s (N, k)`` has ``s_1 > 0`` and every value above ``loose * s_1``: then (with
+    ``floor <= loose``) every row's rank by :func:`numerical_rank` is ``k``; where not, some rows may still have
+    rank ``k`` by the gap test, and :func:`numerical_ranks` decides row by row. The smallest value of a row over
+    its first is the smallest of the row's ratios (division by a positive number is monotone, also once
+    rounded), so the test is the one :func:`numerical_rank` makes, exactly; NaN and infinite values fail it."""
     if s.shape[1] == 0 or len(s) == 0 or not tol.floor <= tol.loose:
         return False
     first = s[:, 0]
