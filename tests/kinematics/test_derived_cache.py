@@ -186,8 +186,26 @@ def test_full_rank_checks_agree_with_numerical_rank_row_by_row() -> None:
             if quick:  # a sufficient test: where it fails, numerical_ranks decides row by row
                 assert full_by_rows(s, tol), name
             assert quick == (name in ("generic", "above loose", "unsorted")), name
-            with np.errstate(invalid="ignore"):  # inf / inf in the general path's ratios
-                assert numerical_ranks(s, tol).tolist() == [numerical_rank(row, tol) for row in s], name
+            with np.errstate(invalid="ignore"):  # inf / inf in numpy's ratios
+                expected = [numerical_rank(row, tol) for row in s]
+                assert numerical_ranks(s, tol).tolist() == expected, name
+            assert numerical_ranks(s, tol, compiled=True).tolist() == expected, name
     assert not all_full_rank(
         base, Tolerances(floor=1e-3, loose=1e-4)
     )  # a floor above loose: the general path
+
+
+def test_compiled_rank_counts_with_gap_tests() -> None:
+    """``numerical_ranks`` with the compiled counts, on rows whose smallest values fall between ``floor`` and
+    ``loose`` (the gap test decides them), against ``numerical_rank`` row by row and the numpy counts."""
+    rng = np.random.default_rng(5)
+    s = np.sort(rng.uniform(0.5, 2.0, size=(400, 6)), axis=1)[:, ::-1].copy()
+    s[:, -1] *= 10.0 ** rng.uniform(-17.0, 0.0, size=400)  # from round-off to not small
+    s[::7, -2] *= 1e-7  # two small values in some rows
+    s[::50] = 0.0
+    s = np.sort(s, axis=1)[:, ::-1].copy()
+    expected = [numerical_rank(row) for row in s]
+    assert len(set(expected)) >= 3  # ranks 0, 4, 5 and 6 occur
+    assert numerical_ranks(s, compiled=True).tolist() == expected
+    with np.errstate(invalid="ignore"):  # the zero rows' ratios in the numpy path
+        assert numerical_ranks(s).tolist() == expected

@@ -308,3 +308,25 @@ def every_row_full_rank(sigma: np.ndarray, loose: float) -> bool:
         ok &= first > 0.0
         ok &= low / first > loose
     return ok
+
+
+@kernel()
+def rank_counts(
+    sigma: np.ndarray, loose: float, floor: float, sure: np.ndarray, candidates: np.ndarray
+) -> None:
+    """For every row of singular values ``sigma (N, r)``: how many ratios ``sigma_i / sigma_1`` are above
+    ``loose`` (``sure[k]``) and above ``floor`` (``candidates[k]``), both 0 where ``sigma_1`` is not positive:
+    the counts :func:`linkwork.kinematics.rank.numerical_ranks` starts from (the same divisions)."""
+    for k in range(sigma.shape[0]):
+        first = sigma[k, 0]
+        above_loose = 0
+        above_floor = 0
+        if first > 0.0:
+            for i in range(sigma.shape[1]):
+                rel = sigma[k, i] / first
+                if rel > loose:
+                    above_loose += 1
+                if rel > floor:
+                    above_floor += 1
+        sure[k] = above_loose
+        candidates[k] = above_floor

@@ -291,7 +291,9 @@ class BranchMarcher:
                         StopReason.TARGET
                     )  # the closing step passed over the target (or ends on it): land there
             limit = self._land_on_limit(chunk) if chunk.code == StopReason.LIMIT else None
-            ranks = numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol)  # every row's rank, once
+            ranks = numerical_ranks(
+                chunk.sigma[: chunk.count], self.cfg.tol, self.ws.kernels.compiled
+            )  # once
             chunk.rank = ranks
             component = self._component_entry(chunk, ranks)
             if component is not None:
@@ -538,7 +540,7 @@ class BranchMarcher:
         rows.u.append(chunk.u[begin:count])
         rows.sigma.append(chunk.sigma[begin:count])
         if chunk.rank is None:
-            chunk.rank = numerical_ranks(chunk.sigma[:count], self.cfg.tol)
+            chunk.rank = numerical_ranks(chunk.sigma[:count], self.cfg.tol, self.ws.kernels.compiled)
         rows.rank.append(chunk.rank[begin:count])
         rows.res.append(chunk.res[begin:count])
         rows.tau.append(chunk.tau[begin:count])

@@ -249,9 +249,13 @@ def _assemble(
     U = np.concatenate(rows.u)
     sigma = np.concatenate(rows.sigma)
     # every row's rank, as the marcher computed it (the closed-form rows come without)
-    ranks = np.concatenate(rows.rank) if len(rows.rank) == len(rows.sigma) else numerical_ranks(sigma, tol)
+    compiled = marcher.ws.kernels.compiled
+    if len(rows.rank) == len(rows.sigma):
+        ranks = np.concatenate(rows.rank)
+    else:
+        ranks = numerical_ranks(sigma, tol, compiled)
     branch = np.concatenate(rows.branch)
-    angles = _angles(mech, U, marcher.ws.kernels.compiled)
+    angles = _angles(mech, U, compiled)
     m = mech.n_unknowns
     branch_list = [
         replace(
@@ -326,7 +330,7 @@ def _closed_form_trace(
         ranks = np.full(len(sigma), sigma.shape[1], dtype=np.int64)
         mobility = m - sigma.shape[1]  # _branch_mobility of a constant
     else:
-        ranks = numerical_ranks(sigma, tol)
+        ranks = numerical_ranks(sigma, tol, compiled)
         mobility = _branch_mobility(m - ranks)
     g = settings.drive
     j = mech.first_joints[g]  # as BranchMarcher.end reports the drive at the last point
