@@ -344,7 +344,7 @@ def _closed_form_trace(
         start_mobility=m - settings.r_path,
         mode="paper",
         closure_tol=tol.closure,
-        max_misfit=float(max(0.0, float(np.max(residual)))),
+        max_misfit=float(max(0.0, float(residual.max()))),
         has_target=until is not None,
         points=len(U),
         seconds=time.perf_counter() - started,
