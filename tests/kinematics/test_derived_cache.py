@@ -209,3 +209,30 @@ def test_compiled_rank_counts_with_gap_tests() -> None:
     assert numerical_ranks(s, compiled=True).tolist() == expected
     with np.errstate(invalid="ignore"):  # the zero rows' ratios in the numpy path
         assert numerical_ranks(s).tolist() == expected
+
+
+@pytest.mark.parametrize("name", ["four-bar", "slider-crank", "watt"])
+def test_the_closed_form_trace_reports_what_the_marcher_would(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The closed form's Trace is built without a marcher: its branch, stats and events are those of the same
+    trace by the predictor-corrector (the closed form switched off), field by field."""
+    from linkwork.kinematics import tracer
+
+    mech = lw.load(str(WATT) if name == "watt" else name)
+    fast = turn(mech, 180)
+    monkeypatch.setattr(tracer, "closed_form_rows", lambda *args, **kwargs: None)
+    general = turn(mech, 180)
+    assert fast.drive == general.drive and fast.bifurcations == general.bifurcations == ()
+    assert fast.folds == general.folds == ()
+    (a,), (b,) = fast.branches, general.branches
+    assert a.end_value is not None and b.end_value is not None
+    assert abs(a.end_value - b.end_value) < 1e-12
+    assert replace(a, end_value=None) == replace(b, end_value=None)
+    same = ("start_rank", "start_mobility", "mode", "closure_tol", "sign_changes_without_rank_drop")
+    same += ("branches_not_retraced", "has_target", "unmet", "points")
+    assert [getattr(fast.stats, k) for k in same] == [getattr(general.stats, k) for k in same]
+    assert fast.stats.max_misfit == float(np.max(fast.residual)) and general.stats.max_misfit < 1e-12
+    assert np.array_equal(fast.rank, general.rank) and np.array_equal(fast.step, general.step)
+    for array in (fast.angles, fast.sigma, fast.residual, fast.rank, fast.step, fast.branch, fast.test):
+        assert array.flags.c_contiguous and array.flags.writeable
