@@ -324,9 +324,7 @@ def _closed_form_trace(
     if len(rows.rank) == len(rows.sigma):
         ranks = _joined(rows.rank)
         mobility = _branch_mobility(m - ranks)
-    elif _every_row_full_rank(
-        sigma, tol, compiled
-    ):  # the usual case: the closed form keeps off singular points
+    elif _every_row_full_rank(sigma, tol, compiled):  # usual: the closed form keeps off singular points
         ranks = np.full(len(sigma), sigma.shape[1], dtype=np.int64)
         mobility = m - sigma.shape[1]  # _branch_mobility of a constant
     else:
@@ -372,8 +370,8 @@ def _joined(blocks: list[Array] | list[NDArray[np.int64]]) -> Any:
 
 
 def _every_row_full_rank(sigma: Array, tol: Tolerances, compiled: bool) -> bool:
-    """Whether :func:`numerical_ranks` gives every row of ``sigma`` its full rank (``compiled``: in one compiled
-    pass)."""
+    """True when every row of ``sigma`` has its full rank by the quick test of :func:`all_full_rank` (``compiled``:
+    in one compiled pass); False leaves the ranks to :func:`numerical_ranks`."""
     if compiled:
         return tol.floor <= tol.loose and bool(kernels.every_row_full_rank(sigma, tol.loose))
     return all_full_rank(sigma, tol)
