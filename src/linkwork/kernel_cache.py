@@ -44,6 +44,7 @@ KERNEL_MODULES = (
     "kinematics/march.py",
     "kinematics/small_svd.py",
     "kinematics/stops.py",
+    "kinematics/trig.py",
     "studies/first_order.py",
     "studies/imperfections.py",
     "studies/misfit.py",
