@@ -32,6 +32,7 @@ import numpy as np
 from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import log_coefficient
 from linkwork.kinematics.small_svd import orthonormalise
+from linkwork.kinematics.trig import SINCOS_LIMIT, atan2, sincos
 
 #: Joint kinds in ``joint_int[:, 0]``.
 REVOLUTE, PRISMATIC = 0, 1
@@ -49,8 +50,7 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
     7,
 )
 N_SETTINGS = 8
-#: Points per block of the closed form's second and third passes (their scratch stays in the cache).
-BLOCK = 64
+TWO_PI = 2.0 * np.pi
 
 
 @kernel(inline="always")
@@ -63,219 +63,320 @@ def wrap_angle(x: float) -> float:
 
 
 @kernel(inline="always")
-def apply_pose(poses: np.ndarray, body: int, x: float, y: float) -> tuple[float, float]:
-    """The point ``(x, y)`` of ``body`` (reference coordinates) where the body's pose ``(cos, sin, tx, ty)``
-    puts it."""
-    c, s = poses[body, 0], poses[body, 1]
-    return c * x - s * y + poses[body, 2], s * x + c * y + poses[body, 3]
+def apply_pose(poses: np.ndarray, body: int, k: int, x: float, y: float) -> tuple[float, float]:
+    """The point ``(x, y)`` of ``body`` (reference coordinates) where the body's pose ``(cos, sin, tx, ty)`` at
+    point ``k`` puts it."""
+    c, s = poses[body, 0, k], poses[body, 1, k]
+    return c * x - s * y + poses[body, 2, k], s * x + c * y + poses[body, 3, k]
 
 
 @kernel(inline="always")
-def set_pose(
-    poses: np.ndarray, body: int, c: float, s: float, x: float, y: float, X: float, Y: float
-) -> None:
-    """Pose of ``body`` turned by the rotation ``(c, s)`` and taking its reference point ``(x, y)`` to ``(X, Y)``."""
-    poses[body, 0] = c
-    poses[body, 1] = s
-    poses[body, 2] = X - (c * x - s * y)
-    poses[body, 3] = Y - (s * x + c * y)
+def set_pose(poses, body, k, c, s, x, y, X, Y):
+    """Pose of ``body`` at point ``k`` turned by the rotation ``(c, s)`` and taking its reference point ``(x, y)``
+    to ``(X, Y)``."""
+    poses[body, 0, k] = c
+    poses[body, 1, k] = s
+    poses[body, 2, k] = X - (c * x - s * y)
+    poses[body, 3, k] = Y - (s * x + c * y)
 
 
 @kernel(inline="always")
-def set_pose_turning(poses, body, x, y, X, Y, ux, uy, vx, vy):
-    """Pose of ``body`` taking its reference point ``(x, y)`` to ``(X, Y)`` and turning the reference vector
-    ``(ux, uy)`` onto the direction of ``(vx, vy)``."""
+def set_pose_turning(poses, body, k, x, y, X, Y, ux, uy, vx, vy):
+    """Pose of ``body`` at point ``k`` taking its reference point ``(x, y)`` to ``(X, Y)`` and turning the
+    reference vector ``(ux, uy)`` onto the direction of ``(vx, vy)``."""
     scale = 1.0 / np.sqrt((ux * ux + uy * uy) * (vx * vx + vy * vy))
-    set_pose(poses, body, (ux * vx + uy * vy) * scale, (ux * vy - uy * vx) * scale, x, y, X, Y)
+    set_pose(poses, body, k, (ux * vx + uy * vy) * scale, (ux * vy - uy * vx) * scale, x, y, X, Y)
 
 
 @kernel(inline="always")
-def place_driven(joint_int, joint_geo, drive, driven, q, poses):
-    """Pose of the body the drive joint moves, the other body of the drive joint being fixed (identity pose)."""
-    sign = 1.0 if joint_int[drive, 2] == driven else -1.0  # g_after = g_before exp(xi q)
-    if joint_int[drive, 0] == REVOLUTE:
-        phi = sign * joint_geo[drive, 2] * q
-        px, py = joint_geo[drive, 0], joint_geo[drive, 1]
-        set_pose(poses, driven, np.cos(phi), np.sin(phi), px, py, px, py)
-    else:
-        set_pose(
-            poses, driven, 1.0, 0.0, 0.0, 0.0, sign * q * joint_geo[drive, 0], sign * q * joint_geo[drive, 1]
-        )
-
-
-@kernel(inline="always")
-def guide_line(joint_geo, poses, j, known, px, py):
-    """The line a point ``(px, py)`` of the body that prismatic joint ``j`` joins to ``known`` runs on: its point
-    and unit direction where ``known``'s pose puts them (the two bodies keep one orientation)."""
-    X, Y = apply_pose(poses, known, px, py)
-    c, s = poses[known, 0], poses[known, 1]
+def guide_line(joint_geo, poses, j, known, k, px, py):
+    """The line a point ``(px, py)`` of the body that prismatic joint ``j`` joins to ``known`` runs on at point
+    ``k``: its point and unit direction where ``known``'s pose puts them (the two bodies keep one orientation)."""
+    X, Y = apply_pose(poses, known, k, px, py)
+    c, s = poses[known, 0, k], poses[known, 1, k]
     dx, dy = joint_geo[j, 0], joint_geo[j, 1]
     return X, Y, c * dx - s * dy, s * dx + c * dy
 
 
-@kernel()
-def place_dyad(joint_int, joint_geo, dyad, mode, poses, min_margin):
-    """Place the two bodies of one dyad ``(j1, j2, j3, K1, B1, B2, K2)`` in closed form; returns a status.
+@kernel(inline="always")
+def first_status(status: np.ndarray, k: int, code: int) -> None:
+    """Keep the first reason a point failed (the dyads are placed in order; a later one sees NaN or garbage)."""
+    status[k] = code if status[k] == CLEAN else status[k]
 
-    ``mode`` is the sign that picks the start's assembly mode. ``min_margin`` is the smallest relative distance
-    from the dyad's limit (a double root) accepted; below it the dyad is too near a fold to trust a closed form
-    where the predictor-corrector would meet the fold.
-    """
+
+@kernel(error_model="numpy")
+def place_driver(joint_int, joint_geo, head, drive_q, poses):
+    """Pose of the body the drive joint moves at every point ``k >= 1`` (the other body of the drive joint is
+    fixed: identity pose), the drive's values ``drive_q``; the rotation by the branch-free
+    :func:`~linkwork.kinematics.trig.sincos` in one vectorised loop."""
+    drive, driven = head[0], head[1]
+    sign = 1.0 if joint_int[drive, 2] == driven else -1.0  # g_after = g_before exp(xi q)
+    K = drive_q.shape[0]
+    if joint_int[drive, 0] == REVOLUTE:
+        turn = sign * joint_geo[drive, 2]
+        px, py = joint_geo[drive, 0], joint_geo[drive, 1]
+        for k in range(1, K):
+            c, s = sincos(turn * drive_q[k])
+            set_pose(poses, driven, k, c, s, px, py, px, py)
+        for k in range(1, K):  # beyond the reduction's range: the C library (never on a sane drive)
+            if not abs(turn * drive_q[k]) <= SINCOS_LIMIT:
+                phi = turn * drive_q[k]
+                set_pose(poses, driven, k, np.cos(phi), np.sin(phi), px, py, px, py)
+    else:
+        dx, dy = sign * joint_geo[drive, 0], sign * joint_geo[drive, 1]
+        for k in range(1, K):
+            set_pose(poses, driven, k, 1.0, 0.0, 0.0, 0.0, drive_q[k] * dx, drive_q[k] * dy)
+
+
+@kernel(error_model="numpy")
+def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
+    """An RRR dyad ``(j1, j2, j3, K1, B1, B2, K2)`` at every point ``k >= 1``: two circles about the placed
+    pivots, the root on the side ``mode``; ``status[k]`` set where there is none or it is within ``min_margin``
+    (relative) of the double root. Straight-line code: the loop over points vectorises."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
-    k1, k2, k3 = joint_int[j1, 0], joint_int[j2, 0], joint_int[j3, 0]
-    if k2 == REVOLUTE:
-        # The middle point p2 (shared by B1 and B2) on a circle or a line from each side.
-        p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
-        if k1 == REVOLUTE and k3 == REVOLUTE:  # RRR: two circles
-            p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
-            L1s = (p2x - p1x) ** 2 + (p2y - p1y) ** 2
-            L2s = (p2x - p3x) ** 2 + (p2y - p3y) ** 2
-            X1, Y1 = apply_pose(poses, K1, p1x, p1y)
-            X3, Y3 = apply_pose(poses, K2, p3x, p3y)
-            Dx, Dy = X3 - X1, Y3 - Y1
-            d2 = Dx * Dx + Dy * Dy
-            if d2 == 0.0:
-                return NO_SOLUTION
-            d = np.sqrt(d2)
-            a = (L1s - L2s + d2) / (2.0 * d)
-            h2 = L1s - a * a
-            if h2 < 0.0:
-                return NO_SOLUTION
-            h = np.sqrt(h2)
-            if h * h < min_margin * min_margin * L1s:
-                return NEAR_SINGULAR
-            X2 = X1 + (a * Dx - mode * h * Dy) / d
-            Y2 = Y1 + (a * Dy + mode * h * Dx) / d
-            set_pose_turning(poses, B1, p1x, p1y, X1, Y1, p2x - p1x, p2y - p1y, X2 - X1, Y2 - Y1)
-            set_pose_turning(poses, B2, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
-            return CLEAN
-        if k1 == PRISMATIC and k3 == PRISMATIC:  # PRP: two lines
-            Ax, Ay, ax, ay = guide_line(joint_geo, poses, j1, K1, p2x, p2y)
-            Cx, Cy, cx, cy = guide_line(joint_geo, poses, j3, K2, p2x, p2y)
-            det = ax * cy - ay * cx
-            if abs(det) < min_margin:
-                return NEAR_SINGULAR
-            s1 = ((Cx - Ax) * cy - (Cy - Ay) * cx) / det
-            X2, Y2 = Ax + s1 * ax, Ay + s1 * ay
-            set_pose(poses, B1, poses[K1, 0], poses[K1, 1], p2x, p2y, X2, Y2)
-            set_pose(poses, B2, poses[K2, 0], poses[K2, 1], p2x, p2y, X2, Y2)
-            return CLEAN
-        # RRP or PRR: a circle about the revolute side's pivot and the prismatic side's line.
-        if k1 == REVOLUTE:
-            jr, Kr, Br, jp, Kp, Bp = j1, K1, B1, j3, K2, B2
-        else:
-            jr, Kr, Br, jp, Kp, Bp = j3, K2, B2, j1, K1, B1
-        prx, pry = joint_geo[jr, 0], joint_geo[jr, 1]
-        Ls = (p2x - prx) ** 2 + (p2y - pry) ** 2
-        Xr, Yr = apply_pose(poses, Kr, prx, pry)
-        Qx, Qy, ex, ey = guide_line(joint_geo, poses, jp, Kp, p2x, p2y)
+    p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
+    p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    L1s = (p2x - p1x) ** 2 + (p2y - p1y) ** 2
+    L2s = (p2x - p3x) ** 2 + (p2y - p3y) ** 2
+    floor = min_margin * min_margin * L1s
+    for k in range(1, poses.shape[2]):
+        X1, Y1 = apply_pose(poses, K1, k, p1x, p1y)
+        X3, Y3 = apply_pose(poses, K2, k, p3x, p3y)
+        Dx, Dy = X3 - X1, Y3 - Y1
+        d2 = Dx * Dx + Dy * Dy
+        d = np.sqrt(d2)
+        a = (L1s - L2s + d2) / (2.0 * d)
+        h2 = L1s - a * a
+        h = np.sqrt(max(h2, 0.0))
+        code = NO_SOLUTION if (d2 == 0.0) | (h2 < 0.0) else (NEAR_SINGULAR if h * h < floor else CLEAN)
+        first_status(status, k, code)
+        X2 = X1 + (a * Dx - mode * h * Dy) / d
+        Y2 = Y1 + (a * Dy + mode * h * Dx) / d
+        set_pose_turning(poses, B1, k, p1x, p1y, X1, Y1, p2x - p1x, p2y - p1y, X2 - X1, Y2 - Y1)
+        set_pose_turning(poses, B2, k, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
+
+
+@kernel(error_model="numpy")
+def place_prp(joint_geo, dyad, poses, min_margin, status):
+    """A PRP dyad at every point ``k >= 1``: the middle pivot where the two guide lines cross."""
+    j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
+    p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    for k in range(1, poses.shape[2]):
+        Ax, Ay, ax, ay = guide_line(joint_geo, poses, j1, K1, k, p2x, p2y)
+        Cx, Cy, cx, cy = guide_line(joint_geo, poses, j3, K2, k, p2x, p2y)
+        det = ax * cy - ay * cx
+        first_status(status, k, NEAR_SINGULAR if abs(det) < min_margin else CLEAN)
+        s1 = ((Cx - Ax) * cy - (Cy - Ay) * cx) / det
+        X2, Y2 = Ax + s1 * ax, Ay + s1 * ay
+        set_pose(poses, B1, k, poses[K1, 0, k], poses[K1, 1, k], p2x, p2y, X2, Y2)
+        set_pose(poses, B2, k, poses[K2, 0, k], poses[K2, 1, k], p2x, p2y, X2, Y2)
+
+
+@kernel(error_model="numpy")
+def place_rrp(joint_int, joint_geo, dyad, mode, poses, min_margin, status):
+    """An RRP or PRR dyad at every point ``k >= 1``: a circle about the revolute side's pivot and the prismatic
+    side's line."""
+    j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
+    if joint_int[j1, 0] == REVOLUTE:
+        jr, Kr, Br, jp, Kp, Bp = j1, K1, B1, j3, K2, B2
+    else:
+        jr, Kr, Br, jp, Kp, Bp = j3, K2, B2, j1, K1, B1
+    p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    prx, pry = joint_geo[jr, 0], joint_geo[jr, 1]
+    Ls = (p2x - prx) ** 2 + (p2y - pry) ** 2
+    floor = min_margin * min_margin * Ls
+    for k in range(1, poses.shape[2]):
+        Xr, Yr = apply_pose(poses, Kr, k, prx, pry)
+        Qx, Qy, ex, ey = guide_line(joint_geo, poses, jp, Kp, k, p2x, p2y)
         b = ex * (Qx - Xr) + ey * (Qy - Yr)
         c = (Qx - Xr) ** 2 + (Qy - Yr) ** 2 - Ls
         disc = b * b - c
-        if disc < 0.0:
-            return NO_SOLUTION
-        if disc < min_margin * min_margin * Ls:
-            return NEAR_SINGULAR
-        s = -b + mode * np.sqrt(disc)
+        first_status(status, k, NO_SOLUTION if disc < 0.0 else (NEAR_SINGULAR if disc < floor else CLEAN))
+        s = -b + mode * np.sqrt(max(disc, 0.0))
         X2, Y2 = Qx + s * ex, Qy + s * ey
-        set_pose_turning(poses, Br, prx, pry, Xr, Yr, p2x - prx, p2y - pry, X2 - Xr, Y2 - Yr)
-        set_pose(poses, Bp, poses[Kp, 0], poses[Kp, 1], p2x, p2y, X2, Y2)
-        return CLEAN
-    if k1 == REVOLUTE and k3 == REVOLUTE:  # RPR: B1 and B2 turn together; B2's pivot on B1's line
-        p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
-        # The slide's direction in B1 (the before body of j2 may be either dyad body: a line is a line).
-        dx, dy = joint_geo[j2, 0], joint_geo[j2, 1]
-        h0 = dx * (p3y - p1y) - dy * (p3x - p1x)  # signed distance of the line from p1, constant in B1
-        X1, Y1 = apply_pose(poses, K1, p1x, p1y)
-        X3, Y3 = apply_pose(poses, K2, p3x, p3y)
+        set_pose_turning(poses, Br, k, prx, pry, Xr, Yr, p2x - prx, p2y - pry, X2 - Xr, Y2 - Yr)
+        set_pose(poses, Bp, k, poses[Kp, 0, k], poses[Kp, 1, k], p2x, p2y, X2, Y2)
+
+
+@kernel(error_model="numpy")
+def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
+    """An RPR dyad at every point ``k >= 1``: ``B1`` and ``B2`` turn together, ``B2``'s pivot on ``B1``'s line."""
+    j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
+    p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
+    # The slide's direction in B1 (the before body of j2 may be either dyad body: a line is a line).
+    dx, dy = joint_geo[j2, 0], joint_geo[j2, 1]
+    h0 = dx * (p3y - p1y) - dy * (p3x - p1x)  # signed distance of the line from p1, constant in B1
+    for k in range(1, poses.shape[2]):
+        X1, Y1 = apply_pose(poses, K1, k, p1x, p1y)
+        X3, Y3 = apply_pose(poses, K2, k, p3x, p3y)
         Dx, Dy = X3 - X1, Y3 - Y1
         rho2 = Dx * Dx + Dy * Dy
         along2 = rho2 - h0 * h0
-        if along2 < 0.0 or rho2 == 0.0:
-            return NO_SOLUTION
-        if along2 < min_margin * min_margin * rho2:
-            return NEAR_SINGULAR
-        along = mode * np.sqrt(along2)
+        code = NO_SOLUTION if (along2 < 0.0) | (rho2 == 0.0) else CLEAN
+        first_status(status, k, NEAR_SINGULAR if code == CLEAN and along2 < min_margin**2 * rho2 else code)
+        along = mode * np.sqrt(max(along2, 0.0))
         # The turn takes the line's direction d (at angle psi from D in B1's frame) onto D's direction:
         # e^{i phi} = (D / rho) conj(d) conj(e^{i psi}), e^{i psi} = (along + i h0) / rho.
         cx, cy = Dx * dx + Dy * dy, Dy * dx - Dx * dy  # D conj(d)
         c = (cx * along + cy * h0) / rho2
         s = (cy * along - cx * h0) / rho2
-        set_pose(poses, B1, c, s, p1x, p1y, X1, Y1)
-        set_pose(poses, B2, c, s, p3x, p3y, X3, Y3)
-        return CLEAN
-    return UNSUPPORTED
+        set_pose(poses, B1, k, c, s, p1x, p1y, X1, Y1)
+        set_pose(poses, B2, k, c, s, p3x, p3y, X3, Y3)
 
 
-@kernel(inline="always")
-def joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q):
-    """Every joint's displacement from its bodies' poses (revolute ones continued from ``q_prev``), the drive's
-    set to ``drive_q``; returns the largest change of a joint (the drive's wrapped for a revolute drive, as its
-    value read back from the poses would be)."""
-    jump = 0.0
+@kernel()
+def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
+    """Every dyad of the plan at every point ``k >= 1``, in solving order (each a loop over the points); sets
+    ``status[k]`` to the first dyad's failure at point ``k`` (:data:`UNSUPPORTED` for a dyad of no solved kind)."""
+    for i in range(dyads.shape[0]):
+        dyad = dyads[i]
+        k1, k2, k3 = joint_int[dyad[0], 0], joint_int[dyad[1], 0], joint_int[dyad[2], 0]
+        if k2 == REVOLUTE and k1 == REVOLUTE and k3 == REVOLUTE:
+            place_rrr(joint_geo, dyad, modes[i], poses, min_margin, status)
+        elif k2 == REVOLUTE and k1 == PRISMATIC and k3 == PRISMATIC:
+            place_prp(joint_geo, dyad, poses, min_margin, status)
+        elif k2 == REVOLUTE:
+            place_rrp(joint_int, joint_geo, dyad, modes[i], poses, min_margin, status)
+        elif k1 == REVOLUTE and k3 == REVOLUTE:
+            place_rpr(joint_geo, dyad, modes[i], poses, min_margin, status)
+        else:
+            for k in range(1, poses.shape[2]):
+                first_status(status, k, UNSUPPORTED)
+
+
+@kernel(error_model="numpy")
+def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump):
+    """Every joint's value at every point from its bodies' poses: ``q[j, k]``; revolute ones continued from
+    point to point (each point's step wrapped onto ``[-pi, pi)``), the drive's ``drive_q``. ``rel[j] = (cos,
+    sin)`` of a revolute joint's relative rotation ``R_a^T R_b = Rz(omega_z q)``; ``jump[k]``: the largest step
+    of a joint into point ``k`` (the drive's wrapped for a revolute drive), as the point-by-point march reads it.
+
+    The angles come from the branch-free :func:`~linkwork.kinematics.trig.atan2` (vectorised); a revolute
+    joint's value is ``raw + 2 pi n`` with ``raw`` the angle read back and ``n`` the count of turns, a running sum
+    of the integer steps (so no round-off accumulates along the path).
+    """
+    K = poses.shape[2]
+    turns = np.empty(K)
     for j in range(joint_int.shape[0]):
-        if j == drive:
-            q[j] = drive_q
-            step = drive_q - q_prev[j]
-            jump = max(jump, abs(wrap_angle(step) if joint_int[j, 0] == REVOLUTE else step))
-            continue
         a, b = joint_int[j, 1], joint_int[j, 2]
-        ca, sa = poses[a, 0], poses[a, 1]
-        if joint_int[j, 0] == REVOLUTE:  # R_a^T R_b = Rz(omega_z q)
-            c = ca * poses[b, 0] + sa * poses[b, 1]
-            s = ca * poses[b, 1] - sa * poses[b, 0]
-            raw = joint_geo[j, 2] * np.arctan2(s, c)
-            q[j] = q_prev[j] + wrap_angle(raw - q_prev[j])
+        revolute = joint_int[j, 0] == REVOLUTE
+        if revolute:  # the relative rotation, also of the drive (the closure's exp reads it)
+            for k in range(K):
+                ca, sa, cb, sb = poses[a, 0, k], poses[a, 1, k], poses[b, 0, k], poses[b, 1, k]
+                rel[j, 0, k] = ca * cb + sa * sb
+                rel[j, 1, k] = ca * sb - sa * cb
+        if j == drive:
+            q[j, 0] = drive_q[0]
+            for k in range(1, K):
+                step = drive_q[k] - drive_q[k - 1]
+                wrapped = step - TWO_PI if step >= np.pi else (step + TWO_PI if step < -np.pi else step)
+                q[j, k] = drive_q[k]
+                jump[k] = max(jump[k], abs(wrapped if revolute else step))
+        elif revolute:
+            omega = joint_geo[j, 2]
+            for k in range(K):
+                q[j, k] = omega * atan2(rel[j, 1, k], rel[j, 0, k])
+            q[j, 0] = 0.0
+            turns[0] = 0.0
+            for k in range(
+                1, K
+            ):  # the step into k: raw angles in [-pi, pi], their difference in [-2 pi, 2 pi]
+                step = q[j, k] - q[j, k - 1]
+                turn = -1.0 if step >= np.pi else (1.0 if step < -np.pi else 0.0)
+                turns[k] = turn
+                jump[k] = max(jump[k], abs(step + TWO_PI * turn))
+            n = 0.0
+            for k in range(1, K):  # the running count of turns (integers: exact)
+                n += turns[k]
+                turns[k] = n
+            for k in range(1, K):
+                q[j, k] += TWO_PI * turns[k]
         else:  # R_a^T (t_b - t_a) = q d
-            tx, ty = poses[b, 2] - poses[a, 2], poses[b, 3] - poses[a, 3]
-            q[j] = joint_geo[j, 0] * (ca * tx + sa * ty) + joint_geo[j, 1] * (-sa * tx + ca * ty)
-        jump = max(jump, abs(q[j] - q_prev[j]))
-    return jump
+            dx, dy = joint_geo[j, 0], joint_geo[j, 1]
+            for k in range(K):
+                ca, sa = poses[a, 0, k], poses[a, 1, k]
+                tx, ty = poses[b, 2, k] - poses[a, 2, k], poses[b, 3, k] - poses[a, 3, k]
+                q[j, k] = dx * (ca * tx + sa * ty) + dy * (-sa * tx + ca * ty)
+            for k in range(1, K):
+                jump[k] = max(jump[k], abs(q[j, k] - q[j, k - 1]))
 
 
-@kernel(inline="always")
-def planar_closure(flat, q, residual, jac, m, E):
+@kernel(error_model="numpy")
+def planar_closure(flat, rel, q, jac, res):
     """Planar closure residual ``(omega_z, v_x, v_y)`` of ``log(P)`` per loop and its ``(E, m)`` Jacobian in the
-    unknowns, for ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``.
+    unknowns at every point ``k < K``: ``jac (E, m, K)`` (point index last), ``res (K,)`` the residual's norm;
+    ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``, ``q (n, K)`` the joint values, ``rel (n, 2,
+    K)`` each revolute joint's ``(cos, sin)`` of ``omega_z q`` (from :func:`joint_values`).
 
     :func:`linkwork.kinematics.kernels.closure_pass` with rows ``(2, 3, 4)`` for twists in the plane, in SE(2):
-    columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)).
-    ``m`` and ``E`` are the Jacobian's sizes (literal constants at a call site for one loop: the loops unroll).
+    columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)). A
+    revolute joint's ``exp`` uses the cosine and sine of its relative rotation as the bodies' poses give them,
+    which equal those of its reported value to an ulp (the value is read back from them by an ``atan2``): no
+    sine or cosine is evaluated here. Each loop joint is one loop over the points, straight-line code that
+    vectorises.
     """
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
-    for e in range(E):
-        for c in range(m):
-            jac[e, c] = 0.0
-    for k in range(E // 3):
-        cg, sg, px, py = 1.0, 0.0, 0.0, 0.0
-        for idx in range(loop_ptr[k], loop_ptr[k + 1]):
+    E, K = jac.shape[0], jac.shape[2]
+    cg, sg, px, py = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
+    jac[:] = 0.0
+    res[:] = 0.0
+    big = 0.0
+    for loop in range(E // 3):
+        cg[:] = 1.0
+        sg[:] = 0.0
+        px[:] = 0.0
+        py[:] = 0.0
+        r0, r1, r2 = 3 * loop, 3 * loop + 1, 3 * loop + 2
+        for idx in range(loop_ptr[loop], loop_ptr[loop + 1]):
             j = loop_joint[idx]
             sign = float(loop_sign[idx])
             w = sign * twists[j, 2]
             vx, vy = sign * twists[j, 3], sign * twists[j, 4]
             g = groups[j]
             if g >= 0:  # Ad(g) xi: (w, R v + p x (0, 0, w))
-                jac[3 * k, g] += w
-                jac[3 * k + 1, g] += cg * vx - sg * vy + py * w
-                jac[3 * k + 2, g] += sg * vx + cg * vy - px * w
-            theta = q[j]
-            if w != 0.0:  # exp: rotation by w theta, translation (I - R)(w x v) (w . v = 0 in the plane)
-                ce, se = np.cos(w * theta), np.sin(w * theta)
+                for k in range(K):
+                    jac[r0, g, k] += w
+                    jac[r1, g, k] += cg[k] * vx - sg[k] * vy + py[k] * w
+                    jac[r2, g, k] += sg[k] * vx + cg[k] * vy - px[k] * w
+            if w != 0.0:  # exp: rotation by w q, translation (I - R)(w x v) (w . v = 0 in the plane)
                 ax, ay = -w * vy, w * vx
-                ex = ax - (ce * ax - se * ay)
-                ey = ay - (se * ax + ce * ay)
+                for k in range(K):
+                    ce, se = rel[j, 0, k], sign * rel[j, 1, k]
+                    ex = ax - (ce * ax - se * ay)
+                    ey = ay - (se * ax + ce * ay)
+                    c, s = cg[k], sg[k]
+                    px[k] += c * ex - s * ey
+                    py[k] += s * ex + c * ey
+                    cg[k], sg[k] = c * ce - s * se, s * ce + c * se
             else:
-                ce, se = 1.0, 0.0
-                ex, ey = vx * theta, vy * theta
-            px += cg * ex - sg * ey
-            py += sg * ex + cg * ey
-            cg, sg = cg * ce - sg * se, sg * ce + cg * se
-        # log of the planar motion (as kernels.log_rigid): angle, then v = p - (w x p)/2 + D w x (w x p)
-        t = np.arctan2(sg, cg)
-        D = log_coefficient(abs(t))
-        residual[3 * k] = t
-        residual[3 * k + 1] = px + 0.5 * t * py - D * t * t * px
-        residual[3 * k + 2] = py - 0.5 * t * px - D * t * t * py
+                for k in range(K):
+                    ex, ey = vx * q[j, k], vy * q[j, k]
+                    c, s = cg[k], sg[k]
+                    px[k] += c * ex - s * ey
+                    py[k] += s * ex + c * ey
+        # log of the planar motion (as kernels.log_rigid): angle, then v = p - (w x p)/2 + D w x (w x p); D by
+        # its Taylor series (a closed loop turns by round-off), log_coefficient where the angle is not small.
+        for k in range(K):
+            t = atan2(sg[k], cg[k])
+            t2 = t * t
+            D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
+            x = px[k] + 0.5 * t * py[k] - D * t2 * px[k]
+            y = py[k] - 0.5 * t * px[k] - D * t2 * py[k]
+            big = max(big, abs(t))
+            cg[k] = t
+            sg[k] = t2 + x * x + y * y  # the loop's share of the squared residual
+        if big >= 1e-2:  # a loop that does not close: the closed form of D where the series does not hold
+            for k in range(K):
+                t = cg[k]
+                if abs(t) >= 1e-2:
+                    D = log_coefficient(abs(t))
+                    x = px[k] + 0.5 * t * py[k] - D * t * t * px[k]
+                    y = py[k] - 0.5 * t * px[k] - D * t * t * py[k]
+                    sg[k] = t * t + x * x + y * y
+        for k in range(K):
+            res[k] += sg[k]
+    for k in range(K):
+        res[k] = np.sqrt(res[k])
 
 
 @kernel(inline="always")
@@ -423,20 +524,6 @@ def triangle_singular_values(M, W, V, sigma, E):
 
 
 @kernel(inline="always")
-def jacobian_rows(flat, q, work, m, E):
-    """At joint values ``q``: the closure residual and Jacobian, the Householder QR of ``J^T`` and the tangent
-    (``Q``'s last column), into ``work = (res, jac, M, beta, t)``; returns ``det(Q) det(R)`` (``R`` is the
-    upper triangle of ``M[:E]``). ``m, E`` are the sizes (literal constants for one loop: the loops unroll)."""
-    res, jac, M, beta, t = work
-    planar_closure(flat, q, res, jac, m, E)
-    det = qr_of_transpose(jac, M, beta, m, E)
-    null_vector(M, beta, t, m, E)
-    for e in range(E):
-        det *= M[e, e]
-    return det
-
-
-@kernel(inline="always")
 def warm_singular_values(R, W, V, history, sigma, E):
     """:func:`triangle_singular_values` of the triangle ``R`` warm-started from the right singular vectors
     extrapolated from the last three points (``V``, then ``history = (V_1, V_2)`` one and two points back):
@@ -452,7 +539,45 @@ def warm_singular_values(R, W, V, history, sigma, E):
     triangle_singular_values(R, W, V, sigma, E)
 
 
+@kernel(inline="always")
+def rows_at_point(jac, k, M, beta, t, W, V, history, sig, m, E):
+    """At point ``k`` of ``jac (E, m, K)``: the Householder QR of ``J^T`` in ``M``, the tangent ``t`` (``Q``'s last
+    column) and the singular values ``sig`` (warm-started, :func:`warm_singular_values`); returns
+    ``det([J; t^T]) = det(Q) det(R)``. ``m, E``: the sizes (literal constants for one loop: the loops unroll)."""
+    det = qr_of_transpose(jac[:, :, k], M, beta, m, E)
+    null_vector(M, beta, t, m, E)
+    for e in range(E):
+        det *= M[e, e]
+    warm_singular_values(M, W, V, history, sig, E)
+    return det
+
+
 @kernel()
+def rows_at_points(jac, sigma, tangent, raw_tau):
+    """The rows of :func:`closed_form_path` from the Jacobians ``jac (E, m, K)``, point by point: ``sigma (E, K)``
+    descending, ``tangent (m, K)`` a unit null vector (either sign), ``raw_tau (K,) = det([J; t^T])`` for that
+    tangent; returns 0 (the number of points without a clean answer, as the batched one-loop kernel reports).
+
+    The singular values by one-sided Jacobi on the triangle of a Householder QR of ``J^T``, warm-started from the
+    right singular vectors extrapolated from the last three points."""
+    E, m, K = jac.shape[0], jac.shape[1], jac.shape[2]
+    M, beta, t = np.empty((m, E)), np.empty(2 * E), np.empty(m)
+    W, V = np.empty((E, E)), np.eye(E)
+    history = (np.eye(E), np.eye(E))
+    sig = np.empty(E)
+    for k in range(K):
+        if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
+            raw_tau[k] = rows_at_point(jac, k, M, beta, t, W, V, history, sig, 4, 3)
+        else:
+            raw_tau[k] = rows_at_point(jac, k, M, beta, t, W, V, history, sig, m, E)
+        for e in range(E):
+            sigma[e, k] = sig[e]
+        for a in range(m):
+            tangent[a, k] = t[a]
+    return 0
+
+
+@kernel(error_model="numpy")
 def closed_form_path(flat, plan, run):
     """The paper-mode path of a driver-and-dyads mechanism from its reference, in closed form, with its rows.
 
@@ -464,12 +589,13 @@ def closed_form_path(flat, plan, run):
     Returns ``(count, status, u, sigma, res, tau, s)``: rows ``0 .. count - 1`` (row 0 the start), status
     :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
 
-    Three passes over the points (the last two a block of :data:`BLOCK` points at a time), each a short loop,
-    give what one pass point by point would: the positions (dyads and joint values, up to the
-    first point where a dyad has no solution or a joint jumps); at each of those points the Jacobian, its QR and
-    the tangent; then, point by point, the singular values (warm-started from the point before), the tangent's
-    orientation, the test function and every check, in the order of the one-pass loop, so the same point ends
-    the path with the same status.
+    Passes over all points, each array indexed by the point last (structure of arrays), each pass a loop over
+    the points with straight-line bodies that vectorise: the drive's poses, each dyad's two bodies, every joint's
+    value (then a scan finds the first point a dyad could not be placed or a joint jumped); the closure residual
+    and Jacobian at those points; the tangent, test function and singular values from the Jacobians; then one
+    scalar pass, point by point, orients the tangent and makes every check in the order of the point-by-point
+    march (``far`` and the tangent's orientation carry from point to point), so the same point ends the path
+    with the same status.
     """
     groups = flat[4]
     joint_int, joint_geo, dyads, modes, head = plan
@@ -481,110 +607,82 @@ def closed_form_path(flat, plan, run):
     h, target, hmax = settings[S_STEP], settings[S_TARGET], settings[S_HMAX]
     min_ratio, min_drive, min_margin = settings[S_MIN_RATIO], settings[S_MIN_DRIVE], settings[S_MIN_MARGIN]
     det_basis = settings[S_DET_BASIS]
-    drive, driven = head[0], head[1]
+    drive = head[0]
     g_drive = groups[drive]
-    out_u = np.zeros((steps + 1, m))
-    out_sigma = np.zeros((steps + 1, E))
-    out_res = np.zeros(steps + 1)
-    out_tau = np.zeros(steps + 1)
-    out_s = np.zeros(steps + 1)
-    # Pass 1: positions. Rows 0 .. last are placed; ``ended`` says why row last + 1 could not be (CLEAN: none).
-    poses = np.zeros((head[2], 4))
-    for b in range(head[2]):
-        poses[b, 0] = 1.0  # the fixed body keeps the identity; every other body is placed at every point
-    q = np.zeros(n)
-    q_prev = np.zeros(n)
-    last, ended = steps, CLEAN
-    for k in range(1, steps + 1):
-        drive_q = q_prev[drive] + h if k < steps else target
-        place_driven(joint_int, joint_geo, drive, driven, drive_q, poses)
-        for i in range(dyads.shape[0]):
-            status = place_dyad(joint_int, joint_geo, dyads[i], modes[i], poses, min_margin)
-            if status != CLEAN:
-                ended = status
-                break
-        if (
-            ended == CLEAN
-            and joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q) > 0.5 * np.pi
-        ):
-            ended = JUMP
-        if ended != CLEAN:
-            last = k - 1
+    K = steps + 1
+    out_u = np.zeros((K, m))
+    out_sigma = np.zeros((K, E))
+    out_tau = np.zeros(K)
+    out_s = np.zeros(K)
+    # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints' values.
+    drive_q = np.empty(K)
+    drive_q[0] = 0.0
+    for k in range(1, K):
+        drive_q[k] = drive_q[k - 1] + h if k < steps else target
+    poses = np.zeros((head[2], 4, K))
+    poses[:, 0, :] = 1.0  # the fixed body keeps the identity, and every body at the start (row 0)
+    status = np.zeros(K, dtype=np.int64)
+    place_driver(joint_int, joint_geo, head, drive_q, poses)
+    place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
+    rel = np.empty((n, 2, K))
+    q = np.empty((n, K))
+    jump = np.zeros(K)
+    joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump)
+    last, ended = steps, CLEAN  # rows 0 .. last are placed; ``ended`` says why row last + 1 could not be
+    for k in range(1, K):
+        code = JUMP if status[k] == CLEAN and jump[k] > 0.5 * np.pi else status[k]
+        if code != CLEAN:
+            last, ended = k - 1, code
             break
-        for j in range(n):
-            out_u[k, groups[j]] = q[j]
-            q_prev[j] = q[j]
-    # Passes 2 and 3, a block of points at a time (the block's scratch stays in the cache).
-    tri = np.empty((BLOCK, E, E))
-    tangents = np.empty((BLOCK, m))
-    work = (np.empty(E), np.empty((E, m)), np.empty((m, E)), np.empty(2 * E), np.empty(m))
-    M, t = work[2], work[4]
-    V = np.eye(E)  # the right singular vectors, carried from point to point
-    history = (np.eye(E), np.eye(E))
-    W = np.empty((E, E))
-    sig = np.empty(E)
-    t_prev = t0.copy()
+    count = last + 1
+    for j in range(n):
+        for k in range(count):
+            out_u[k, groups[j]] = q[j, k]
+    # The Jacobians, then their rows (the tangent, det([J; t^T]), the singular values).
+    jac = np.empty((E, m, count))
+    out_res = np.zeros(K)
+    planar_closure(flat, rel[:, :, :count], q[:, :count], jac, out_res[:count])
+    sigma = np.empty((E, count))
+    tangent = np.empty((m, count))
+    raw_tau = np.empty(count)
+    rows_at_points(jac, sigma, tangent, raw_tau)
+    # Point by point: the tangent's orientation, the test function and every check.
     far = 0.0
-    for first in range(0, last + 1, BLOCK):
-        stop = min(first + BLOCK, last + 1)
-        # Pass 2: at every point of the block, the Jacobian's triangle R, the tangent and det(Q) det(R).
-        for k in range(first, stop):
-            i = k - first
-            for j in range(n):
-                q[j] = out_u[k, groups[j]]
-            if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
-                out_tau[k] = jacobian_rows(flat, q, work, 4, 3)
-            else:
-                out_tau[k] = jacobian_rows(flat, q, work, m, E)
-            acc = 0.0
-            for e in range(E):
-                acc += work[0][e] * work[0][e]
-                for c in range(E):
-                    tri[i, e, c] = M[e, c]
-            out_res[k] = np.sqrt(acc)
-            for a in range(m):
-                tangents[i, a] = t[a]
-        # Pass 3: point by point, singular values, orientation, test function and the checks.
-        for k in range(first, stop):
-            i = k - first
-            if E == 3:
-                warm_singular_values(tri[i], W, V, history, sig, 3)
-            else:
-                warm_singular_values(tri[i], W, V, history, sig, E)
-            dot = 0.0
-            for a in range(m):
-                dot += tangents[i, a] * t_prev[a]
-            orient = -1.0 if dot < 0.0 else 1.0
-            tau = det_basis * out_tau[k] * orient
-            t_drive = tangents[i, g_drive]
-            # Where the predictor-corrector would do more than step: hand over to it.
-            if sig[E - 1] < min_ratio * sig[0] or abs(t_drive) < min_drive:
-                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-            if k > 0 and (orient * t_drive) * h <= 0.0:
-                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-            if k > 0 and tau * out_tau[k - 1] < 0.0:
-                return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
-            dist = 0.0
-            wrapped = 0.0
-            for g in range(m):
-                x = out_u[k, g]
-                if x < lo[g] or x > hi[g]:
-                    return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
-                du = x - out_u[k - 1, g] if k > 0 else 0.0
-                dist += du * du
-                x = wrap_angle(x) if periodic[g] else x
-                wrapped += x * x
-            for a in range(m):
-                t_prev[a] = orient * tangents[i, a]
-            for e in range(E):
-                out_sigma[k, e] = sig[e]
-            out_tau[k] = tau
-            out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
-            if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-                d = np.sqrt(wrapped)
-                far = max(far, d)
-                if far > 4.0 * hmax and d < 1.5 * abs(h):
-                    return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
+    orient_prev = 1.0
+    for k in range(count):
+        dot = 0.0  # with the previous point's oriented tangent (the start's tangent at row 0)
+        for a in range(m):
+            dot += tangent[a, k] * (orient_prev * tangent[a, k - 1] if k > 0 else t0[a])
+        orient = -1.0 if dot < 0.0 else 1.0
+        tau = det_basis * raw_tau[k] * orient
+        t_drive = tangent[g_drive, k]
+        # Where the predictor-corrector would do more than step: hand over to it.
+        if sigma[E - 1, k] < min_ratio * sigma[0, k] or abs(t_drive) < min_drive:
+            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
+        if k > 0 and (orient * t_drive) * h <= 0.0:
+            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
+        if k > 0 and tau * out_tau[k - 1] < 0.0:
+            return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
+        dist = 0.0
+        wrapped = 0.0
+        for g in range(m):
+            x = out_u[k, g]
+            if x < lo[g] or x > hi[g]:
+                return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
+            du = x - out_u[k - 1, g] if k > 0 else 0.0
+            dist += du * du
+            x = wrap_angle(x) if periodic[g] else x
+            wrapped += x * x
+        orient_prev = orient
+        for e in range(E):
+            out_sigma[k, e] = sigma[e, k]
+        out_tau[k] = tau
+        out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
+        if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
+            d = np.sqrt(wrapped)
+            far = max(far, d)
+            if far > 4.0 * hmax and d < 1.5 * abs(h):
+                return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
     if ended != CLEAN:
-        return last + 1, ended, out_u, out_sigma, out_res, out_tau, out_s
-    return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
+        return count, ended, out_u, out_sigma, out_res, out_tau, out_s
+    return count, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
