@@ -245,60 +245,141 @@ def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
 
 
 @kernel(error_model="numpy")
+def read_angles(ca, sa, cb, sb, rel, omega, q):
+    """A revolute joint between bodies of rotations ``(ca, sa)`` and ``(cb, sb)`` at every point: ``rel = (c,
+    s)`` of ``R_a^T R_b``, and ``q[k] = omega atan2(s[k], c[k])`` by the branch-free
+    :func:`~linkwork.kinematics.trig.atan2`."""
+    c, s = rel[0], rel[1]
+    for k in range(q.shape[0]):
+        ck = ca[k] * cb[k] + sa[k] * sb[k]
+        sk = ca[k] * sb[k] - sa[k] * cb[k]
+        c[k] = ck
+        s[k] = sk
+        q[k] = omega * atan2(sk, ck)
+
+
+@kernel(error_model="numpy")
+def angle_steps(q, turns, jump):
+    """The step of an angle read in ``[-pi, pi]`` into each point ``k >= 1``, wrapped onto ``[-pi, pi)``: ``turns[k]``
+    the whole turns the wrapping added (-1, 0, 1), ``jump[k]`` raised to the wrapped step's size where larger;
+    returns the number of points with a turn."""
+    count = 0
+    for k in range(1, q.shape[0]):
+        step = q[k] - q[k - 1]
+        turn = -1.0 if step >= np.pi else (1.0 if step < -np.pi else 0.0)
+        size = abs(step + TWO_PI * turn)
+        turns[k] = turn
+        jump[k] = size if size > jump[k] else jump[k]
+        count += 0 if turn == 0.0 else 1
+    return count
+
+
+@kernel(error_model="numpy")
+def slide_values(ca, sa, ta, tb, dx, dy, q):
+    """``q[k] = d . R_a^T (t_b - t_a)``: a prismatic joint's value along its unit direction ``d = (dx, dy)`` from
+    the rotation ``(ca, sa)`` of its before body and both bodies' translations ``ta``, ``tb`` (``(2, K)``)."""
+    for k in range(q.shape[0]):
+        tx, ty = tb[0, k] - ta[0, k], tb[1, k] - ta[1, k]
+        q[k] = dx * (ca[k] * tx + sa[k] * ty) + dy * (-sa[k] * tx + ca[k] * ty)
+
+
+@kernel(error_model="numpy")
 def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump):
     """Every joint's value at every point from its bodies' poses: ``q[j, k]``; revolute ones continued from
     point to point (each point's step wrapped onto ``[-pi, pi)``), the drive's ``drive_q``. ``rel[j] = (cos,
-    sin)`` of a revolute joint's relative rotation ``R_a^T R_b = Rz(omega_z q)``; ``jump[k]``: the largest step
-    of a joint into point ``k`` (the drive's wrapped for a revolute drive), as the point-by-point march reads it.
+    sin)`` of a joint's relative rotation ``R_a^T R_b`` (``Rz(omega_z q)`` for a revolute joint, the identity for
+    a prismatic one); ``jump[k]``: the largest step of a joint into point ``k`` (the drive's wrapped for a
+    revolute drive), as the point-by-point march reads it.
 
     The angles come from the branch-free :func:`~linkwork.kinematics.trig.atan2` (vectorised); a revolute
     joint's value is ``raw + 2 pi n`` with ``raw`` the angle read back and ``n`` the count of turns, a running sum
     of the integer steps (so no round-off accumulates along the path).
     """
     K = poses.shape[2]
-    turns = np.empty(K)
+    turns = np.zeros(K)
     for j in range(joint_int.shape[0]):
         a, b = joint_int[j, 1], joint_int[j, 2]
         revolute = joint_int[j, 0] == REVOLUTE
-        if revolute:  # the relative rotation, also of the drive (the closure's exp reads it)
-            for k in range(K):
-                ca, sa, cb, sb = poses[a, 0, k], poses[a, 1, k], poses[b, 0, k], poses[b, 1, k]
-                rel[j, 0, k] = ca * cb + sa * sb
-                rel[j, 1, k] = ca * sb - sa * cb
+        if revolute:  # also the drive's relative rotation (the closure's exp reads it)
+            read_angles(poses[a, 0], poses[a, 1], poses[b, 0], poses[b, 1], rel[j], joint_geo[j, 2], q[j])
+        else:
+            rel[j, 0, :] = 1.0
+            rel[j, 1, :] = 0.0
         if j == drive:
-            q[j, 0] = drive_q[0]
+            q[j, :] = drive_q
             for k in range(1, K):
                 step = drive_q[k] - drive_q[k - 1]
                 wrapped = step - TWO_PI if step >= np.pi else (step + TWO_PI if step < -np.pi else step)
-                q[j, k] = drive_q[k]
-                jump[k] = max(jump[k], abs(wrapped if revolute else step))
+                size = abs(wrapped if revolute else step)
+                jump[k] = size if size > jump[k] else jump[k]
         elif revolute:
-            omega = joint_geo[j, 2]
-            for k in range(K):
-                q[j, k] = omega * atan2(rel[j, 1, k], rel[j, 0, k])
-            q[j, 0] = 0.0
-            turns[0] = 0.0
-            for k in range(
-                1, K
-            ):  # the step into k: raw angles in [-pi, pi], their difference in [-2 pi, 2 pi]
-                step = q[j, k] - q[j, k - 1]
-                turn = -1.0 if step >= np.pi else (1.0 if step < -np.pi else 0.0)
-                turns[k] = turn
-                jump[k] = max(jump[k], abs(step + TWO_PI * turn))
-            n = 0.0
-            for k in range(1, K):  # the running count of turns (integers: exact)
-                n += turns[k]
-                turns[k] = n
+            if angle_steps(q[j], turns, jump) > 0:
+                n = 0.0
+                for k in range(1, K):  # the running count of turns (whole numbers: exact)
+                    n += turns[k]
+                    q[j, k] += TWO_PI * n
+        else:
+            slide_values(
+                poses[a, 0], poses[a, 1], poses[a, 2:], poses[b, 2:], joint_geo[j, 0], joint_geo[j, 1], q[j]
+            )
             for k in range(1, K):
-                q[j, k] += TWO_PI * turns[k]
-        else:  # R_a^T (t_b - t_a) = q d
-            dx, dy = joint_geo[j, 0], joint_geo[j, 1]
-            for k in range(K):
-                ca, sa = poses[a, 0, k], poses[a, 1, k]
-                tx, ty = poses[b, 2, k] - poses[a, 2, k], poses[b, 3, k] - poses[a, 3, k]
-                q[j, k] = dx * (ca * tx + sa * ty) + dy * (-sa * tx + ca * ty)
-            for k in range(1, K):
-                jump[k] = max(jump[k], abs(q[j, k] - q[j, k - 1]))
+                size = abs(q[j, k] - q[j, k - 1])
+                jump[k] = size if size > jump[k] else jump[k]
+
+
+@kernel(error_model="numpy")
+def turn_column(product, col1, col2, rel, sign, w, vx, vy):
+    """A revolute loop joint at every point: rows 2 and 3 of its Jacobian column ``Ad(g) xi = (w, R v + p x (0,
+    0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2``, with ``g = product = (cos, sin, p_x, p_y)`` the loop's
+    product before the joint, then ``g <- g exp(xi q)``: the rotation ``rel = (c, sign s)``, the translation
+    ``(I - R)(w x v)`` (``w . v = 0`` in the plane)."""
+    c, s, px, py = product[0], product[1], product[2], product[3]
+    rc, rs = rel[0], rel[1]
+    ax, ay = -w * vy, w * vx
+    for k in range(c.shape[0]):
+        ck, sk, xk, yk = c[k], s[k], px[k], py[k]
+        col1[k] += ck * vx - sk * vy + yk * w
+        col2[k] += sk * vx + ck * vy - xk * w
+        cr, sr = rc[k], sign * rs[k]
+        ex = ax - (cr * ax - sr * ay)
+        ey = ay - (sr * ax + cr * ay)
+        px[k] = xk + (ck * ex - sk * ey)
+        py[k] = yk + (sk * ex + ck * ey)
+        c[k] = ck * cr - sk * sr
+        s[k] = sk * cr + ck * sr
+
+
+@kernel(error_model="numpy")
+def slide_column(product, col1, col2, q, vx, vy):
+    """A prismatic loop joint at every point: its Jacobian column's rows 2 and 3 (``R v``) added to ``col1``,
+    ``col2``, then ``g <- g exp(xi q)``: the translation ``v q``."""
+    c, s, px, py = product[0], product[1], product[2], product[3]
+    for k in range(c.shape[0]):
+        ck, sk = c[k], s[k]
+        col1[k] += ck * vx - sk * vy
+        col2[k] += sk * vx + ck * vy
+        ex, ey = vx * q[k], vy * q[k]
+        px[k] += ck * ex - sk * ey
+        py[k] += sk * ex + ck * ey
+
+
+@kernel(error_model="numpy")
+def loop_log(c, s, px, py, angle, share):
+    """The twist ``log(g)`` of the loop product at every point (as ``kernels.log_rigid``): the angle ``t``, then
+    ``v = p - (w x p)/2 + D w x (w x p)`` with ``D`` by its Taylor series (a closed loop turns by round-off);
+    ``share[k]`` its squared norm, ``angle[k] = t``. Returns the number of points where ``|t| >= 1e-2`` (there
+    the series does not hold: the caller uses :func:`~linkwork.kinematics.kernels.log_coefficient`)."""
+    wide = 0
+    for k in range(c.shape[0]):
+        t = atan2(s[k], c[k])
+        t2 = t * t
+        D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
+        x = px[k] + 0.5 * t * py[k] - D * t2 * px[k]
+        y = py[k] - 0.5 * t * px[k] - D * t2 * py[k]
+        angle[k] = t
+        share[k] = t2 + x * x + y * y
+        wide += 0 if abs(t) < 1e-2 else 1
+    return wide
 
 
 @kernel(error_model="numpy")
@@ -306,75 +387,52 @@ def planar_closure(flat, rel, q, jac, res):
     """Planar closure residual ``(omega_z, v_x, v_y)`` of ``log(P)`` per loop and its ``(E, m)`` Jacobian in the
     unknowns at every point ``k < K``: ``jac (E, m, K)`` (point index last), ``res (K,)`` the residual's norm;
     ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``, ``q (n, K)`` the joint values, ``rel (n, 2,
-    K)`` each revolute joint's ``(cos, sin)`` of ``omega_z q`` (from :func:`joint_values`).
+    K)`` each joint's relative rotation (from :func:`joint_values`).
 
     :func:`linkwork.kinematics.kernels.closure_pass` with rows ``(2, 3, 4)`` for twists in the plane, in SE(2):
     columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)). A
     revolute joint's ``exp`` uses the cosine and sine of its relative rotation as the bodies' poses give them,
     which equal those of its reported value to an ulp (the value is read back from them by an ``atan2``): no
-    sine or cosine is evaluated here. Each loop joint is one loop over the points, straight-line code that
-    vectorises.
+    sine or cosine is evaluated here. Each step is one loop over the points on 1-d arrays (straight-line code
+    that vectorises).
     """
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
     E, K = jac.shape[0], jac.shape[2]
-    cg, sg, px, py = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
+    product = np.empty((4, K))  # the loop product's partial (cos, sin, p_x, p_y)
+    angle = np.empty(K)
+    share = np.empty(K)
     jac[:] = 0.0
     res[:] = 0.0
-    big = 0.0
     for loop in range(E // 3):
-        cg[:] = 1.0
-        sg[:] = 0.0
+        c, s, px, py = product[0], product[1], product[2], product[3]
+        c[:] = 1.0
+        s[:] = 0.0
         px[:] = 0.0
         py[:] = 0.0
-        r0, r1, r2 = 3 * loop, 3 * loop + 1, 3 * loop + 2
         for idx in range(loop_ptr[loop], loop_ptr[loop + 1]):
             j = loop_joint[idx]
             sign = float(loop_sign[idx])
             w = sign * twists[j, 2]
             vx, vy = sign * twists[j, 3], sign * twists[j, 4]
-            g = groups[j]
-            if g >= 0:  # Ad(g) xi: (w, R v + p x (0, 0, w))
-                for k in range(K):
-                    jac[r0, g, k] += w
-                    jac[r1, g, k] += cg[k] * vx - sg[k] * vy + py[k] * w
-                    jac[r2, g, k] += sg[k] * vx + cg[k] * vy - px[k] * w
-            if w != 0.0:  # exp: rotation by w q, translation (I - R)(w x v) (w . v = 0 in the plane)
-                ax, ay = -w * vy, w * vx
-                for k in range(K):
-                    ce, se = rel[j, 0, k], sign * rel[j, 1, k]
-                    ex = ax - (ce * ax - se * ay)
-                    ey = ay - (se * ax + ce * ay)
-                    c, s = cg[k], sg[k]
-                    px[k] += c * ex - s * ey
-                    py[k] += s * ex + c * ey
-                    cg[k], sg[k] = c * ce - s * se, s * ce + c * se
+            g = groups[
+                j
+            ]  # every joint is its own unknown in a dyad plan; a fixed one adds to a scratch column
+            col1, col2 = (jac[3 * loop + 1, g], jac[3 * loop + 2, g]) if g >= 0 else (angle, share)
+            if g >= 0:
+                jac[3 * loop, g, :] += w
+            if w != 0.0:
+                turn_column(product, col1, col2, rel[j], sign, w, vx, vy)
             else:
-                for k in range(K):
-                    ex, ey = vx * q[j, k], vy * q[j, k]
-                    c, s = cg[k], sg[k]
-                    px[k] += c * ex - s * ey
-                    py[k] += s * ex + c * ey
-        # log of the planar motion (as kernels.log_rigid): angle, then v = p - (w x p)/2 + D w x (w x p); D by
-        # its Taylor series (a closed loop turns by round-off), log_coefficient where the angle is not small.
-        for k in range(K):
-            t = atan2(sg[k], cg[k])
-            t2 = t * t
-            D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
-            x = px[k] + 0.5 * t * py[k] - D * t2 * px[k]
-            y = py[k] - 0.5 * t * px[k] - D * t2 * py[k]
-            big = max(big, abs(t))
-            cg[k] = t
-            sg[k] = t2 + x * x + y * y  # the loop's share of the squared residual
-        if big >= 1e-2:  # a loop that does not close: the closed form of D where the series does not hold
+                slide_column(product, col1, col2, q[j], vx, vy)
+        if loop_log(c, s, px, py, angle, share) > 0:  # a loop that does not close (never after a dyad solve)
             for k in range(K):
-                t = cg[k]
+                t = angle[k]
                 if abs(t) >= 1e-2:
                     D = log_coefficient(abs(t))
                     x = px[k] + 0.5 * t * py[k] - D * t * t * px[k]
                     y = py[k] - 0.5 * t * px[k] - D * t * t * py[k]
-                    sg[k] = t * t + x * x + y * y
-        for k in range(K):
-            res[k] += sg[k]
+                    share[k] = t * t + x * x + y * y
+        res += share
     for k in range(K):
         res[k] = np.sqrt(res[k])
 
@@ -607,20 +665,19 @@ def closed_form_path(flat, plan, run):
     h, target, hmax = settings[S_STEP], settings[S_TARGET], settings[S_HMAX]
     min_ratio, min_drive, min_margin = settings[S_MIN_RATIO], settings[S_MIN_DRIVE], settings[S_MIN_MARGIN]
     det_basis = settings[S_DET_BASIS]
-    drive = head[0]
-    g_drive = groups[drive]
+    drive, driven = head[0], head[1]
     K = steps + 1
-    out_u = np.zeros((K, m))
-    out_sigma = np.zeros((K, E))
-    out_tau = np.zeros(K)
-    out_s = np.zeros(K)
     # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints' values.
     drive_q = np.empty(K)
     drive_q[0] = 0.0
     for k in range(1, K):
         drive_q[k] = drive_q[k - 1] + h if k < steps else target
-    poses = np.zeros((head[2], 4, K))
-    poses[:, 0, :] = 1.0  # the fixed body keeps the identity, and every body at the start (row 0)
+    poses = np.empty((head[2], 4, K))  # every body but the fixed one is placed at every point k >= 1
+    fixed = joint_int[drive, 1] if joint_int[drive, 2] == driven else joint_int[drive, 2]
+    poses[fixed] = 0.0
+    poses[fixed, 0] = 1.0
+    poses[:, :, 0] = 0.0
+    poses[:, 0, 0] = 1.0  # every body at the start (row 0): the reference
     status = np.zeros(K, dtype=np.int64)
     place_driver(joint_int, joint_geo, head, drive_q, poses)
     place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
@@ -635,54 +692,93 @@ def closed_form_path(flat, plan, run):
             last, ended = k - 1, code
             break
     count = last + 1
-    for j in range(n):
-        for k in range(count):
-            out_u[k, groups[j]] = q[j, k]
+    q = q[:, :count]
     # The Jacobians, then their rows (the tangent, det([J; t^T]), the singular values).
     jac = np.empty((E, m, count))
-    out_res = np.zeros(K)
-    planar_closure(flat, rel[:, :, :count], q[:, :count], jac, out_res[:count])
+    res = np.empty(count)
+    planar_closure(flat, rel[:, :, :count], q, jac, res)
     sigma = np.empty((E, count))
     tangent = np.empty((m, count))
     raw_tau = np.empty(count)
     rows_at_points(jac, sigma, tangent, raw_tau)
-    # Point by point: the tangent's orientation, the test function and every check.
+    # What the checks read, at every point at once: the tangent's inner product with the previous point's
+    # (the start's at row 0), the step's length, the distance from the start (angles wrapped), the limits.
+    align = np.zeros(count)
+    dist = np.zeros(count)
+    wrapped = np.zeros(count)
+    outside = np.zeros(count)
+    path_measures(q, groups, tangent, t0, (lo, hi, periodic), (align, dist, wrapped, outside))
+    # Point by point: the tangent's orientation, the test function and every check, in the march's order.
+    out_tau = np.zeros(K)
+    out_s = np.zeros(K)
     far = 0.0
-    orient_prev = 1.0
+    orient = 1.0
+    g_drive = groups[drive]
+    end, code = count, ended
     for k in range(count):
-        dot = 0.0  # with the previous point's oriented tangent (the start's tangent at row 0)
-        for a in range(m):
-            dot += tangent[a, k] * (orient_prev * tangent[a, k - 1] if k > 0 else t0[a])
-        orient = -1.0 if dot < 0.0 else 1.0
+        orient = -1.0 if align[k] * (orient if k > 0 else 1.0) < 0.0 else 1.0
         tau = det_basis * raw_tau[k] * orient
         t_drive = tangent[g_drive, k]
         # Where the predictor-corrector would do more than step: hand over to it.
         if sigma[E - 1, k] < min_ratio * sigma[0, k] or abs(t_drive) < min_drive:
-            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and (orient * t_drive) * h <= 0.0:
-            return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-        if k > 0 and tau * out_tau[k - 1] < 0.0:
-            return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
-        dist = 0.0
-        wrapped = 0.0
-        for g in range(m):
-            x = out_u[k, g]
-            if x < lo[g] or x > hi[g]:
-                return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
-            du = x - out_u[k - 1, g] if k > 0 else 0.0
-            dist += du * du
-            x = wrap_angle(x) if periodic[g] else x
-            wrapped += x * x
-        orient_prev = orient
-        for e in range(E):
-            out_sigma[k, e] = sigma[e, k]
+            end, code = k, NEAR_SINGULAR
+        elif k > 0 and (orient * t_drive) * h <= 0.0:
+            end, code = k, NEAR_SINGULAR
+        elif k > 0 and tau * out_tau[k - 1] < 0.0:
+            end, code = k, SIGN_CHANGE
+        elif outside[k] > 0.0:
+            end, code = k, LIMIT
+        if end == k:
+            break
         out_tau[k] = tau
-        out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
+        out_s[k] = out_s[k - 1] + dist[k] if k > 0 else 0.0
         if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-            d = np.sqrt(wrapped)
+            d = wrapped[k]
             far = max(far, d)
             if far > 4.0 * hmax and d < 1.5 * abs(h):
-                return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
-    if ended != CLEAN:
-        return count, ended, out_u, out_sigma, out_res, out_tau, out_s
-    return count, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
+                end, code = k, CLOSED
+                break
+    # The rows in the caller's layout (point index first); rows from ``end`` on are zero.
+    out_u = np.zeros((K, m))
+    out_sigma = np.zeros((K, E))
+    out_res = np.zeros(K)
+    for j in range(n):
+        g = groups[j]
+        for k in range(end):
+            out_u[k, g] = q[j, k]
+    for e in range(E):
+        for k in range(end):
+            out_sigma[k, e] = sigma[e, k]
+    out_res[:end] = res[:end]
+    return end, code, out_u, out_sigma, out_res, out_tau, out_s
+
+
+@kernel(error_model="numpy")
+def path_measures(q, groups, tangent, t0, bounds, measures):
+    """At every point ``k`` of a path of joint values ``q (n, K)`` with unit tangents ``tangent (m, K)``:
+    ``measures = (align, dist, wrapped, outside)``: ``align[k]`` the tangent's inner product with the one before
+    (``t0`` at ``k = 0``; orientations aside), ``dist[k]`` the step's length from ``k - 1``, ``wrapped[k]`` the
+    distance from the start with periodic unknowns wrapped onto ``[-pi, pi)``, ``outside[k]`` how many unknowns
+    are outside ``bounds = (lo, hi, periodic)``. Loops over the points, one unknown at a time (vectorised)."""
+    lo, hi, periodic = bounds
+    align, dist, wrapped, outside = measures
+    m, K = tangent.shape[0], tangent.shape[1]
+    for a in range(m):
+        align[0] += tangent[a, 0] * t0[a]
+        ta = tangent[a]
+        for k in range(1, K):
+            align[k] += ta[k] * ta[k - 1]
+    for j in range(q.shape[0]):
+        g = groups[j]
+        qj = q[j]
+        low, high, turn = lo[g], hi[g], TWO_PI if periodic[g] else 0.0
+        for k in range(K):
+            x = qj[k]
+            du = x - qj[k - 1] if k > 0 else 0.0
+            dist[k] += du * du
+            x -= turn * np.floor((x + np.pi) * (1.0 / TWO_PI))  # periodic: onto [-pi, pi), as wrap_angle
+            wrapped[k] += x * x
+            outside[k] += 1.0 if (qj[k] < low) | (qj[k] > high) else 0.0
+    for k in range(K):
+        dist[k] = np.sqrt(dist[k])
+        wrapped[k] = np.sqrt(wrapped[k])
