@@ -42,6 +42,7 @@ KERNEL_MODULES = (
     "kinematics/dyad_solver.py",
     "kinematics/kernels.py",
     "kinematics/march.py",
+    "kinematics/planar_rows.py",
     "kinematics/small_svd.py",
     "kinematics/stops.py",
     "kinematics/trig.py",
