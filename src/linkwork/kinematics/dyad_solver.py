@@ -31,6 +31,7 @@ import numpy as np
 
 from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import log_coefficient
+from linkwork.kinematics.planar_rows import one_loop_rows
 from linkwork.kinematics.small_svd import orthonormalise
 from linkwork.kinematics.trig import SINCOS_LIMIT, atan2, sincos
 
@@ -700,7 +701,10 @@ def closed_form_path(flat, plan, run):
     sigma = np.empty((E, count))
     tangent = np.empty((m, count))
     raw_tau = np.empty(count)
-    rows_at_points(jac, sigma, tangent, raw_tau)
+    if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
+        one_loop_rows(jac, sigma, tangent, raw_tau)
+    else:
+        rows_at_points(jac, sigma, tangent, raw_tau)
     # What the checks read, at every point at once: the tangent's inner product with the previous point's
     # (the start's at row 0), the step's length, the distance from the start (angles wrapped), the limits.
     align = np.zeros(count)
