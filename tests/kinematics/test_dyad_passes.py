@@ -1,0 +1,152 @@
+"""The closed form's passes over all points against computations outside them: the closure Jacobian and residual
+(built from the poses' relative rotations) against :mod:`linkwork.kinematics.closure` at the reported joint
+values (numpy's sine and cosine), the joint values against the poses, and the first failing point of a path (a
+joint limit, a dyad without a solution) where an independent reading of the rows puts it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import linkwork as lw
+from linkwork.kinematics import dyad_solver
+from linkwork.kinematics.closure import closure_residual, jacobian
+from linkwork.kinematics.mechanism import Mechanism
+
+WATT = Path(__file__).resolve().parents[2] / "examples" / "specs" / "watt-six-bar.toml"
+
+
+@pytest.fixture(autouse=True)
+def compiled(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("LINKWORK_JIT", "compiled")
+
+
+def kernel_call(mech: Mechanism, turn: float, steps: int) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+    """``(arguments, outputs)`` of the closed-form kernel on a paper-mode trace of ``turn`` radians of joint A."""
+    original = dyad_solver.closed_form_path
+    seen: list[tuple[tuple[Any, ...], tuple[Any, ...]]] = []
+
+    def watched(*args: Any) -> Any:
+        out = original(*args)
+        seen.append((args, out))
+        return out
+
+    try:
+        dyad_solver.closed_form_path = watched  # type: ignore[assignment]
+        lw.trace(mech, until=("A", float(mech.offsets[mech.index("A")] + turn)), steps=steps)
+    finally:
+        dyad_solver.closed_form_path = original
+    assert seen, "the closed form was not tried"
+    return seen[-1]
+
+
+def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The positions and closure passes of the kernel on its own arguments: ``(poses, q, jac, res)``."""
+    flat, plan, run = args
+    joint_int, joint_geo, dyads, modes, head = plan
+    settings = run[0]
+    steps = int(settings[dyad_solver.S_STEPS])
+    K = steps + 1
+    # the drive's values as the kernel steps them: a running sum, the target last
+    drive_q = np.concatenate([[0.0], np.cumsum(np.full(steps - 1, settings[dyad_solver.S_STEP]))])
+    drive_q = np.append(drive_q, settings[dyad_solver.S_TARGET])
+    poses = np.zeros((head[2], 4, K))
+    poses[:, 0] = 1.0
+    status = np.zeros(K, dtype=np.int64)
+    dyad_solver.place_driver(joint_int, joint_geo, head, drive_q, poses)
+    dyad_solver.place_dyads(
+        joint_int, joint_geo, dyads, modes, poses, settings[dyad_solver.S_MIN_MARGIN], status
+    )
+    assert not status.any()
+    n, m, E = joint_int.shape[0], run[1].shape[0], 3 * (flat[3].shape[0] - 1)
+    rel, q, jump = np.empty((n, 2, K)), np.empty((n, K)), np.zeros(K)
+    dyad_solver.joint_values(joint_int, joint_geo, poses, head[0], drive_q, rel, q, jump)
+    jac, res = np.empty((E, m, K)), np.empty(K)
+    dyad_solver.planar_closure(flat, rel, q, jac, res)
+    return poses, q, jac, res
+
+
+CASES = {
+    "four-bar": lambda: lw.load("four-bar"),
+    "slider-crank": lambda: lw.load("slider-crank", offset=0.3),
+    "watt": lambda: lw.load(str(WATT)),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_jacobian_and_residual_from_poses_equal_the_closure_at_the_reported_values(name: str) -> None:
+    """The closure pass reads each revolute joint's cosine and sine from the bodies' poses, not from its value:
+    its Jacobian equals :func:`~linkwork.kinematics.closure.jacobian` at the reported values (numpy's sin/cos)
+    to 1e-13 of its size, and its residual norm that of :func:`~linkwork.kinematics.closure.closure_residual`
+    to 1e-13 (both at round-off). Over 350 degrees of the crank (short of the closed path), 250 points."""
+    mech = CASES[name]()
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(350.0), 250)
+    assert status == dyad_solver.CLEAN and count == 251
+    _poses, q, jac, res = passes(args)
+    groups = args[0][4]
+    assert np.array_equal(q[:, :count].T, u[:count][:, groups])  # the rows are these joint values
+    for k in range(0, count, 5):
+        angles = mech.q_from_u(u[k])
+        reference = jacobian(mech, angles)
+        assert np.max(np.abs(jac[:, :, k] - reference)) < 1e-13 * max(1.0, np.max(np.abs(reference))), k
+        independent = float(np.linalg.norm(closure_residual(mech, angles)))
+        assert independent < 1e-13 and abs(res[k] - independent) < 1e-13, k
+
+
+def test_joint_values_match_the_poses_and_continue_through_turns() -> None:
+    """Every revolute joint's value turns its before body's pose into its after body's (to 1e-14), and successive
+    values differ by less than the wrapped step (no spurious 2 pi jumps) over 350 degrees of the crank, in which
+    the crank-coupler angle crosses +-180 degrees."""
+    mech = lw.load("four-bar")
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(350.0), 350)
+    assert count == 351
+    assert status == dyad_solver.CLEAN
+    poses, q, _jac, _res = passes(args)
+    joint_int, joint_geo = args[1][0], args[1][1]
+    for j in range(joint_int.shape[0]):
+        a, b = joint_int[j, 1], joint_int[j, 2]
+        turn = joint_geo[j, 2] * q[j]
+        c = np.cos(turn) * poses[a, 0] - np.sin(turn) * poses[a, 1]  # R_a Rz(omega q)
+        s = np.sin(turn) * poses[a, 0] + np.cos(turn) * poses[a, 1]
+        assert np.max(np.hypot(c - poses[b, 0], s - poses[b, 1])) < 1e-14
+        assert np.max(np.abs(np.diff(q[j]))) < 0.1
+    assert abs(q[0, -1] - np.radians(350.0)) < 1e-12
+    assert np.ptp(q[mech.index("B")]) > np.pi  # the angle read in [-pi, pi] was continued across the cut
+
+
+def test_a_joint_limit_ends_the_path_at_the_first_row_beyond_it() -> None:
+    """With an upper limit on the rocker's joint D inside its range, the kernel stops with LIMIT at exactly the
+    first row whose D exceeds it (read from the unlimited run's rows)."""
+    mech = lw.load("four-bar")
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(300.0), 300)
+    assert status == dyad_solver.CLEAN
+    g = args[0][4][mech.index("D")]
+    limit = 0.5 * (u[:count, g].max() + u[:count, g].min())
+    settings, t0, lo, hi, periodic = args[2]
+    hi = hi.copy()
+    hi[g] = limit
+    out = dyad_solver.closed_form_path(args[0], args[1], (settings, t0, lo, hi, periodic))
+    expected = int(np.argmax(u[:count, g] > limit))
+    assert expected > 0
+    assert out[:2] == (expected, dyad_solver.LIMIT)
+    np.testing.assert_array_equal(out[2][:expected], u[:expected])
+
+
+def test_a_dyad_without_a_solution_ends_the_path_at_the_first_such_row() -> None:
+    """A double rocker driven past its fold: the kernel stops at the first row where the coupler and rocker
+    cannot reach (distance from B to D above their sum, computed here) or hands over just before, near the fold
+    (within its margin)."""
+    mech = lw.load("four-bar", ground=2.0, crank=1.8, coupler=1.0, rocker=1.7, theta=np.radians(60.0))
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(150.0), 150)
+    assert status in (dyad_solver.NO_SOLUTION, dyad_solver.NEAR_SINGULAR)
+    settings = args[2][0]
+    crank_angle = np.radians(60.0) + np.arange(151) * settings[dyad_solver.S_STEP]
+    b = 1.8 * np.stack([np.cos(crank_angle), np.sin(crank_angle)], axis=1)
+    reach = np.linalg.norm(b - np.array([2.0, 0.0]), axis=1)
+    first = int(np.argmax(reach > 1.0 + 1.7))
+    assert first > 0 and count <= first
+    if status == dyad_solver.NO_SOLUTION:
+        assert count == first
