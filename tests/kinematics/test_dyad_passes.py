@@ -63,7 +63,8 @@ def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, n
     assert not status.any()
     n, m, E = joint_int.shape[0], run[1].shape[0], 3 * (flat[3].shape[0] - 1)
     rel, q, jump = np.empty((n, 2, K)), np.empty((n, K)), np.zeros(K)
-    dyad_solver.joint_values(joint_int, joint_geo, poses, head[0], drive_q, rel, q, jump)
+    carry = (np.zeros(n), np.zeros(n))  # the start: every joint at 0, no turns
+    dyad_solver.joint_values(joint_int, joint_geo, poses, head[0], drive_q, rel, q, jump, carry)
     jac, res = np.empty((E, m, K)), np.empty(K)
     dyad_solver.planar_closure(flat, rel, q, jac, res)
     return poses, q, jac, res
@@ -81,13 +82,16 @@ def test_jacobian_and_residual_from_poses_equal_the_closure_at_the_reported_valu
     """The closure pass reads each revolute joint's cosine and sine from the bodies' poses, not from its value:
     its Jacobian equals :func:`~linkwork.kinematics.closure.jacobian` at the reported values (numpy's sin/cos)
     to 1e-13 of its size, and its residual norm that of :func:`~linkwork.kinematics.closure.closure_residual`
-    to 1e-13 (both at round-off). Over 350 degrees of the crank (short of the closed path), 250 points."""
+    to 1e-13 (both at round-off). Over 350 degrees of the crank (short of the closed path), in more points than
+    two of the kernel's blocks: its rows equal these passes over the whole path exactly."""
     mech = CASES[name]()
-    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(350.0), 250)
-    assert status == dyad_solver.CLEAN and count == 251
+    steps = 2 * dyad_solver.BLOCK + 7
+    args, (count, status, u, _sigma, out_res, *_rest) = kernel_call(mech, np.radians(350.0), steps)
+    assert status == dyad_solver.CLEAN and count == steps + 1
     _poses, q, jac, res = passes(args)
     groups = args[0][4]
     assert np.array_equal(q[:, :count].T, u[:count][:, groups])  # the rows are these joint values
+    assert np.array_equal(res, out_res)
     for k in range(0, count, 5):
         angles = mech.q_from_u(u[k])
         reference = jacobian(mech, angles)

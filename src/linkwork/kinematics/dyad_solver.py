@@ -52,6 +52,8 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
 )
 N_SETTINGS = 8
 TWO_PI = 2.0 * np.pi
+#: Points per block of :func:`closed_form_path` (a block's arrays stay in the second-level cache).
+BLOCK = 256
 
 
 @kernel(inline="always")
@@ -248,10 +250,15 @@ def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
 @kernel(error_model="numpy")
 def read_angles(ca, sa, cb, sb, rel, omega, q):
     """A revolute joint between bodies of rotations ``(ca, sa)`` and ``(cb, sb)`` at every point: ``rel = (c,
-    s)`` of ``R_a^T R_b``, and ``q[k] = omega atan2(s[k], c[k])`` by the branch-free
+    s)`` of ``R_a^T R_b``, and (unless ``q`` is empty) ``q[k] = omega atan2(s[k], c[k])`` by the branch-free
     :func:`~linkwork.kinematics.trig.atan2`."""
     c, s = rel[0], rel[1]
-    for k in range(q.shape[0]):
+    if q.shape[0] == 0:
+        for k in range(c.shape[0]):
+            c[k] = ca[k] * cb[k] + sa[k] * sb[k]
+            s[k] = ca[k] * sb[k] - sa[k] * cb[k]
+        return
+    for k in range(c.shape[0]):
         ck = ca[k] * cb[k] + sa[k] * sb[k]
         sk = ca[k] * sb[k] - sa[k] * cb[k]
         c[k] = ck
@@ -285,24 +292,29 @@ def slide_values(ca, sa, ta, tb, dx, dy, q):
 
 
 @kernel(error_model="numpy")
-def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump):
+def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry):
     """Every joint's value at every point from its bodies' poses: ``q[j, k]``; revolute ones continued from
     point to point (each point's step wrapped onto ``[-pi, pi)``), the drive's ``drive_q``. ``rel[j] = (cos,
     sin)`` of a joint's relative rotation ``R_a^T R_b`` (``Rz(omega_z q)`` for a revolute joint, the identity for
-    a prismatic one); ``jump[k]``: the largest step of a joint into point ``k`` (the drive's wrapped for a
+    a prismatic one); ``jump[k]``: the largest step of a joint into point ``k >= 1`` (the drive's wrapped for a
     revolute drive), as the point-by-point march reads it.
+
+    ``carry = (start, turns)``: each joint's value at point 0 (the last point of the block before) and the whole
+    turns its angle has made there; ``turns`` is updated to the last point's, for the next block.
 
     The angles come from the branch-free :func:`~linkwork.kinematics.trig.atan2` (vectorised); a revolute
     joint's value is ``raw + 2 pi n`` with ``raw`` the angle read back and ``n`` the count of turns, a running sum
     of the integer steps (so no round-off accumulates along the path).
     """
+    start, total = carry
     K = poses.shape[2]
     turns = np.zeros(K)
     for j in range(joint_int.shape[0]):
         a, b = joint_int[j, 1], joint_int[j, 2]
         revolute = joint_int[j, 0] == REVOLUTE
-        if revolute:  # also the drive's relative rotation (the closure's exp reads it)
-            read_angles(poses[a, 0], poses[a, 1], poses[b, 0], poses[b, 1], rel[j], joint_geo[j, 2], q[j])
+        if revolute:  # also the drive's relative rotation (the closure's exp reads it; its value is drive_q)
+            angles = q[j, :0] if j == drive else q[j]
+            read_angles(poses[a, 0], poses[a, 1], poses[b, 0], poses[b, 1], rel[j], joint_geo[j, 2], angles)
         else:
             rel[j, 0, :] = 1.0
             rel[j, 1, :] = 0.0
@@ -314,11 +326,15 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump):
                 size = abs(wrapped if revolute else step)
                 jump[k] = size if size > jump[k] else jump[k]
         elif revolute:
+            n = total[j]
             if angle_steps(q[j], turns, jump) > 0:
-                n = 0.0
                 for k in range(1, K):  # the running count of turns (whole numbers: exact)
                     n += turns[k]
                     q[j, k] += TWO_PI * n
+            elif n != 0.0:
+                for k in range(1, K):
+                    q[j, k] += TWO_PI * n
+            total[j] = n
         else:
             slide_values(
                 poses[a, 0], poses[a, 1], poses[a, 2:], poses[b, 2:], joint_geo[j, 0], joint_geo[j, 1], q[j]
@@ -326,6 +342,7 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump):
             for k in range(1, K):
                 size = abs(q[j, k] - q[j, k - 1])
                 jump[k] = size if size > jump[k] else jump[k]
+        q[j, 0] = start[j]
 
 
 @kernel(error_model="numpy")
@@ -666,95 +683,110 @@ def closed_form_path(flat, plan, run):
     h, target, hmax = settings[S_STEP], settings[S_TARGET], settings[S_HMAX]
     min_ratio, min_drive, min_margin = settings[S_MIN_RATIO], settings[S_MIN_DRIVE], settings[S_MIN_MARGIN]
     det_basis = settings[S_DET_BASIS]
-    drive, driven = head[0], head[1]
-    K = steps + 1
-    # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints' values.
-    drive_q = np.empty(K)
-    drive_q[0] = 0.0
-    for k in range(1, K):
-        drive_q[k] = drive_q[k - 1] + h if k < steps else target
-    poses = np.empty((head[2], 4, K))  # every body but the fixed one is placed at every point k >= 1
-    fixed = joint_int[drive, 1] if joint_int[drive, 2] == driven else joint_int[drive, 2]
-    poses[fixed] = 0.0
-    poses[fixed, 0] = 1.0
-    poses[:, :, 0] = 0.0
-    poses[:, 0, 0] = 1.0  # every body at the start (row 0): the reference
-    status = np.zeros(K, dtype=np.int64)
-    place_driver(joint_int, joint_geo, head, drive_q, poses)
-    place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
-    rel = np.empty((n, 2, K))
-    q = np.empty((n, K))
-    jump = np.zeros(K)
-    joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump)
-    last, ended = steps, CLEAN  # rows 0 .. last are placed; ``ended`` says why row last + 1 could not be
-    for k in range(1, K):
-        code = JUMP if status[k] == CLEAN and jump[k] > 0.5 * np.pi else status[k]
-        if code != CLEAN:
-            last, ended = k - 1, code
-            break
-    count = last + 1
-    q = q[:, :count]
-    # The Jacobians, then their rows (the tangent, det([J; t^T]), the singular values).
-    jac = np.empty((E, m, count))
-    res = np.empty(count)
-    planar_closure(flat, rel[:, :, :count], q, jac, res)
-    sigma = np.empty((E, count))
-    tangent = np.empty((m, count))
-    raw_tau = np.empty(count)
-    if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
-        one_loop_rows(jac, sigma, tangent, raw_tau)
-    else:
-        rows_at_points(jac, sigma, tangent, raw_tau)
-    # What the checks read, at every point at once: the tangent's inner product with the previous point's
-    # (the start's at row 0), the step's length, the distance from the start (angles wrapped), the limits.
-    align = np.zeros(count)
-    dist = np.zeros(count)
-    wrapped = np.zeros(count)
-    outside = np.zeros(count)
-    path_measures(q, groups, tangent, t0, (lo, hi, periodic), (align, dist, wrapped, outside))
-    # Point by point: the tangent's orientation, the test function and every check, in the march's order.
-    out_tau = np.zeros(K)
-    out_s = np.zeros(K)
+    drive = head[0]
+    g_drive = groups[drive]
+    out_u = np.zeros((steps + 1, m))
+    out_sigma = np.zeros((steps + 1, E))
+    out_res = np.zeros(steps + 1)
+    out_tau = np.zeros(steps + 1)
+    out_s = np.zeros(steps + 1)
+    # A block's arrays: column i is point first - 1 + i; column 0 the block before's last point (the start for
+    # the first block), columns 1 .. BLOCK this block's points (past the last point: harmless extrapolation).
+    C = BLOCK + 1
+    drive_q = np.zeros(C)
+    poses = np.zeros((head[2], 4, C))
+    poses[:, 0, :] = 1.0  # the fixed body keeps the identity, every body is the reference at the start
+    status = np.zeros(C, dtype=np.int64)
+    rel = np.empty((n, 2, C))
+    q = np.empty((n, C))
+    jump = np.empty(C)
+    carry = (np.zeros(n), np.zeros(n))  # each joint's value at column 0 and its whole turns there
+    jac = np.empty((E, m, C))
+    res = np.empty(C)
+    sigma = np.empty((E, C))
+    tangent = np.empty((m, C))
+    raw_tau = np.empty(C)
+    measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))
+    align, dist, wrapped, outside = measures
+    flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
     far = 0.0
     orient = 1.0
-    g_drive = groups[drive]
-    end, code = count, ended
-    for k in range(count):
-        orient = -1.0 if align[k] * (orient if k > 0 else 1.0) < 0.0 else 1.0
-        tau = det_basis * raw_tau[k] * orient
-        t_drive = tangent[g_drive, k]
-        # Where the predictor-corrector would do more than step: hand over to it.
-        if sigma[E - 1, k] < min_ratio * sigma[0, k] or abs(t_drive) < min_drive:
-            end, code = k, NEAR_SINGULAR
-        elif k > 0 and (orient * t_drive) * h <= 0.0:
-            end, code = k, NEAR_SINGULAR
-        elif k > 0 and tau * out_tau[k - 1] < 0.0:
-            end, code = k, SIGN_CHANGE
-        elif outside[k] > 0.0:
-            end, code = k, LIMIT
-        if end == k:
-            break
-        out_tau[k] = tau
-        out_s[k] = out_s[k - 1] + dist[k] if k > 0 else 0.0
-        if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-            d = wrapped[k]
-            far = max(far, d)
-            if far > 4.0 * hmax and d < 1.5 * abs(h):
-                end, code = k, CLOSED
+    for first in range(1, steps + 1, BLOCK):
+        # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
+        for i in range(1, C):
+            k = first - 1 + i
+            drive_q[i] = target if k == steps else drive_q[i - 1] + h
+        status[:] = CLEAN
+        jump[:] = 0.0
+        place_driver(joint_int, joint_geo, head, drive_q, poses)
+        place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
+        joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry)
+        size, ended = min(BLOCK, steps + 1 - first), CLEAN  # points of the block placed; why the next was not
+        for i in range(1, size + 1):
+            code = JUMP if status[i] == CLEAN and jump[i] > 0.5 * np.pi else status[i]
+            if code != CLEAN:
+                size, ended = i - 1, code
                 break
-    # The rows in the caller's layout (point index first); rows from ``end`` on are zero.
-    out_u = np.zeros((K, m))
-    out_sigma = np.zeros((K, E))
-    out_res = np.zeros(K)
-    for j in range(n):
-        g = groups[j]
-        for k in range(end):
-            out_u[k, g] = q[j, k]
-    for e in range(E):
-        for k in range(end):
-            out_sigma[k, e] = sigma[e, k]
-    out_res[:end] = res[:end]
-    return end, code, out_u, out_sigma, out_res, out_tau, out_s
+        # The Jacobians and their rows (the tangent, det([J; t^T]), the singular values), column 0 included.
+        planar_closure(flat, rel, q, jac, res)
+        if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
+            one_loop_rows(jac, sigma, tangent, raw_tau)
+        else:
+            rows_at_points(jac, sigma, tangent, raw_tau)
+        for x in measures:
+            x[:] = 0.0
+        path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)
+        # The tangent's orientation (continuous from point to point, the start's at row 0), then the test function
+        # and every check at every point, then, point by point, the first point that fails (in the march's order:
+        # a rank or drive check, a sign change, a limit, then the closed path after the point is stored).
+        begin = 0 if first == 1 else 1
+        for i in range(begin, size + 1):
+            orient = -1.0 if align[i] * (orient if first + i > 1 else 1.0) < 0.0 else 1.0
+            flips[i] = orient
+        taus[0] = out_tau[first - 1]
+        for i in range(begin, size + 1):
+            taus[i] = det_basis * raw_tau[i] * flips[i]
+        for i in range(begin, size + 1):
+            later = first + i > 1  # not the start
+            t_drive = tangent[g_drive, i]
+            singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
+            turned = later & ((flips[i] * t_drive) * h <= 0.0)
+            crossed = later & (taus[i] * taus[i - 1] < 0.0)
+            code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
+            status[i] = LIMIT if code == CLEAN and outside[i] > 0.0 else code
+        stop, code = size + 1, ended
+        for i in range(begin, size + 1):
+            k = first - 1 + i
+            if status[i] != CLEAN:
+                stop, code = i, status[i]
+                break
+            out_s[k] = out_s[k - 1] + dist[i] if k > 0 else 0.0
+            if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
+                d = wrapped[i]
+                far = far if far >= d else d
+                if far > 4.0 * hmax and d < 1.5 * abs(h):
+                    stop, code = i, CLOSED  # row k is stored, but the path ends before it
+                    break
+        for j in range(n):
+            g = groups[j]
+            for i in range(begin, stop + 1 if code == CLOSED else stop):
+                out_u[first - 1 + i, g] = q[j, i]
+        for e in range(E):
+            for i in range(begin, stop + 1 if code == CLOSED else stop):
+                out_sigma[first - 1 + i, e] = sigma[e, i]
+        for i in range(begin, stop + 1 if code == CLOSED else stop):
+            out_res[first - 1 + i] = res[i]
+            out_tau[first - 1 + i] = taus[i]
+        if stop <= size:
+            return first - 1 + stop, code, out_u, out_sigma, out_res, out_tau, out_s
+        if ended != CLEAN:
+            return first + size, ended, out_u, out_sigma, out_res, out_tau, out_s
+        # The block's last column is the next block's column 0.
+        poses[:, :, 0] = poses[:, :, BLOCK]
+        drive_q[0] = drive_q[BLOCK]
+        for j in range(n):
+            carry[0][j] = q[j, BLOCK]
+    return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
 
 
 @kernel(error_model="numpy")
@@ -776,13 +808,14 @@ def path_measures(q, groups, tangent, t0, bounds, measures):
         g = groups[j]
         qj = q[j]
         low, high, turn = lo[g], hi[g], TWO_PI if periodic[g] else 0.0
+        for k in range(1, K):
+            du = qj[k] - qj[k - 1]
+            dist[k] += du * du
         for k in range(K):
             x = qj[k]
-            du = x - qj[k - 1] if k > 0 else 0.0
-            dist[k] += du * du
+            outside[k] += 1.0 if (x < low) | (x > high) else 0.0
             x -= turn * np.floor((x + np.pi) * (1.0 / TWO_PI))  # periodic: onto [-pi, pi), as wrap_angle
             wrapped[k] += x * x
-            outside[k] += 1.0 if (qj[k] < low) | (qj[k] > high) else 0.0
     for k in range(K):
         dist[k] = np.sqrt(dist[k])
         wrapped[k] = np.sqrt(wrapped[k])
