@@ -6,18 +6,27 @@ drive value without iterating: each dyad is a circle-circle (RRR), circle-line (
 rotating-line (RPR) intersection, the root taken on the side of the start configuration (its assembly mode).
 At every point the planar closure residual and Jacobian are evaluated (the kept rows ``(omega_z, v_x, v_y)`` of
 :func:`linkwork.kinematics.kernels.closure_pass`, in SE(2) arithmetic), and from them what the predictor-corrector
-records: the singular values (one-sided Jacobi on the triangular factor of a Householder QR of ``J^T``), the
-tangent (the QR's last column, oriented continuously) and the signed test function of
-:mod:`linkwork.kinematics.march`, ``det([U_r^T J; t])``, which for a Jacobian of full row rank is
-``det(U_r) det(R) s det(Q)``.
+records: the singular values, the tangent (oriented continuously) and the signed test function of
+:mod:`linkwork.kinematics.march`, ``det([U_r^T J; t])``, here ``det(U_r) det([J; t^T])`` (for one loop by
+:func:`linkwork.kinematics.planar_rows.one_loop_rows`; for more, a Householder QR of ``J^T``, whose last column is
+the tangent, and one-sided Jacobi on its triangle, ``det([J; t^T]) = det(Q) det(R)``).
+
+The work is laid out as passes over all points (structure of arrays: every array's last index is the point), a
+block of :data:`BLOCK` points at a time: the drive's poses, each dyad's two bodies, every joint's value, the
+closure Jacobian and residual, the rows, the checks. Each pass is a loop over the points with straight-line code
+(conditional expressions, no exceptions: ``error_model="numpy"``) on one-dimensional arrays, which LLVM vectorises;
+the sines, cosines and arctangents are the branch-free ones of :mod:`linkwork.kinematics.trig` (numba's call the C
+library one value at a time). The closure uses each revolute joint's cosine and sine as the bodies' poses give
+them, not the sine and cosine of its reported value (they agree to an ulp: the value is read back from them).
 
 The kernel gives up (returns a non-zero status) wherever the predictor-corrector's bookkeeping would act: a dyad
 without a real solution or near its limit (a fold of the drive), a rank ratio below the local-minimum threshold
 (a bifurcation or a higher-dimensional component nearby), a sign change of the test function, a joint limit, a
 closed path before the target; the caller then traces with the predictor-corrector as before.
 
-Body poses are planar displacements from the reference ``x -> R x + t``, kept as ``(cos, sin, t_x, t_y)``; a joint between bodies ``a`` (before)
-and ``b`` (after) satisfies ``g_b = g_a exp(xi q)`` (:func:`linkwork.kinematics.closure.body_poses`).
+Body poses are planar displacements from the reference ``x -> R x + t``, kept as ``(cos, sin, t_x, t_y)`` (each
+an array over the points); a joint between bodies ``a`` (before) and ``b`` (after) satisfies ``g_b = g_a exp(xi
+q)`` (:func:`linkwork.kinematics.closure.body_poses`).
 
 References
 ----------
@@ -54,15 +63,6 @@ N_SETTINGS = 8
 TWO_PI = 2.0 * np.pi
 #: Points per block of :func:`closed_form_path` (a block's arrays stay in the second-level cache).
 BLOCK = 256
-
-
-@kernel(inline="always")
-def wrap_angle(x: float) -> float:
-    """``x`` wrapped onto ``[-pi, pi)`` (compiled copy of :func:`linkwork.geometry.angles.wrap`); a value already
-    in the range is returned as it is (exactly, and without the floating-point modulo's cost)."""
-    if -np.pi <= x < np.pi:
-        return x
-    return (x + np.pi) % (2.0 * np.pi) - np.pi
 
 
 @kernel(inline="always")
@@ -814,7 +814,9 @@ def path_measures(q, groups, tangent, t0, bounds, measures):
         for k in range(K):
             x = qj[k]
             outside[k] += 1.0 if (x < low) | (x > high) else 0.0
-            x -= turn * np.floor((x + np.pi) * (1.0 / TWO_PI))  # periodic: onto [-pi, pi), as wrap_angle
+            x -= turn * np.floor(
+                (x + np.pi) * (1.0 / TWO_PI)
+            )  # periodic: onto [-pi, pi) (geometry.angles.wrap)
             wrapped[k] += x * x
     for k in range(K):
         dist[k] = np.sqrt(dist[k])
