@@ -629,19 +629,22 @@ def rows_at_point(jac, k, M, beta, t, W, V, history, sig, m, E):
 
 
 @kernel()
-def rows_at_points(jac, sigma, tangent, raw_tau):
-    """The rows of :func:`closed_form_path` from the Jacobians ``jac (E, m, K)``, point by point: ``sigma (E, K)``
-    descending, ``tangent (m, K)`` a unit null vector (either sign), ``raw_tau (K,) = det([J; t^T])`` for that
-    tangent; returns 0 (the number of points without a clean answer, as the batched one-loop kernel reports).
+def rows_at_points(jac, sigma, tangent, raw_tau, begin, state):
+    """The rows of :func:`closed_form_path` from the Jacobians ``jac (E, m, K)``, point by point from ``begin``:
+    ``sigma (E, K)`` descending, ``tangent (m, K)`` a unit null vector (either sign), ``raw_tau (K,) = det([J;
+    t^T])`` for that tangent; returns 0 (the number of points without a clean answer, as the batched one-loop
+    kernel reports).
 
     The singular values by one-sided Jacobi on the triangle of a Householder QR of ``J^T``, warm-started from the
-    right singular vectors extrapolated from the last three points."""
+    right singular vectors extrapolated from the last three points: ``state = (V, V_1, V_2)`` (the identity at the
+    start), carried from one block of points to the next."""
     E, m, K = jac.shape[0], jac.shape[1], jac.shape[2]
     M, beta, t = np.empty((m, E)), np.empty(2 * E), np.empty(m)
-    W, V = np.empty((E, E)), np.eye(E)
-    history = (np.eye(E), np.eye(E))
+    W = np.empty((E, E))
+    V, V_1, V_2 = state
+    history = (V_1, V_2)
     sig = np.empty(E)
-    for k in range(K):
+    for k in range(begin, K):
         if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
             raw_tau[k] = rows_at_point(jac, k, M, beta, t, W, V, history, sig, 4, 3)
         else:
@@ -709,6 +712,7 @@ def closed_form_path(flat, plan, run):
     measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))
     align, dist, wrapped, outside = measures
     flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
+    svd_state = (np.eye(E), np.eye(E), np.eye(E))  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
     orient = 1.0
     for first in range(1, steps + 1, BLOCK):
@@ -727,12 +731,15 @@ def closed_form_path(flat, plan, run):
             if code != CLEAN:
                 size, ended = i - 1, code
                 break
+        for i in range(size + 1, C):  # past the block's last point: its copies (no NaN, no work for the rows)
+            rel[:, :, i] = rel[:, :, size]
+            q[:, i] = q[:, size]
         # The Jacobians and their rows (the tangent, det([J; t^T]), the singular values), column 0 included.
         planar_closure(flat, rel, q, jac, res)
         if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
             one_loop_rows(jac, sigma, tangent, raw_tau)
         else:
-            rows_at_points(jac, sigma, tangent, raw_tau)
+            rows_at_points(jac, sigma, tangent, raw_tau, 0 if first == 1 else 1, svd_state)
         for x in measures:
             x[:] = 0.0
         path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)
@@ -786,6 +793,9 @@ def closed_form_path(flat, plan, run):
         drive_q[0] = drive_q[BLOCK]
         for j in range(n):
             carry[0][j] = q[j, BLOCK]
+        sigma[:, 0] = sigma[:, BLOCK]
+        tangent[:, 0] = tangent[:, BLOCK]
+        raw_tau[0] = raw_tau[BLOCK]
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
 
 
