@@ -154,3 +154,30 @@ def test_a_dyad_without_a_solution_ends_the_path_at_the_first_such_row() -> None
     assert first > 0 and count <= first
     if status == dyad_solver.NO_SOLUTION:
         assert count == first
+
+
+def test_a_path_back_at_its_start_ends_closed_where_the_march_would_see_it() -> None:
+    """Two turns of a four-bar's crank in 1-degree steps: the kernel stops with CLOSED at the first row (not the
+    last) whose distance from the start (angles wrapped, numpy's reading here) is below 1.5 steps after the path
+    went farther than 4 maximum steps; that row is stored, the ones before are the path."""
+    mech = lw.load("four-bar")
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(720.0), 720)
+    assert status == dyad_solver.CLOSED
+    settings, periodic = args[2][0], args[2][4]
+    h, hmax = settings[dyad_solver.S_STEP], settings[dyad_solver.S_HMAX]
+    rows = u[: count + 1].copy()
+    rows[:, periodic] = (rows[:, periodic] + np.pi) % (2.0 * np.pi) - np.pi
+    distance = np.linalg.norm(rows, axis=1)
+    far = np.maximum.accumulate(distance)
+    closed = [k for k in range(1, count + 1) if far[k] > 4.0 * hmax and distance[k] < 1.5 * abs(h)]
+    assert closed and closed[0] == count
+    assert 350 < count <= 360  # about one turn
+
+
+def test_a_drive_step_over_a_quarter_turn_ends_the_path_at_once() -> None:
+    """Three steps for a full turn (120 degrees each): the march reads a jump of more than 90 degrees at the first
+    step, so the kernel returns row 0 only, with JUMP (the tracer then decides)."""
+    mech = lw.load("four-bar")
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(360.0), 3)
+    assert (count, status) == (1, dyad_solver.JUMP)
+    assert abs(args[2][0][dyad_solver.S_STEP]) > 0.5 * np.pi
