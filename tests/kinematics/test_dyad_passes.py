@@ -181,3 +181,72 @@ def test_a_drive_step_over_a_quarter_turn_ends_the_path_at_once() -> None:
     args, (count, status, *_rest) = kernel_call(mech, np.radians(360.0), 3)
     assert (count, status) == (1, dyad_solver.JUMP)
     assert abs(args[2][0][dyad_solver.S_STEP]) > 0.5 * np.pi
+
+
+def slotted_lever() -> Mechanism:
+    """A crank and slotted lever: crank A, a block pinned to it at B sliding in a slot of the lever (P, its line
+    through the lever's pivot D at 10 degrees off the line D-B, so B is off it), the lever pivoted on the ground at D:
+    an RPR dyad on the crank."""
+    b = np.array([np.cos(np.radians(60.0)), np.sin(np.radians(60.0))])
+    d = np.array([0.2, -2.0])
+    toward = (b - d) / np.linalg.norm(b - d)
+    turn = np.radians(10.0)
+    slot = (
+        np.cos(turn) * toward[0] - np.sin(turn) * toward[1],
+        np.sin(turn) * toward[0] + np.cos(turn) * toward[1],
+    )
+    z = (0.0, 0.0, 1.0)
+    joints = [
+        {"name": "A", "bodies": ("ground", "crank"), "point": (0.0, 0.0), "direction": z},
+        {"name": "B", "bodies": ("crank", "block"), "point": b, "direction": z},
+        {"name": "S", "type": "P", "bodies": ("block", "lever"), "point": d, "direction": (*slot, 0.0)},
+        {"name": "D", "bodies": ("lever", "ground"), "point": d, "direction": z},
+    ]
+    return Mechanism.from_joints("slotted lever", joints, planar=True)
+
+
+def cross_slides() -> Mechanism:
+    """A PRP dyad on a crank: a block sliding along x on the ground, pinned at P to a second block that slides
+    along a line fixed in the crank (through P, along y at the start)."""
+    z = (0.0, 0.0, 1.0)
+    p = (1.5, 0.8)
+    joints = [
+        {"name": "A", "bodies": ("ground", "crank"), "point": (0.0, 0.0), "direction": z},
+        {"name": "G", "type": "P", "bodies": ("ground", "runner"), "point": p, "direction": (1.0, 0.0, 0.0)},
+        {"name": "P", "bodies": ("runner", "follower"), "point": p, "direction": z},
+        {"name": "F", "type": "P", "bodies": ("follower", "crank"), "point": p, "direction": (0.0, 1.0, 0.0)},
+    ]
+    return Mechanism.from_joints("cross slides", joints, planar=True)
+
+
+@pytest.mark.parametrize(
+    ("build", "kind", "turn", "steps"), [(slotted_lever, "RPR", 300.0, 300), (cross_slides, "PRP", 60.0, 120)]
+)
+def test_rpr_and_prp_dyads_equal_the_predictor_corrector(
+    build: Any, kind: str, turn: float, steps: int
+) -> None:
+    """The two dyad kinds no built-in has: the closed form takes the path (each dyad one vectorised loop), its
+    rows equal the predictor-corrector's (angles and slides to 1e-10, singular values to 1e-12 of the largest),
+    and it closes to round-off."""
+    from linkwork.kinematics import tracer
+    from linkwork.kinematics.dyads import dyad_plan
+
+    mech = build()
+    plan = dyad_plan(mech, mech.index("A"))
+    assert plan is not None and len(plan.dyads) == 1
+    kinds = "".join("RP"[plan.joint_int[j, 0]] for j in plan.dyads[0][:3])
+    assert kinds == kind
+    until = ("A", float(np.radians(turn)))
+    _args, (count, status, *_rest) = kernel_call(mech, np.radians(turn), steps)
+    assert (count, status) == (steps + 1, dyad_solver.CLEAN)
+    fast = lw.trace(mech, until=until, steps=steps)
+    original = tracer.closed_form_rows
+    try:
+        tracer.closed_form_rows = lambda *args, **kwargs: None  # type: ignore[assignment]
+        general = lw.trace(mech, until=until, steps=steps)
+    finally:
+        tracer.closed_form_rows = original
+    assert fast.angles.shape == general.angles.shape
+    assert np.max(np.abs(fast.angles - general.angles)) < 1e-10
+    assert np.max(np.abs(fast.sigma - general.sigma)) < 1e-12 * float(np.max(general.sigma))
+    assert np.all(fast.residual < 1e-13)

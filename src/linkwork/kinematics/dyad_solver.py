@@ -164,15 +164,19 @@ def place_prp(joint_geo, dyad, poses, min_margin, status):
     """A PRP dyad at every point ``k >= 1``: the middle pivot where the two guide lines cross."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
     p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    d1x, d1y, d3x, d3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
     for k in range(1, poses.shape[2]):
-        Ax, Ay, ax, ay = guide_line(joint_geo, poses, j1, K1, k, p2x, p2y)
-        Cx, Cy, cx, cy = guide_line(joint_geo, poses, j3, K2, k, p2x, p2y)
+        c1, s1, c3, s3 = poses[K1, 0, k], poses[K1, 1, k], poses[K2, 0, k], poses[K2, 1, k]
+        Ax, Ay = apply_pose(poses, K1, k, p2x, p2y)  # the guide lines: a point and the unit direction
+        Cx, Cy = apply_pose(poses, K2, k, p2x, p2y)
+        ax, ay = c1 * d1x - s1 * d1y, s1 * d1x + c1 * d1y
+        cx, cy = c3 * d3x - s3 * d3y, s3 * d3x + c3 * d3y
         det = ax * cy - ay * cx
         first_status(status, k, NEAR_SINGULAR if abs(det) < min_margin else CLEAN)
-        s1 = ((Cx - Ax) * cy - (Cy - Ay) * cx) / det
-        X2, Y2 = Ax + s1 * ax, Ay + s1 * ay
-        set_pose(poses, B1, k, poses[K1, 0, k], poses[K1, 1, k], p2x, p2y, X2, Y2)
-        set_pose(poses, B2, k, poses[K2, 0, k], poses[K2, 1, k], p2x, p2y, X2, Y2)
+        along = ((Cx - Ax) * cy - (Cy - Ay) * cx) / det
+        X2, Y2 = Ax + along * ax, Ay + along * ay
+        set_pose(poses, B1, k, c1, s1, p2x, p2y, X2, Y2)
+        set_pose(poses, B2, k, c3, s3, p2x, p2y, X2, Y2)
 
 
 @kernel(error_model="numpy")
@@ -209,14 +213,17 @@ def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
     # The slide's direction in B1 (the before body of j2 may be either dyad body: a line is a line).
     dx, dy = joint_geo[j2, 0], joint_geo[j2, 1]
     h0 = dx * (p3y - p1y) - dy * (p3x - p1x)  # signed distance of the line from p1, constant in B1
+    floor = min_margin * min_margin
     for k in range(1, poses.shape[2]):
         X1, Y1 = apply_pose(poses, K1, k, p1x, p1y)
         X3, Y3 = apply_pose(poses, K2, k, p3x, p3y)
         Dx, Dy = X3 - X1, Y3 - Y1
         rho2 = Dx * Dx + Dy * Dy
         along2 = rho2 - h0 * h0
-        code = NO_SOLUTION if (along2 < 0.0) | (rho2 == 0.0) else CLEAN
-        first_status(status, k, NEAR_SINGULAR if code == CLEAN and along2 < min_margin**2 * rho2 else code)
+        near = along2 < floor * rho2
+        first_status(
+            status, k, NO_SOLUTION if (along2 < 0.0) | (rho2 == 0.0) else (NEAR_SINGULAR if near else CLEAN)
+        )
         along = mode * np.sqrt(max(along2, 0.0))
         # The turn takes the line's direction d (at angle psi from D in B1's frame) onto D's direction:
         # e^{i phi} = (D / rho) conj(d) conj(e^{i psi}), e^{i psi} = (along + i h0) / rho.
