@@ -195,7 +195,7 @@ def test_exact_fall_back_alone() -> None:
     work = (np.empty((3, 4)), np.empty((4, 4)), np.empty((3, 4)), np.empty(4), np.empty(4, dtype=np.int64))
     twin = python_twin({"exact_lane": planar_rows.exact_lane}).exact_lane
     for k in range(K):
-        twin(jac, k, sigma, tangent, tau, work)
+        twin(jac, k, sigma, tangent, tau, work, k % 7 != 0)  # warm-started mostly
 
     def exact_only(jac, sigma_out, tangent_out, tau_out):  # type: ignore[no-untyped-def]
         sigma_out[:], tangent_out[:], tau_out[:] = sigma, tangent, tau
