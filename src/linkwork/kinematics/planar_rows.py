@@ -10,24 +10,31 @@ measure the distance to a bifurcation) has for a ``3 x 4`` matrix a closed form:
 * The four signed ``3 x 3`` minors (cofactors) ``c_i = (-1)^(i+3) det(J without column i)`` span the null space:
   ``J c = 0`` (each row of ``J`` bordered below ``J`` gives a determinant with two equal rows). So ``t = c / |c|``
   is a unit tangent and ``det([J; t^T]) = c . t = |c|``: the raw test function.
-* The characteristic polynomial of ``J J^T`` is ``lambda^3 - p1 lambda^2 + p2 lambda - p3`` with ``p1`` the sum
-  of the squares of ``J``'s entries, ``p2`` the sum of the squares of its eighteen ``2 x 2`` minors and ``p3 =
-  |c|^2`` (Cauchy-Binet), each a sum of squares computed from ``J`` itself (``J J^T`` is never formed). Its
-  largest root ``lambda_1 = sigma_1^2`` is found by Newton's method from an upper bound (the iterates decrease
-  monotonically to it: the polynomial is convex and increasing above ``p1 / 3``); then ``sigma_2^2 + sigma_3^2 =
-  (p2 - p3 / lambda_1) / lambda_1`` and ``sigma_2^2 sigma_3^2 = p3 / lambda_1`` give ``sigma_2`` as the larger
-  root of a quadratic, and ``sigma_3 = |c| / (sigma_1 sigma_2)`` (accurate relative to itself however small).
+* The characteristic polynomial ``f(lambda) = lambda^3 - p1 lambda^2 + p2 lambda - p3`` of ``J J^T`` has ``p1``
+  the sum of the squares of ``J``'s entries, ``p2`` the sum of the squares of its eighteen ``2 x 2`` minors
+  (Lagrange's identity gives them row pair by row pair, ``|J_i|^2 |J_j|^2 - (J_i . J_j)^2``) and ``p3 = |c|^2``
+  (Cauchy-Binet). Its largest root ``lambda_1 = sigma_1^2`` is reached from Samuelson's upper bound of the roots
+  by two Halley steps and one Newton step (the same count in every lane). Dividing ``f`` by ``lambda -
+  lambda_1`` leaves ``x^2 - S x + P`` with ``S = p1 - lambda_1``, ``P = lambda_1 (lambda_1 - p1) + p2``; its
+  larger root is ``lambda_2 = sigma_2^2``, and ``sigma_3 = |c| / (sigma_1 sigma_2)`` (accurate relative to itself
+  however small).
 
 Each lane carries a first-order bound of its rounding errors (running error analysis of every sum, product and
-Horner step, and the conditioning of each root: ``lambda_1`` through ``f'(lambda_1) = (lambda_1 - lambda_2)
-(lambda_1 - lambda_3)``, ``lambda_2`` through the quadratic's discriminant ``(lambda_2 - lambda_3)^2``). Where the
-bound exceeds :data:`SIGMA_TOL` (singular values, relative to ``sigma_1``) or :data:`TANGENT_TOL` (the cofactors,
-relative to ``|c|``) -- near a double root, a near rank drop, or a Newton iteration not converged in
-:data:`NEWTON_STEPS` -- the lane is recomputed by the exact fall-back, a one-sided Jacobi SVD of ``J``
-(:func:`linkwork.kinematics.small_svd.jacobi_svd`), in a second pass.
+Horner step; a root's error is the bound of ``f`` there over ``|f'|``, with the residual ``|f|`` counted, so that
+an unconverged iteration is caught too). The first pass certifies the cofactors to :data:`TANGENT_TOL` (relative
+to ``|c|``), ``sigma_1`` to :data:`SIGMA_1_TOL` and ``sigma_2`` to :data:`SIGMA_2_TOL` (relative to ``sigma_1``).
+A second pass recomputes the lanes it could not certify: where only ``sigma_2`` failed (``lambda_2`` nearly
+double with ``lambda_3``: the coefficients' rounding moves such a root far), from the ``2 x 2`` compression of
+``J J^T`` off its top eigenvector (:func:`gap_lane`, no cancellation); elsewhere (``sigma_1 = sigma_2``, a near
+rank drop, a zero Jacobian) by the exact fall-back, a one-sided Jacobi SVD of ``J``
+(:func:`linkwork.kinematics.small_svd.jacobi_svd`, warm-started from the previous fall-back point when it is the
+point before).
 
-The first pass is straight-line code over the points (a fixed number of Newton steps, conditional expressions, no
-branches and no exceptions: ``error_model="numpy"``), which LLVM vectorises across points.
+The first pass is straight-line code over the points (a fixed number of iterations, conditional expressions, no
+branches and no exceptions: ``error_model="numpy"``), which LLVM vectorises across points (packed ``vsqrtpd``,
+``vdivpd``, ``vfmadd`` on ``ymm`` registers). Every kernel here also runs as plain Python (the twins of
+:mod:`linkwork.kinematics.jit`): the scalars are Python floats and every divisor and square root is guarded, so a
+degenerate lane gives a flagged value, never an exception or a warning.
 
 References
 ----------
@@ -36,7 +43,12 @@ and singular values).
 N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM (2002): Sec. 3.1 and 5.1 (running
 error bounds of sums and of Horner's rule), Sec. 1.12 (the conditioning of a root).
 J. Stoer, R. Bulirsch, *Introduction to Numerical Analysis*, 3rd ed., Springer (2002), Sec. 5.5 (Newton's method
-on a polynomial with real roots from an upper bound of the largest root: monotone convergence).
+on a polynomial with real roots from an upper bound of the largest root); Halley's method: J. M. Ortega, W. C.
+Rheinboldt, *Iterative Solution of Nonlinear Equations in Several Variables*, SIAM (2000), Sec. 7.1.
+E. Carlen, E. H. Lieb, M. Loss, Methods Appl. Anal. 13 (2006) 1-17 (``per(A) <= n! / n^(n/2) prod |a_i|``, which
+bounds the cofactors' rounding errors).
+G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed., Johns Hopkins (2013), Sec. 8.1.2 (Weyl: a symmetric
+matrix's eigenvalues move by at most the norm of its perturbation), Sec. 8.6.3 (one-sided Jacobi).
 P. A. Samuelson, J. Am. Stat. Assoc. 63 (1968) 1522-1525 (the upper bound ``mean + sqrt(n - 1) std`` of the roots).
 """
 
@@ -51,8 +63,9 @@ from linkwork.kinematics.small_svd import jacobi_svd
 
 U = 2.0**-53
 """The unit round-off of float64."""
-NEWTON_STEPS = 4
-"""Newton steps on the characteristic polynomial, the same in every lane (so that the loop vectorises)."""
+HALLEY_STEPS = 2
+"""Halley steps on the characteristic polynomial before one Newton step, the same in every lane (so that the
+loop vectorises)."""
 SIGMA_1_TOL = 2e-14
 """A lane is certified when its error bound on ``sigma_1`` is below this times ``sigma_1``, ..."""
 SIGMA_2_TOL = 7e-14
@@ -73,12 +86,12 @@ def fast_lane(jac, k, sigma, tangent, raw_tau):
     """The closed form at point ``k`` (see the module's docstring) into ``sigma[:, k]``, ``tangent[:, k]`` and
     ``raw_tau[k]``; ``raw_tau[k] = FLAGGED`` where its error bounds do not certify it.
 
-    The bounds are first-order running error bounds (``u`` the unit round-off): each sum of ``n`` products
-    ``n u`` times the sum of their absolute values, bounded by Cauchy-Schwarz through the rows' squared norms
-    ``r_e``; a cofactor ``4 u`` times the permanent of ``|J|`` without its column, at most ``6 / 3^(3/2)`` times
-    the product of its rows' norms (Carlen, Lieb and Loss's Hadamard inequality for permanents); Horner's rule
-    ``2 u`` times the sum of its intermediate magnitudes. A root's error is then its polynomial's error bound
-    over ``|f'|`` there (first order; the residual ``|f|`` counted too).
+    The bounds are first-order running error bounds (``u`` the unit round-off): a sum of ``n`` products errs by
+    at most ``n u`` times the sum of their absolute values, bounded by Cauchy-Schwarz through the rows' squared
+    norms ``r_e``; a cofactor by ``5 u`` times the permanent of ``|J|`` without its column, at most ``6 / 3^(3/2)``
+    times the product of its rows' norms (Carlen, Lieb and Loss), so ``|dc|^2 <= 133 u^2 r0 r1 r2``; Horner's rule
+    by ``3 u`` times its intermediate magnitudes, which at a root are at most ``p2``. A root's error is then the
+    polynomial's error bound over ``|f'|`` there, plus the residual ``|f| / |f'|`` (first order).
     """
     a0, a1, a2, a3 = float(jac[0, 0, k]), float(jac[0, 1, k]), float(jac[0, 2, k]), float(jac[0, 3, k])
     b0, b1, b2, b3 = float(jac[1, 0, k]), float(jac[1, 1, k]), float(jac[1, 2, k]), float(jac[1, 3, k])
@@ -112,10 +125,14 @@ def fast_lane(jac, k, sigma, tangent, raw_tau):
     # lambda_1 by Newton from Samuelson's bound (mean + sqrt(2) std of the three roots): monotone from above.
     spread = p1 * p1 - 3.0 * p2
     lam = (p1 + 2.0 * math.sqrt(spread if spread > 0.0 else 0.0)) * (1.0 / 3.0) * (1.0 + 4.0 * U)
-    for _ in range(NEWTON_STEPS):
+    for _ in range(HALLEY_STEPS):
         f = ((lam - p1) * lam + p2) * lam - p3
         fp = (3.0 * lam - 2.0 * p1) * lam + p2
-        lam -= f / (fp if fp > FLOOR else FLOOR)
+        den = fp * fp - f * (3.0 * lam - p1)
+        lam -= f * fp / (den if den > FLOOR else FLOOR)
+    f = ((lam - p1) * lam + p2) * lam - p3
+    fp = (3.0 * lam - 2.0 * p1) * lam + p2
+    lam -= f / (fp if fp > FLOOR else FLOOR)
     t1 = lam - p1
     t3 = t1 * lam + p2
     f1 = t3 * lam - p3
