@@ -14,7 +14,7 @@ measure the distance to a bifurcation) has for a ``3 x 4`` matrix a closed form:
   the sum of the squares of ``J``'s entries, ``p2`` the sum of the squares of its eighteen ``2 x 2`` minors
   (Lagrange's identity gives them row pair by row pair, ``|J_i|^2 |J_j|^2 - (J_i . J_j)^2``) and ``p3 = |c|^2``
   (Cauchy-Binet). Its largest root ``lambda_1 = sigma_1^2`` is reached from Samuelson's upper bound of the roots
-  by two Halley steps and one Newton step (the same count in every lane). Dividing ``f`` by ``lambda -
+  by two steps of Householder's fourth-order method (the same count in every lane, a division each). Dividing ``f`` by ``lambda -
   lambda_1`` leaves ``x^2 - S x + P`` with ``S = p1 - lambda_1``, ``P = lambda_1 (lambda_1 - p1) + p2``; its
   larger root is ``lambda_2 = sigma_2^2``, and ``sigma_3 = |c| / (sigma_1 sigma_2)`` (accurate relative to itself
   however small).
@@ -43,8 +43,9 @@ and singular values).
 N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM (2002): Sec. 3.1 and 5.1 (running
 error bounds of sums and of Horner's rule), Sec. 1.12 (the conditioning of a root).
 J. Stoer, R. Bulirsch, *Introduction to Numerical Analysis*, 3rd ed., Springer (2002), Sec. 5.5 (Newton's method
-on a polynomial with real roots from an upper bound of the largest root); Halley's method: J. M. Ortega, W. C.
-Rheinboldt, *Iterative Solution of Nonlinear Equations in Several Variables*, SIAM (2000), Sec. 7.1.
+on a polynomial with real roots from an upper bound of the largest root); A. S. Householder, *The Numerical
+Treatment of a Single Nonlinear Equation*, McGraw-Hill (1970), Sec. 4.4 (the methods of order ``d + 1``,
+``x + d (1/f)^(d-1) / (1/f)^(d)``, here ``d = 3``).
 E. Carlen, E. H. Lieb, M. Loss, Methods Appl. Anal. 13 (2006) 1-17 (``per(A) <= n! / n^(n/2) prod |a_i|``, which
 bounds the cofactors' rounding errors).
 G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed., Johns Hopkins (2013), Sec. 8.1.2 (Weyl: a symmetric
@@ -63,9 +64,9 @@ from linkwork.kinematics.small_svd import jacobi_svd
 
 U = 2.0**-53
 """The unit round-off of float64."""
-HALLEY_STEPS = 2
-"""Halley steps on the characteristic polynomial before one Newton step, the same in every lane (so that the
-loop vectorises)."""
+ROOT_STEPS = 2
+"""Steps of Householder's fourth-order method on the characteristic polynomial, the same in every lane (so that
+the loop vectorises)."""
 SIGMA_1_TOL = 2e-14
 """A lane is certified when its error bound on ``sigma_1`` is below this times ``sigma_1``, ..."""
 SIGMA_2_TOL = 7e-14
@@ -122,17 +123,16 @@ def fast_lane(jac, k, sigma, tangent, raw_tau):
     dp1 = 4.0 * U * p1
     dp2 = 14.0 * U * e2 + 7.0 * U * p2
     dp3 = 11.6 * U * (hadamard + p3) + 3.0 * U * p3
-    # lambda_1 by Newton from Samuelson's bound (mean + sqrt(2) std of the three roots): monotone from above.
+    # lambda_1 from Samuelson's bound (mean + sqrt(2) std of the three roots) by Householder's fourth-order steps
+    # x - f (f'^2 - f f'' / 2) / (f'^3 - f f' f'' + f^2 f''' / 6), f''' = 6: its error ~1e-2 -> 1e-8 -> round-off.
     spread = p1 * p1 - 3.0 * p2
     lam = (p1 + 2.0 * math.sqrt(spread if spread > 0.0 else 0.0)) * (1.0 / 3.0) * (1.0 + 4.0 * U)
-    for _ in range(HALLEY_STEPS):
+    for _ in range(ROOT_STEPS):
         f = ((lam - p1) * lam + p2) * lam - p3
         fp = (3.0 * lam - 2.0 * p1) * lam + p2
-        den = fp * fp - f * (3.0 * lam - p1)
-        lam -= f * fp / (den if den > FLOOR else FLOOR)
-    f = ((lam - p1) * lam + p2) * lam - p3
-    fp = (3.0 * lam - 2.0 * p1) * lam + p2
-    lam -= f / (fp if fp > FLOOR else FLOOR)
+        fpp = 6.0 * lam - 2.0 * p1
+        den = (fp * fp - f * fpp) * fp + f * f
+        lam -= f * (fp * fp - 0.5 * f * fpp) / (den if den > FLOOR else FLOOR)
     t1 = lam - p1
     t3 = t1 * lam + p2
     f1 = t3 * lam - p3
