@@ -202,3 +202,32 @@ def test_exact_fall_back_alone() -> None:
         return K
 
     assert check_rows(J, exact_only) == K
+
+
+def jacobi_calls(J: np.ndarray) -> tuple[int, int]:
+    """``(second-pass points, of which by the Jacobi SVD)`` of the plain-Python twin on ``J (K, 3, 4)``."""
+    twin = python_twin({"one_loop_rows": one_loop_rows}).one_loop_rows
+    exact = twin.__globals__["exact_lane"]
+    calls = []
+
+    def counted(*args):  # type: ignore[no-untyped-def]
+        calls.append(args[1])
+        return exact(*args)
+
+    twin.__globals__["exact_lane"] = counted
+    _, _, _, second = rows(J, twin)
+    return second, len(calls)
+
+
+def test_which_pass_computes_what() -> None:
+    """Real four-bar and slider-crank turns never reach the Jacobi SVD (the points where sigma_2 nearly equals
+    sigma_3 are finished by the 2x2 compression); sigma_2 = sigma_3 goes to the compression too; sigma_1 = sigma_2
+    and a near rank drop go to the Jacobi SVD."""
+    for name in ("four-bar", "slider-crank"):
+        second, jacobi = jacobi_calls(turn_jacobians(name))
+        assert jacobi == 0, name
+    second, jacobi = jacobi_calls(with_singular_values(np.array([1.0, 0.5, 0.5]), 30))
+    assert second == 30 and jacobi == 0
+    for values in ((1.0, 1.0, 0.3), (1.0, 0.3, 1e-8)):
+        second, jacobi = jacobi_calls(with_singular_values(np.array(values), 30))
+        assert second == jacobi == 30
