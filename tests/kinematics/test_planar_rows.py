@@ -136,6 +136,7 @@ def test_zero_jacobian_and_rank_one() -> None:
     assert count == 3
     assert np.all(np.isfinite(sigma)) and np.all(np.isfinite(t)) and np.all(np.isfinite(tau))
     assert np.allclose(np.linalg.norm(t, axis=1), 1.0, rtol=0.0, atol=1e-15)
+    assert rows(np.zeros((0, 3, 4)))[3] == 0  # no points
     s = np.linalg.svd(J, compute_uv=False)
     assert np.all(np.abs(np.einsum("kec,kc->ke", J, t)) <= RESIDUAL_TOL * np.maximum(s[:, :1], 1e-300))
     assert np.all(np.abs(sigma - s) <= SIGMA_TOL * s[:, :1])

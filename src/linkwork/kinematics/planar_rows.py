@@ -75,6 +75,8 @@ SIGMA_2_TOL + TANGENT_TOL < 1e-13`` times ``sigma_1``), ..."""
 TANGENT_TOL = 8e-15
 """... and its bound on the cofactors' error below this times ``|c|`` (the tangent's residual ``|J t|`` is then
 below this times ``sigma_1``, and the raw test function this relative)."""
+THIRD_UP = (1.0 + 4.0 * U) / 3.0
+"""A third, rounded up (Samuelson's bound, times it, stays above the largest root)."""
 FLOOR = 1e-300
 """Divisors are at least this (a degenerate lane then gives finite nonsense, flagged, not an exception)."""
 FLAGGED = -np.inf
@@ -126,7 +128,7 @@ def fast_lane(jac, k, sigma, tangent, raw_tau):
     # lambda_1 from Samuelson's bound (mean + sqrt(2) std of the three roots) by Householder's fourth-order steps
     # x - f (f'^2 - f f'' / 2) / (f'^3 - f f' f'' + f^2 f''' / 6), f''' = 6: its error ~1e-2 -> 1e-8 -> round-off.
     spread = p1 * p1 - 3.0 * p2
-    lam = (p1 + 2.0 * math.sqrt(spread if spread > 0.0 else 0.0)) * (1.0 / 3.0) * (1.0 + 4.0 * U)
+    lam = (p1 + 2.0 * math.sqrt(spread if spread > 0.0 else 0.0)) * THIRD_UP
     for _ in range(ROOT_STEPS):
         f = ((lam - p1) * lam + p2) * lam - p3
         fp = (3.0 * lam - 2.0 * p1) * lam + p2
