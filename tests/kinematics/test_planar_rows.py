@@ -4,6 +4,8 @@ ones (equal singular values, near rank drops, a zero column, scaled by 1e-6 and 
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
@@ -39,10 +41,13 @@ def check_rows(J: np.ndarray, kernel=one_loop_rows) -> int:  # type: ignore[no-u
     residual = np.linalg.norm(np.einsum("kec,kc->ke", J, t), axis=1)
     assert np.all(residual <= RESIDUAL_TOL * s[:, 0]), np.max(residual / s[:, 0])
     assert np.all(np.abs(np.linalg.norm(t, axis=1) - 1.0) <= UNIT_TOL)
-    det = np.linalg.det(np.concatenate([J, t[:, None, :]], axis=1))
-    # LAPACK's determinant is itself accurate to about eps * sigma_1 / sigma_3 relative: compare relative where
-    # J is well conditioned, else with the product of LAPACK's singular values (accurate to eps sigma_1^2
-    # sigma_2) and the sign of its determinant.
+    # LAPACK's determinant of [J; t^T], J scaled by a power of two near 1 / sigma_1 (exactly; unscaled, the
+    # bordered matrix's rows differ in scale by sigma_1 and LU loses that much), is accurate to about eps sigma_1
+    # / sigma_3 relative: compare relative where J is well conditioned, else with the product of LAPACK's
+    # singular values (accurate to eps sigma_1^2 sigma_2) and the sign of the determinant.
+    exponent = np.frexp(np.maximum(s[:, 0], 1e-300))[1]
+    scaled = np.ldexp(J, -exponent[:, None, None])
+    det = np.ldexp(np.linalg.det(np.concatenate([scaled, t[:, None, :]], axis=1)), 3 * exponent)
     conditioned = s[:, 2] > 1e-2 * s[:, 0]
     assert np.all(np.abs(tau - det)[conditioned] <= TAU_TOL * np.abs(det[conditioned]))
     product = np.sign(det) * np.prod(s, axis=1)
@@ -136,6 +141,7 @@ def test_zero_jacobian_and_rank_one() -> None:
     assert count == 3
     assert np.all(np.isfinite(sigma)) and np.all(np.isfinite(t)) and np.all(np.isfinite(tau))
     assert np.allclose(np.linalg.norm(t, axis=1), 1.0, rtol=0.0, atol=1e-15)
+    assert rows(np.zeros((0, 3, 4)))[3] == 0  # no points
     s = np.linalg.svd(J, compute_uv=False)
     assert np.all(np.abs(np.einsum("kec,kc->ke", J, t)) <= RESIDUAL_TOL * np.maximum(s[:, :1], 1e-300))
     assert np.all(np.abs(sigma - s) <= SIGMA_TOL * s[:, :1])
@@ -195,10 +201,75 @@ def test_exact_fall_back_alone() -> None:
     work = (np.empty((3, 4)), np.empty((4, 4)), np.empty((3, 4)), np.empty(4), np.empty(4, dtype=np.int64))
     twin = python_twin({"exact_lane": planar_rows.exact_lane}).exact_lane
     for k in range(K):
-        twin(jac, k, sigma, tangent, tau, work)
+        twin(jac, k, sigma, tangent, tau, work, k % 7 != 0)  # warm-started mostly
 
     def exact_only(jac, sigma_out, tangent_out, tau_out):  # type: ignore[no-untyped-def]
         sigma_out[:], tangent_out[:], tau_out[:] = sigma, tangent, tau
         return K
 
     assert check_rows(J, exact_only) == K
+
+
+def jacobi_calls(J: np.ndarray) -> tuple[int, int]:
+    """``(second-pass points, of which by the Jacobi SVD)`` of the plain-Python twin on ``J (K, 3, 4)``."""
+    twin = python_twin({"one_loop_rows": one_loop_rows}).one_loop_rows
+    exact = twin.__globals__["exact_lane"]
+    calls = []
+
+    def counted(*args):  # type: ignore[no-untyped-def]
+        calls.append(args[1])
+        return exact(*args)
+
+    twin.__globals__["exact_lane"] = counted
+    _, _, _, second = rows(J, twin)
+    return second, len(calls)
+
+
+def test_which_pass_computes_what() -> None:
+    """Real four-bar and slider-crank turns never reach the Jacobi SVD (the points where sigma_2 nearly equals
+    sigma_3 are finished by the 2x2 compression); sigma_2 = sigma_3 goes to the compression too; sigma_1 = sigma_2
+    and a near rank drop go to the Jacobi SVD."""
+    for name in ("four-bar", "slider-crank"):
+        second, jacobi = jacobi_calls(turn_jacobians(name))
+        assert jacobi == 0, name
+    second, jacobi = jacobi_calls(with_singular_values(np.array([1.0, 0.5, 0.5]), 30))
+    assert second == 30 and jacobi == 0
+    for values in ((1.0, 1.0, 0.3), (1.0, 0.3, 1e-8)):
+        second, jacobi = jacobi_calls(with_singular_values(np.array(values), 30))
+        assert second == jacobi == 30
+
+
+def exact_determinant(rows: list[list[Fraction]]) -> Fraction:
+    """The determinant of a small matrix of rationals, by expansion along the first row (exact)."""
+    if len(rows) == 1:
+        return rows[0][0]
+    return sum(
+        (
+            (-1) ** j * rows[0][j] * exact_determinant([r[:j] + r[j + 1 :] for r in rows[1:]])
+            for j in range(len(rows))
+        ),
+        Fraction(0),
+    )
+
+
+def test_raw_tau_against_exact_rational_determinants() -> None:
+    """``raw_tau`` against ``det([J; t^T])`` of the returned ``t`` in exact rational arithmetic (every float is a
+    rational): to 1e-14 relative on generic Jacobians, scaled by 1e-6 and with nearly equal singular values (the
+    closed form, the 2x2 compression and the Jacobi SVD); next to a rank drop (sigma_3 = 1e-4 sigma_1) to 1e-14
+    sigma_1^2 sigma_2, what a rounding error of sigma_1 eps in sigma_3 makes of the determinant sigma_1 sigma_2
+    sigma_3 (relative 1e-10 here; double precision gives no better there)."""
+    J = np.concatenate(
+        [
+            RNG.normal(size=(8, 3, 4)),
+            1e-6 * RNG.normal(size=(4, 3, 4)),
+            with_singular_values(np.array([1.0, 1.0 - 1e-6, 0.2]), 4),
+            with_singular_values(np.array([1.0, 0.5, 0.5 - 1e-7]), 4),
+            with_singular_values(np.array([1.0, 0.3, 1e-4]), 4),
+        ]
+    )
+    sigma, t, tau, _ = rows(J)
+    for k in range(len(J)):
+        bordered = [[Fraction(float(x)) for x in row] for row in np.concatenate([J[k], t[k][None]])]
+        exact = float(exact_determinant(bordered))
+        scale = abs(exact) if k < len(J) - 4 else sigma[k, 0] ** 2 * sigma[k, 1]
+        assert abs(tau[k] - exact) <= 1e-14 * scale, k
