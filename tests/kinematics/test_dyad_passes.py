@@ -63,10 +63,10 @@ def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, n
     assert not status.any()
     n, m, E = joint_int.shape[0], run[1].shape[0], 3 * (flat[3].shape[0] - 1)
     rel, q, jump = np.empty((n, 2, K)), np.empty((n, K)), np.zeros(K)
-    carry = (np.zeros(n), np.zeros(n))  # the start: every joint at 0, no turns
+    carry = (np.zeros(n), np.zeros(n), np.zeros(K))  # the start: every joint at 0, no turns
     dyad_solver.joint_values(joint_int, joint_geo, poses, head[0], drive_q, rel, q, jump, carry)
     jac, res = np.empty((E, m, K)), np.empty(K)
-    dyad_solver.planar_closure(flat, rel, q, jac, res)
+    dyad_solver.planar_closure(flat, rel, q, jac, res, (np.empty((4, K)), np.empty(K), np.empty(K)))
     return poses, q, jac, res
 
 

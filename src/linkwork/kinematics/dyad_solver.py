@@ -306,16 +306,15 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carr
     a prismatic one); ``jump[k]``: the largest step of a joint into point ``k >= 1`` (the drive's wrapped for a
     revolute drive), as the point-by-point march reads it.
 
-    ``carry = (start, turns)``: each joint's value at point 0 (the last point of the block before) and the whole
-    turns its angle has made there; ``turns`` is updated to the last point's, for the next block.
+    ``carry = (start, total, turns)``: each joint's value at point 0 (the last point of the block before), the
+    whole turns its angle has made there (updated to the last point's, for the next block), and scratch ``(K,)``.
 
     The angles come from the branch-free :func:`~linkwork.kinematics.trig.atan2` (vectorised); a revolute
     joint's value is ``raw + 2 pi n`` with ``raw`` the angle read back and ``n`` the count of turns, a running sum
     of the integer steps (so no round-off accumulates along the path).
     """
-    start, total = carry
+    start, total, turns = carry
     K = poses.shape[2]
-    turns = np.zeros(K)
     for j in range(joint_int.shape[0]):
         a, b = joint_int[j, 1], joint_int[j, 2]
         revolute = joint_int[j, 0] == REVOLUTE
@@ -408,11 +407,12 @@ def loop_log(c, s, px, py, angle, share):
 
 
 @kernel(error_model="numpy")
-def planar_closure(flat, rel, q, jac, res):
+def planar_closure(flat, rel, q, jac, res, scratch):
     """Planar closure residual ``(omega_z, v_x, v_y)`` of ``log(P)`` per loop and its ``(E, m)`` Jacobian in the
     unknowns at every point ``k < K``: ``jac (E, m, K)`` (point index last), ``res (K,)`` the residual's norm;
     ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``, ``q (n, K)`` the joint values, ``rel (n, 2,
-    K)`` each joint's relative rotation (from :func:`joint_values`).
+    K)`` each joint's relative rotation (from :func:`joint_values`); ``scratch = (product (4, K), angle (K,),
+    share (K,))``.
 
     :func:`linkwork.kinematics.kernels.closure_pass` with rows ``(2, 3, 4)`` for twists in the plane, in SE(2):
     columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)). A
@@ -423,9 +423,9 @@ def planar_closure(flat, rel, q, jac, res):
     """
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
     E, K = jac.shape[0], jac.shape[2]
-    product = np.empty((4, K))  # the loop product's partial (cos, sin, p_x, p_y)
-    angle = np.empty(K)
-    share = np.empty(K)
+    product, angle, share = (
+        scratch  # the loop product's partial (cos, sin, p_x, p_y); its log's angle and norm
+    )
     jac[:] = 0.0
     res[:] = 0.0
     for loop in range(E // 3):
@@ -710,7 +710,8 @@ def closed_form_path(flat, plan, run):
     rel = np.empty((n, 2, C))
     q = np.empty((n, C))
     jump = np.empty(C)
-    carry = (np.zeros(n), np.zeros(n))  # each joint's value at column 0 and its whole turns there
+    carry = (np.zeros(n), np.zeros(n), np.zeros(C))  # each joint's value at column 0, its whole turns there
+    scratch = (np.empty((4, C)), np.empty(C), np.empty(C))
     jac = np.empty((E, m, C))
     res = np.empty(C)
     sigma = np.empty((E, C))
@@ -742,7 +743,7 @@ def closed_form_path(flat, plan, run):
             rel[:, :, i] = rel[:, :, size]
             q[:, i] = q[:, size]
         # The Jacobians and their rows (the tangent, det([J; t^T]), the singular values), column 0 included.
-        planar_closure(flat, rel, q, jac, res)
+        planar_closure(flat, rel, q, jac, res, scratch)
         if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
             one_loop_rows(jac, sigma, tangent, raw_tau)
         else:
