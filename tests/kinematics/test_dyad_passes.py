@@ -250,3 +250,14 @@ def test_rpr_and_prp_dyads_equal_the_predictor_corrector(
     assert np.max(np.abs(fast.angles - general.angles)) < 1e-10
     assert np.max(np.abs(fast.sigma - general.sigma)) < 1e-12 * float(np.max(general.sigma))
     assert np.all(fast.residual < 1e-13)
+
+
+def test_a_drive_step_of_whole_turns_is_no_jump() -> None:
+    """One step of two whole turns brings every body back where it was: the march reads the drive's step wrapped
+    (0), so the kernel reaches the target (2 rows) with the crank's value 720 degrees and every other joint at 0."""
+    mech = lw.load("four-bar")
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(720.0), 1)
+    assert (count, status) == (2, dyad_solver.CLEAN)
+    g = args[0][4][mech.index("A")]
+    assert abs(u[1, g] - np.radians(720.0)) < 1e-12
+    assert np.max(np.abs(np.delete(u[1], g))) < 1e-12

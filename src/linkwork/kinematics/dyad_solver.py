@@ -328,7 +328,7 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carr
             q[j, :] = drive_q
             for k in range(1, K):
                 step = drive_q[k] - drive_q[k - 1]
-                wrapped = step - TWO_PI if step >= np.pi else (step + TWO_PI if step < -np.pi else step)
+                wrapped = step - TWO_PI * np.floor((step + np.pi) * (1.0 / TWO_PI))  # any number of turns
                 size = abs(wrapped if revolute else step)
                 jump[k] = size if size > jump[k] else jump[k]
         elif revolute:
