@@ -770,12 +770,14 @@ def closed_form_path(flat, plan, run):
             code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
             status[i] = LIMIT if code == CLEAN and outside[i] > 0.0 else code
         stop, code = size + 1, ended
+        arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
         for i in range(begin, size + 1):
             k = first - 1 + i
             if status[i] != CLEAN:
                 stop, code = i, status[i]
                 break
-            out_s[k] = out_s[k - 1] + dist[i] if k > 0 else 0.0
+            arc = arc + dist[i] if k > 0 else 0.0
+            out_s[k] = arc
             if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
                 d = wrapped[i]
                 far = far if far >= d else d
