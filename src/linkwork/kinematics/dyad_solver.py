@@ -147,14 +147,14 @@ def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
         X3, Y3 = apply_pose(poses, K2, k, p3x, p3y)
         Dx, Dy = X3 - X1, Y3 - Y1
         d2 = Dx * Dx + Dy * Dy
-        d = np.sqrt(d2)
-        a = (L1s - L2s + d2) / (2.0 * d)
+        inv_d = 1.0 / np.sqrt(d2)  # one division for the three below
+        a = (L1s - L2s + d2) * (0.5 * inv_d)
         h2 = L1s - a * a
         h = np.sqrt(max(h2, 0.0))
         code = NO_SOLUTION if (d2 == 0.0) | (h2 < 0.0) else (NEAR_SINGULAR if h * h < floor else CLEAN)
         first_status(status, k, code)
-        X2 = X1 + (a * Dx - mode * h * Dy) / d
-        Y2 = Y1 + (a * Dy + mode * h * Dx) / d
+        X2 = X1 + (a * Dx - mode * h * Dy) * inv_d
+        Y2 = Y1 + (a * Dy + mode * h * Dx) * inv_d
         set_pose_turning(poses, B1, k, p1x, p1y, X1, Y1, p2x - p1x, p2y - p1y, X2 - X1, Y2 - Y1)
         set_pose_turning(poses, B2, k, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
 
@@ -397,7 +397,8 @@ def loop_log(c, s, px, py, angle, share):
     for k in range(c.shape[0]):
         t = atan2(s[k], c[k])
         t2 = t * t
-        D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
+        # (products by the reciprocals, folded at compile time: no division in the loop)
+        D = 1.0 / 12.0 + t2 * (1.0 / 720.0) + t2 * t2 * (1.0 / 30240.0) + t2 * t2 * t2 * (1.0 / 1209600.0)
         x = px[k] + 0.5 * t * py[k] - D * t2 * px[k]
         y = py[k] - 0.5 * t * px[k] - D * t2 * py[k]
         angle[k] = t
