@@ -424,9 +424,8 @@ def planar_closure(flat, rel, q, jac, res, scratch):
     """
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
     E, K = jac.shape[0], jac.shape[2]
-    product, angle, share = (
-        scratch  # the loop product's partial (cos, sin, p_x, p_y); its log's angle and norm
-    )
+    # the loop product's partial (cos, sin, p_x, p_y); its log's angle and norm
+    product, angle, share = scratch
     jac[:] = 0.0
     res[:] = 0.0
     for loop in range(E // 3):
@@ -440,9 +439,8 @@ def planar_closure(flat, rel, q, jac, res, scratch):
             sign = float(loop_sign[idx])
             w = sign * twists[j, 2]
             vx, vy = sign * twists[j, 3], sign * twists[j, 4]
-            g = groups[
-                j
-            ]  # every joint is its own unknown in a dyad plan; a fixed one adds to a scratch column
+            # every joint is its own unknown in a dyad plan; a fixed one would add to a scratch column
+            g = groups[j]
             col1, col2 = (jac[3 * loop + 1, g], jac[3 * loop + 2, g]) if g >= 0 else (angle, share)
             if g >= 0:
                 jac[3 * loop, g, :] += w
