@@ -6,18 +6,27 @@ drive value without iterating: each dyad is a circle-circle (RRR), circle-line (
 rotating-line (RPR) intersection, the root taken on the side of the start configuration (its assembly mode).
 At every point the planar closure residual and Jacobian are evaluated (the kept rows ``(omega_z, v_x, v_y)`` of
 :func:`linkwork.kinematics.kernels.closure_pass`, in SE(2) arithmetic), and from them what the predictor-corrector
-records: the singular values (one-sided Jacobi on the triangular factor of a Householder QR of ``J^T``), the
-tangent (the QR's last column, oriented continuously) and the signed test function of
-:mod:`linkwork.kinematics.march`, ``det([U_r^T J; t])``, which for a Jacobian of full row rank is
-``det(U_r) det(R) s det(Q)``.
+records: the singular values, the tangent (oriented continuously) and the signed test function of
+:mod:`linkwork.kinematics.march`, ``det([U_r^T J; t])``, here ``det(U_r) det([J; t^T])`` (for one loop by
+:func:`linkwork.kinematics.planar_rows.one_loop_rows`; for more, a Householder QR of ``J^T``, whose last column is
+the tangent, and one-sided Jacobi on its triangle, ``det([J; t^T]) = det(Q) det(R)``).
+
+The work is laid out as passes over all points (structure of arrays: every array's last index is the point), a
+block of :data:`BLOCK` points at a time: the drive's poses, each dyad's two bodies, every joint's value, the
+closure Jacobian and residual, the rows, the checks. Each pass is a loop over the points with straight-line code
+(conditional expressions, no exceptions: ``error_model="numpy"``) on one-dimensional arrays, which LLVM vectorises;
+the sines, cosines and arctangents are the branch-free ones of :mod:`linkwork.kinematics.trig` (numba's call the C
+library one value at a time). The closure uses each revolute joint's cosine and sine as the bodies' poses give
+them, not the sine and cosine of its reported value (they agree to an ulp: the value is read back from them).
 
 The kernel gives up (returns a non-zero status) wherever the predictor-corrector's bookkeeping would act: a dyad
 without a real solution or near its limit (a fold of the drive), a rank ratio below the local-minimum threshold
 (a bifurcation or a higher-dimensional component nearby), a sign change of the test function, a joint limit, a
 closed path before the target; the caller then traces with the predictor-corrector as before.
 
-Body poses are planar displacements from the reference ``x -> R x + t``, kept as ``(cos, sin, t_x, t_y)``; a joint between bodies ``a`` (before)
-and ``b`` (after) satisfies ``g_b = g_a exp(xi q)`` (:func:`linkwork.kinematics.closure.body_poses`).
+Body poses are planar displacements from the reference ``x -> R x + t``, kept as ``(cos, sin, t_x, t_y)`` (each
+an array over the points); a joint between bodies ``a`` (before) and ``b`` (after) satisfies ``g_b = g_a exp(xi
+q)`` (:func:`linkwork.kinematics.closure.body_poses`).
 
 References
 ----------
@@ -31,7 +40,9 @@ import numpy as np
 
 from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import log_coefficient
+from linkwork.kinematics.planar_rows import one_loop_rows
 from linkwork.kinematics.small_svd import orthonormalise
+from linkwork.kinematics.trig import SINCOS_LIMIT, atan2, sincos
 
 #: Joint kinds in ``joint_int[:, 0]``.
 REVOLUTE, PRISMATIC = 0, 1
@@ -49,233 +60,405 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
     7,
 )
 N_SETTINGS = 8
-#: Points per block of the closed form's second and third passes (their scratch stays in the cache).
-BLOCK = 64
+TWO_PI = 2.0 * np.pi
+#: Points per block of :func:`closed_form_path` (a block's arrays stay in the second-level cache).
+BLOCK = 256
 
 
 @kernel(inline="always")
-def wrap_angle(x: float) -> float:
-    """``x`` wrapped onto ``[-pi, pi)`` (compiled copy of :func:`linkwork.geometry.angles.wrap`); a value already
-    in the range is returned as it is (exactly, and without the floating-point modulo's cost)."""
-    if -np.pi <= x < np.pi:
-        return x
-    return (x + np.pi) % (2.0 * np.pi) - np.pi
+def apply_pose(poses: np.ndarray, body: int, k: int, x: float, y: float) -> tuple[float, float]:
+    """The point ``(x, y)`` of ``body`` (reference coordinates) where the body's pose ``(cos, sin, tx, ty)`` at
+    point ``k`` puts it."""
+    c, s = poses[body, 0, k], poses[body, 1, k]
+    return c * x - s * y + poses[body, 2, k], s * x + c * y + poses[body, 3, k]
 
 
 @kernel(inline="always")
-def apply_pose(poses: np.ndarray, body: int, x: float, y: float) -> tuple[float, float]:
-    """The point ``(x, y)`` of ``body`` (reference coordinates) where the body's pose ``(cos, sin, tx, ty)``
-    puts it."""
-    c, s = poses[body, 0], poses[body, 1]
-    return c * x - s * y + poses[body, 2], s * x + c * y + poses[body, 3]
+def set_pose(poses, body, k, c, s, x, y, X, Y):
+    """Pose of ``body`` at point ``k`` turned by the rotation ``(c, s)`` and taking its reference point ``(x, y)``
+    to ``(X, Y)``."""
+    poses[body, 0, k] = c
+    poses[body, 1, k] = s
+    poses[body, 2, k] = X - (c * x - s * y)
+    poses[body, 3, k] = Y - (s * x + c * y)
 
 
 @kernel(inline="always")
-def set_pose(
-    poses: np.ndarray, body: int, c: float, s: float, x: float, y: float, X: float, Y: float
-) -> None:
-    """Pose of ``body`` turned by the rotation ``(c, s)`` and taking its reference point ``(x, y)`` to ``(X, Y)``."""
-    poses[body, 0] = c
-    poses[body, 1] = s
-    poses[body, 2] = X - (c * x - s * y)
-    poses[body, 3] = Y - (s * x + c * y)
-
-
-@kernel(inline="always")
-def set_pose_turning(poses, body, x, y, X, Y, ux, uy, vx, vy):
-    """Pose of ``body`` taking its reference point ``(x, y)`` to ``(X, Y)`` and turning the reference vector
-    ``(ux, uy)`` onto the direction of ``(vx, vy)``."""
+def set_pose_turning(poses, body, k, x, y, X, Y, ux, uy, vx, vy):
+    """Pose of ``body`` at point ``k`` taking its reference point ``(x, y)`` to ``(X, Y)`` and turning the
+    reference vector ``(ux, uy)`` onto the direction of ``(vx, vy)``."""
     scale = 1.0 / np.sqrt((ux * ux + uy * uy) * (vx * vx + vy * vy))
-    set_pose(poses, body, (ux * vx + uy * vy) * scale, (ux * vy - uy * vx) * scale, x, y, X, Y)
+    set_pose(poses, body, k, (ux * vx + uy * vy) * scale, (ux * vy - uy * vx) * scale, x, y, X, Y)
 
 
 @kernel(inline="always")
-def place_driven(joint_int, joint_geo, drive, driven, q, poses):
-    """Pose of the body the drive joint moves, the other body of the drive joint being fixed (identity pose)."""
-    sign = 1.0 if joint_int[drive, 2] == driven else -1.0  # g_after = g_before exp(xi q)
-    if joint_int[drive, 0] == REVOLUTE:
-        phi = sign * joint_geo[drive, 2] * q
-        px, py = joint_geo[drive, 0], joint_geo[drive, 1]
-        set_pose(poses, driven, np.cos(phi), np.sin(phi), px, py, px, py)
-    else:
-        set_pose(
-            poses, driven, 1.0, 0.0, 0.0, 0.0, sign * q * joint_geo[drive, 0], sign * q * joint_geo[drive, 1]
-        )
-
-
-@kernel(inline="always")
-def guide_line(joint_geo, poses, j, known, px, py):
-    """The line a point ``(px, py)`` of the body that prismatic joint ``j`` joins to ``known`` runs on: its point
-    and unit direction where ``known``'s pose puts them (the two bodies keep one orientation)."""
-    X, Y = apply_pose(poses, known, px, py)
-    c, s = poses[known, 0], poses[known, 1]
+def guide_line(joint_geo, poses, j, known, k, px, py):
+    """The line a point ``(px, py)`` of the body that prismatic joint ``j`` joins to ``known`` runs on at point
+    ``k``: its point and unit direction where ``known``'s pose puts them (the two bodies keep one orientation)."""
+    X, Y = apply_pose(poses, known, k, px, py)
+    c, s = poses[known, 0, k], poses[known, 1, k]
     dx, dy = joint_geo[j, 0], joint_geo[j, 1]
     return X, Y, c * dx - s * dy, s * dx + c * dy
 
 
-@kernel()
-def place_dyad(joint_int, joint_geo, dyad, mode, poses, min_margin):
-    """Place the two bodies of one dyad ``(j1, j2, j3, K1, B1, B2, K2)`` in closed form; returns a status.
+@kernel(inline="always")
+def first_status(status: np.ndarray, k: int, code: int) -> None:
+    """Keep the first reason a point failed (the dyads are placed in order; a later one sees NaN or garbage)."""
+    status[k] = code if status[k] == CLEAN else status[k]
 
-    ``mode`` is the sign that picks the start's assembly mode. ``min_margin`` is the smallest relative distance
-    from the dyad's limit (a double root) accepted; below it the dyad is too near a fold to trust a closed form
-    where the predictor-corrector would meet the fold.
-    """
+
+@kernel(error_model="numpy")
+def place_driver(joint_int, joint_geo, head, drive_q, poses):
+    """Pose of the body the drive joint moves at every point ``k >= 1`` (the other body of the drive joint is
+    fixed: identity pose), the drive's values ``drive_q``; the rotation by the branch-free
+    :func:`~linkwork.kinematics.trig.sincos` in one vectorised loop."""
+    drive, driven = head[0], head[1]
+    sign = 1.0 if joint_int[drive, 2] == driven else -1.0  # g_after = g_before exp(xi q)
+    K = drive_q.shape[0]
+    if joint_int[drive, 0] == REVOLUTE:
+        turn = sign * joint_geo[drive, 2]
+        px, py = joint_geo[drive, 0], joint_geo[drive, 1]
+        for k in range(1, K):
+            c, s = sincos(turn * drive_q[k])
+            set_pose(poses, driven, k, c, s, px, py, px, py)
+        for k in range(1, K):  # beyond the reduction's range: the C library (never on a sane drive)
+            if not abs(turn * drive_q[k]) <= SINCOS_LIMIT:
+                phi = turn * drive_q[k]
+                set_pose(poses, driven, k, np.cos(phi), np.sin(phi), px, py, px, py)
+    else:
+        dx, dy = sign * joint_geo[drive, 0], sign * joint_geo[drive, 1]
+        for k in range(1, K):
+            set_pose(poses, driven, k, 1.0, 0.0, 0.0, 0.0, drive_q[k] * dx, drive_q[k] * dy)
+
+
+@kernel(error_model="numpy")
+def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
+    """An RRR dyad ``(j1, j2, j3, K1, B1, B2, K2)`` at every point ``k >= 1``: two circles about the placed
+    pivots, the root on the side ``mode``; ``status[k]`` set where there is none or it is within ``min_margin``
+    (relative) of the double root. Straight-line code: the loop over points vectorises."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
-    k1, k2, k3 = joint_int[j1, 0], joint_int[j2, 0], joint_int[j3, 0]
-    if k2 == REVOLUTE:
-        # The middle point p2 (shared by B1 and B2) on a circle or a line from each side.
-        p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
-        if k1 == REVOLUTE and k3 == REVOLUTE:  # RRR: two circles
-            p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
-            L1s = (p2x - p1x) ** 2 + (p2y - p1y) ** 2
-            L2s = (p2x - p3x) ** 2 + (p2y - p3y) ** 2
-            X1, Y1 = apply_pose(poses, K1, p1x, p1y)
-            X3, Y3 = apply_pose(poses, K2, p3x, p3y)
-            Dx, Dy = X3 - X1, Y3 - Y1
-            d2 = Dx * Dx + Dy * Dy
-            if d2 == 0.0:
-                return NO_SOLUTION
-            d = np.sqrt(d2)
-            a = (L1s - L2s + d2) / (2.0 * d)
-            h2 = L1s - a * a
-            if h2 < 0.0:
-                return NO_SOLUTION
-            h = np.sqrt(h2)
-            if h * h < min_margin * min_margin * L1s:
-                return NEAR_SINGULAR
-            X2 = X1 + (a * Dx - mode * h * Dy) / d
-            Y2 = Y1 + (a * Dy + mode * h * Dx) / d
-            set_pose_turning(poses, B1, p1x, p1y, X1, Y1, p2x - p1x, p2y - p1y, X2 - X1, Y2 - Y1)
-            set_pose_turning(poses, B2, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
-            return CLEAN
-        if k1 == PRISMATIC and k3 == PRISMATIC:  # PRP: two lines
-            Ax, Ay, ax, ay = guide_line(joint_geo, poses, j1, K1, p2x, p2y)
-            Cx, Cy, cx, cy = guide_line(joint_geo, poses, j3, K2, p2x, p2y)
-            det = ax * cy - ay * cx
-            if abs(det) < min_margin:
-                return NEAR_SINGULAR
-            s1 = ((Cx - Ax) * cy - (Cy - Ay) * cx) / det
-            X2, Y2 = Ax + s1 * ax, Ay + s1 * ay
-            set_pose(poses, B1, poses[K1, 0], poses[K1, 1], p2x, p2y, X2, Y2)
-            set_pose(poses, B2, poses[K2, 0], poses[K2, 1], p2x, p2y, X2, Y2)
-            return CLEAN
-        # RRP or PRR: a circle about the revolute side's pivot and the prismatic side's line.
-        if k1 == REVOLUTE:
-            jr, Kr, Br, jp, Kp, Bp = j1, K1, B1, j3, K2, B2
-        else:
-            jr, Kr, Br, jp, Kp, Bp = j3, K2, B2, j1, K1, B1
-        prx, pry = joint_geo[jr, 0], joint_geo[jr, 1]
-        Ls = (p2x - prx) ** 2 + (p2y - pry) ** 2
-        Xr, Yr = apply_pose(poses, Kr, prx, pry)
-        Qx, Qy, ex, ey = guide_line(joint_geo, poses, jp, Kp, p2x, p2y)
+    p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
+    p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    L1s = (p2x - p1x) ** 2 + (p2y - p1y) ** 2
+    L2s = (p2x - p3x) ** 2 + (p2y - p3y) ** 2
+    floor = min_margin * min_margin * L1s
+    for k in range(1, poses.shape[2]):
+        X1, Y1 = apply_pose(poses, K1, k, p1x, p1y)
+        X3, Y3 = apply_pose(poses, K2, k, p3x, p3y)
+        Dx, Dy = X3 - X1, Y3 - Y1
+        d2 = Dx * Dx + Dy * Dy
+        inv_d = 1.0 / np.sqrt(d2)  # one division for the three below
+        a = (L1s - L2s + d2) * (0.5 * inv_d)
+        h2 = L1s - a * a
+        h = np.sqrt(max(h2, 0.0))
+        code = NO_SOLUTION if (d2 == 0.0) | (h2 < 0.0) else (NEAR_SINGULAR if h * h < floor else CLEAN)
+        first_status(status, k, code)
+        X2 = X1 + (a * Dx - mode * h * Dy) * inv_d
+        Y2 = Y1 + (a * Dy + mode * h * Dx) * inv_d
+        set_pose_turning(poses, B1, k, p1x, p1y, X1, Y1, p2x - p1x, p2y - p1y, X2 - X1, Y2 - Y1)
+        set_pose_turning(poses, B2, k, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
+
+
+@kernel(error_model="numpy")
+def place_prp(joint_geo, dyad, poses, min_margin, status):
+    """A PRP dyad at every point ``k >= 1``: the middle pivot where the two guide lines cross."""
+    j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
+    p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    d1x, d1y, d3x, d3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
+    for k in range(1, poses.shape[2]):
+        c1, s1, c3, s3 = poses[K1, 0, k], poses[K1, 1, k], poses[K2, 0, k], poses[K2, 1, k]
+        Ax, Ay = apply_pose(poses, K1, k, p2x, p2y)  # the guide lines: a point and the unit direction
+        Cx, Cy = apply_pose(poses, K2, k, p2x, p2y)
+        ax, ay = c1 * d1x - s1 * d1y, s1 * d1x + c1 * d1y
+        cx, cy = c3 * d3x - s3 * d3y, s3 * d3x + c3 * d3y
+        det = ax * cy - ay * cx
+        first_status(status, k, NEAR_SINGULAR if abs(det) < min_margin else CLEAN)
+        along = ((Cx - Ax) * cy - (Cy - Ay) * cx) / det
+        X2, Y2 = Ax + along * ax, Ay + along * ay
+        set_pose(poses, B1, k, c1, s1, p2x, p2y, X2, Y2)
+        set_pose(poses, B2, k, c3, s3, p2x, p2y, X2, Y2)
+
+
+@kernel(error_model="numpy")
+def place_rrp(joint_int, joint_geo, dyad, mode, poses, min_margin, status):
+    """An RRP or PRR dyad at every point ``k >= 1``: a circle about the revolute side's pivot and the prismatic
+    side's line."""
+    j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
+    if joint_int[j1, 0] == REVOLUTE:
+        jr, Kr, Br, jp, Kp, Bp = j1, K1, B1, j3, K2, B2
+    else:
+        jr, Kr, Br, jp, Kp, Bp = j3, K2, B2, j1, K1, B1
+    p2x, p2y = joint_geo[j2, 0], joint_geo[j2, 1]
+    prx, pry = joint_geo[jr, 0], joint_geo[jr, 1]
+    Ls = (p2x - prx) ** 2 + (p2y - pry) ** 2
+    floor = min_margin * min_margin * Ls
+    for k in range(1, poses.shape[2]):
+        Xr, Yr = apply_pose(poses, Kr, k, prx, pry)
+        Qx, Qy, ex, ey = guide_line(joint_geo, poses, jp, Kp, k, p2x, p2y)
         b = ex * (Qx - Xr) + ey * (Qy - Yr)
         c = (Qx - Xr) ** 2 + (Qy - Yr) ** 2 - Ls
         disc = b * b - c
-        if disc < 0.0:
-            return NO_SOLUTION
-        if disc < min_margin * min_margin * Ls:
-            return NEAR_SINGULAR
-        s = -b + mode * np.sqrt(disc)
+        first_status(status, k, NO_SOLUTION if disc < 0.0 else (NEAR_SINGULAR if disc < floor else CLEAN))
+        s = -b + mode * np.sqrt(max(disc, 0.0))
         X2, Y2 = Qx + s * ex, Qy + s * ey
-        set_pose_turning(poses, Br, prx, pry, Xr, Yr, p2x - prx, p2y - pry, X2 - Xr, Y2 - Yr)
-        set_pose(poses, Bp, poses[Kp, 0], poses[Kp, 1], p2x, p2y, X2, Y2)
-        return CLEAN
-    if k1 == REVOLUTE and k3 == REVOLUTE:  # RPR: B1 and B2 turn together; B2's pivot on B1's line
-        p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
-        # The slide's direction in B1 (the before body of j2 may be either dyad body: a line is a line).
-        dx, dy = joint_geo[j2, 0], joint_geo[j2, 1]
-        h0 = dx * (p3y - p1y) - dy * (p3x - p1x)  # signed distance of the line from p1, constant in B1
-        X1, Y1 = apply_pose(poses, K1, p1x, p1y)
-        X3, Y3 = apply_pose(poses, K2, p3x, p3y)
+        set_pose_turning(poses, Br, k, prx, pry, Xr, Yr, p2x - prx, p2y - pry, X2 - Xr, Y2 - Yr)
+        set_pose(poses, Bp, k, poses[Kp, 0, k], poses[Kp, 1, k], p2x, p2y, X2, Y2)
+
+
+@kernel(error_model="numpy")
+def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
+    """An RPR dyad at every point ``k >= 1``: ``B1`` and ``B2`` turn together, ``B2``'s pivot on ``B1``'s line."""
+    j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
+    p1x, p1y, p3x, p3y = joint_geo[j1, 0], joint_geo[j1, 1], joint_geo[j3, 0], joint_geo[j3, 1]
+    # The slide's direction in B1 (the before body of j2 may be either dyad body: a line is a line).
+    dx, dy = joint_geo[j2, 0], joint_geo[j2, 1]
+    h0 = dx * (p3y - p1y) - dy * (p3x - p1x)  # signed distance of the line from p1, constant in B1
+    floor = min_margin * min_margin
+    for k in range(1, poses.shape[2]):
+        X1, Y1 = apply_pose(poses, K1, k, p1x, p1y)
+        X3, Y3 = apply_pose(poses, K2, k, p3x, p3y)
         Dx, Dy = X3 - X1, Y3 - Y1
         rho2 = Dx * Dx + Dy * Dy
         along2 = rho2 - h0 * h0
-        if along2 < 0.0 or rho2 == 0.0:
-            return NO_SOLUTION
-        if along2 < min_margin * min_margin * rho2:
-            return NEAR_SINGULAR
-        along = mode * np.sqrt(along2)
+        near = along2 < floor * rho2
+        first_status(
+            status, k, NO_SOLUTION if (along2 < 0.0) | (rho2 == 0.0) else (NEAR_SINGULAR if near else CLEAN)
+        )
+        along = mode * np.sqrt(max(along2, 0.0))
         # The turn takes the line's direction d (at angle psi from D in B1's frame) onto D's direction:
         # e^{i phi} = (D / rho) conj(d) conj(e^{i psi}), e^{i psi} = (along + i h0) / rho.
         cx, cy = Dx * dx + Dy * dy, Dy * dx - Dx * dy  # D conj(d)
         c = (cx * along + cy * h0) / rho2
         s = (cy * along - cx * h0) / rho2
-        set_pose(poses, B1, c, s, p1x, p1y, X1, Y1)
-        set_pose(poses, B2, c, s, p3x, p3y, X3, Y3)
-        return CLEAN
-    return UNSUPPORTED
+        set_pose(poses, B1, k, c, s, p1x, p1y, X1, Y1)
+        set_pose(poses, B2, k, c, s, p3x, p3y, X3, Y3)
 
 
-@kernel(inline="always")
-def joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q):
-    """Every joint's displacement from its bodies' poses (revolute ones continued from ``q_prev``), the drive's
-    set to ``drive_q``; returns the largest change of a joint (the drive's wrapped for a revolute drive, as its
-    value read back from the poses would be)."""
-    jump = 0.0
+@kernel()
+def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
+    """Every dyad of the plan at every point ``k >= 1``, in solving order (each a loop over the points); sets
+    ``status[k]`` to the first dyad's failure at point ``k`` (:data:`UNSUPPORTED` for a dyad of no solved kind)."""
+    for i in range(dyads.shape[0]):
+        dyad = dyads[i]
+        k1, k2, k3 = joint_int[dyad[0], 0], joint_int[dyad[1], 0], joint_int[dyad[2], 0]
+        if k2 == REVOLUTE and k1 == REVOLUTE and k3 == REVOLUTE:
+            place_rrr(joint_geo, dyad, modes[i], poses, min_margin, status)
+        elif k2 == REVOLUTE and k1 == PRISMATIC and k3 == PRISMATIC:
+            place_prp(joint_geo, dyad, poses, min_margin, status)
+        elif k2 == REVOLUTE:
+            place_rrp(joint_int, joint_geo, dyad, modes[i], poses, min_margin, status)
+        elif k1 == REVOLUTE and k3 == REVOLUTE:
+            place_rpr(joint_geo, dyad, modes[i], poses, min_margin, status)
+        else:
+            for k in range(1, poses.shape[2]):
+                first_status(status, k, UNSUPPORTED)
+
+
+@kernel(error_model="numpy")
+def read_angles(ca, sa, cb, sb, rel, omega, q):
+    """A revolute joint between bodies of rotations ``(ca, sa)`` and ``(cb, sb)`` at every point: ``rel = (c,
+    s)`` of ``R_a^T R_b``, and (unless ``q`` is empty) ``q[k] = omega atan2(s[k], c[k])`` by the branch-free
+    :func:`~linkwork.kinematics.trig.atan2`."""
+    c, s = rel[0], rel[1]
+    if q.shape[0] == 0:
+        for k in range(c.shape[0]):
+            c[k] = ca[k] * cb[k] + sa[k] * sb[k]
+            s[k] = ca[k] * sb[k] - sa[k] * cb[k]
+        return
+    for k in range(c.shape[0]):
+        ck = ca[k] * cb[k] + sa[k] * sb[k]
+        sk = ca[k] * sb[k] - sa[k] * cb[k]
+        c[k] = ck
+        s[k] = sk
+        q[k] = omega * atan2(sk, ck)
+
+
+@kernel(error_model="numpy")
+def angle_steps(q, turns, jump):
+    """The step of an angle read in ``[-pi, pi]`` into each point ``k >= 1``, wrapped onto ``[-pi, pi)``: ``turns[k]``
+    the whole turns the wrapping added (-1, 0, 1), ``jump[k]`` raised to the wrapped step's size where larger;
+    returns the number of points with a turn."""
+    count = 0
+    for k in range(1, q.shape[0]):
+        step = q[k] - q[k - 1]
+        turn = -1.0 if step >= np.pi else (1.0 if step < -np.pi else 0.0)
+        size = abs(step + TWO_PI * turn)
+        turns[k] = turn
+        jump[k] = size if size > jump[k] else jump[k]
+        count += 0 if turn == 0.0 else 1
+    return count
+
+
+@kernel(error_model="numpy")
+def slide_values(ca, sa, ta, tb, dx, dy, q):
+    """``q[k] = d . R_a^T (t_b - t_a)``: a prismatic joint's value along its unit direction ``d = (dx, dy)`` from
+    the rotation ``(ca, sa)`` of its before body and both bodies' translations ``ta``, ``tb`` (``(2, K)``)."""
+    for k in range(q.shape[0]):
+        tx, ty = tb[0, k] - ta[0, k], tb[1, k] - ta[1, k]
+        q[k] = dx * (ca[k] * tx + sa[k] * ty) + dy * (-sa[k] * tx + ca[k] * ty)
+
+
+@kernel(error_model="numpy")
+def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry):
+    """Every joint's value at every point from its bodies' poses: ``q[j, k]``; revolute ones continued from
+    point to point (each point's step wrapped onto ``[-pi, pi)``), the drive's ``drive_q``. ``rel[j] = (cos,
+    sin)`` of a joint's relative rotation ``R_a^T R_b`` (``Rz(omega_z q)`` for a revolute joint, the identity for
+    a prismatic one); ``jump[k]``: the largest step of a joint into point ``k >= 1`` (the drive's wrapped for a
+    revolute drive), as the point-by-point march reads it.
+
+    ``carry = (start, total, turns)``: each joint's value at point 0 (the last point of the block before), the
+    whole turns its angle has made there (updated to the last point's, for the next block), and scratch ``(K,)``.
+
+    The angles come from the branch-free :func:`~linkwork.kinematics.trig.atan2` (vectorised); a revolute
+    joint's value is ``raw + 2 pi n`` with ``raw`` the angle read back and ``n`` the count of turns, a running sum
+    of the integer steps (so no round-off accumulates along the path).
+    """
+    start, total, turns = carry
+    K = poses.shape[2]
     for j in range(joint_int.shape[0]):
-        if j == drive:
-            q[j] = drive_q
-            step = drive_q - q_prev[j]
-            jump = max(jump, abs(wrap_angle(step) if joint_int[j, 0] == REVOLUTE else step))
-            continue
         a, b = joint_int[j, 1], joint_int[j, 2]
-        ca, sa = poses[a, 0], poses[a, 1]
-        if joint_int[j, 0] == REVOLUTE:  # R_a^T R_b = Rz(omega_z q)
-            c = ca * poses[b, 0] + sa * poses[b, 1]
-            s = ca * poses[b, 1] - sa * poses[b, 0]
-            raw = joint_geo[j, 2] * np.arctan2(s, c)
-            q[j] = q_prev[j] + wrap_angle(raw - q_prev[j])
-        else:  # R_a^T (t_b - t_a) = q d
-            tx, ty = poses[b, 2] - poses[a, 2], poses[b, 3] - poses[a, 3]
-            q[j] = joint_geo[j, 0] * (ca * tx + sa * ty) + joint_geo[j, 1] * (-sa * tx + ca * ty)
-        jump = max(jump, abs(q[j] - q_prev[j]))
-    return jump
+        revolute = joint_int[j, 0] == REVOLUTE
+        if revolute:  # also the drive's relative rotation (the closure's exp reads it; its value is drive_q)
+            angles = q[j, :0] if j == drive else q[j]
+            read_angles(poses[a, 0], poses[a, 1], poses[b, 0], poses[b, 1], rel[j], joint_geo[j, 2], angles)
+        else:
+            rel[j, 0, :] = 1.0
+            rel[j, 1, :] = 0.0
+        if j == drive:
+            q[j, :] = drive_q
+            for k in range(1, K):
+                step = drive_q[k] - drive_q[k - 1]
+                wrapped = step - TWO_PI * np.floor((step + np.pi) * (1.0 / TWO_PI))  # any number of turns
+                size = abs(wrapped if revolute else step)
+                jump[k] = size if size > jump[k] else jump[k]
+        elif revolute:
+            n = total[j]
+            if angle_steps(q[j], turns, jump) > 0:
+                for k in range(1, K):  # the running count of turns (whole numbers: exact)
+                    n += turns[k]
+                    q[j, k] += TWO_PI * n
+            elif n != 0.0:
+                for k in range(1, K):
+                    q[j, k] += TWO_PI * n
+            total[j] = n
+        else:
+            slide_values(
+                poses[a, 0], poses[a, 1], poses[a, 2:], poses[b, 2:], joint_geo[j, 0], joint_geo[j, 1], q[j]
+            )
+            for k in range(1, K):
+                size = abs(q[j, k] - q[j, k - 1])
+                jump[k] = size if size > jump[k] else jump[k]
+        q[j, 0] = start[j]
 
 
-@kernel(inline="always")
-def planar_closure(flat, q, residual, jac, m, E):
+@kernel(error_model="numpy")
+def turn_column(product, col1, col2, rel, sign, w, vx, vy):
+    """A revolute loop joint at every point: rows 2 and 3 of its Jacobian column ``Ad(g) xi = (w, R v + p x (0,
+    0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2``, with ``g = product = (cos, sin, p_x, p_y)`` the loop's
+    product before the joint, then ``g <- g exp(xi q)``: the rotation ``rel = (c, sign s)``, the translation
+    ``(I - R)(w x v)`` (``w . v = 0`` in the plane)."""
+    c, s, px, py = product[0], product[1], product[2], product[3]
+    rc, rs = rel[0], rel[1]
+    ax, ay = -w * vy, w * vx
+    for k in range(c.shape[0]):
+        ck, sk, xk, yk = c[k], s[k], px[k], py[k]
+        col1[k] += ck * vx - sk * vy + yk * w
+        col2[k] += sk * vx + ck * vy - xk * w
+        cr, sr = rc[k], sign * rs[k]
+        ex = ax - (cr * ax - sr * ay)
+        ey = ay - (sr * ax + cr * ay)
+        px[k] = xk + (ck * ex - sk * ey)
+        py[k] = yk + (sk * ex + ck * ey)
+        c[k] = ck * cr - sk * sr
+        s[k] = sk * cr + ck * sr
+
+
+@kernel(error_model="numpy")
+def slide_column(product, col1, col2, q, vx, vy):
+    """A prismatic loop joint at every point: its Jacobian column's rows 2 and 3 (``R v``) added to ``col1``,
+    ``col2``, then ``g <- g exp(xi q)``: the translation ``v q``."""
+    c, s, px, py = product[0], product[1], product[2], product[3]
+    for k in range(c.shape[0]):
+        ck, sk = c[k], s[k]
+        col1[k] += ck * vx - sk * vy
+        col2[k] += sk * vx + ck * vy
+        ex, ey = vx * q[k], vy * q[k]
+        px[k] += ck * ex - sk * ey
+        py[k] += sk * ex + ck * ey
+
+
+@kernel(error_model="numpy")
+def loop_log(c, s, px, py, angle, share):
+    """The twist ``log(g)`` of the loop product at every point (as ``kernels.log_rigid``): the angle ``t``, then
+    ``v = p - (w x p)/2 + D w x (w x p)`` with ``D`` by its Taylor series (a closed loop turns by round-off);
+    ``share[k]`` its squared norm, ``angle[k] = t``. Returns the number of points where ``|t| >= 1e-2`` (there
+    the series does not hold: the caller uses :func:`~linkwork.kinematics.kernels.log_coefficient`)."""
+    wide = 0
+    for k in range(c.shape[0]):
+        t = atan2(s[k], c[k])
+        t2 = t * t
+        # (products by the reciprocals, folded at compile time: no division in the loop)
+        D = 1.0 / 12.0 + t2 * (1.0 / 720.0) + t2 * t2 * (1.0 / 30240.0) + t2 * t2 * t2 * (1.0 / 1209600.0)
+        x = px[k] + 0.5 * t * py[k] - D * t2 * px[k]
+        y = py[k] - 0.5 * t * px[k] - D * t2 * py[k]
+        angle[k] = t
+        share[k] = t2 + x * x + y * y
+        wide += 0 if abs(t) < 1e-2 else 1
+    return wide
+
+
+@kernel(error_model="numpy")
+def planar_closure(flat, rel, q, jac, res, scratch):
     """Planar closure residual ``(omega_z, v_x, v_y)`` of ``log(P)`` per loop and its ``(E, m)`` Jacobian in the
-    unknowns, for ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``.
+    unknowns at every point ``k < K``: ``jac (E, m, K)`` (point index last), ``res (K,)`` the residual's norm;
+    ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``, ``q (n, K)`` the joint values, ``rel (n, 2,
+    K)`` each joint's relative rotation (from :func:`joint_values`); ``scratch = (product (4, K), angle (K,),
+    share (K,))``.
 
     :func:`linkwork.kinematics.kernels.closure_pass` with rows ``(2, 3, 4)`` for twists in the plane, in SE(2):
-    columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)).
-    ``m`` and ``E`` are the Jacobian's sizes (literal constants at a call site for one loop: the loops unroll).
+    columns ``s Ad(g) xi`` (G&P Eq. (21)), the residual the twist ``log(g)`` of the loop product (Eq. (23)). A
+    revolute joint's ``exp`` uses the cosine and sine of its relative rotation as the bodies' poses give them,
+    which equal those of its reported value to an ulp (the value is read back from them by an ``atan2``): no
+    sine or cosine is evaluated here. Each step is one loop over the points on 1-d arrays (straight-line code
+    that vectorises).
     """
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
-    for e in range(E):
-        for c in range(m):
-            jac[e, c] = 0.0
-    for k in range(E // 3):
-        cg, sg, px, py = 1.0, 0.0, 0.0, 0.0
-        for idx in range(loop_ptr[k], loop_ptr[k + 1]):
+    E, K = jac.shape[0], jac.shape[2]
+    # the loop product's partial (cos, sin, p_x, p_y); its log's angle and norm
+    product, angle, share = scratch
+    jac[:] = 0.0
+    res[:] = 0.0
+    for loop in range(E // 3):
+        c, s, px, py = product[0], product[1], product[2], product[3]
+        c[:] = 1.0
+        s[:] = 0.0
+        px[:] = 0.0
+        py[:] = 0.0
+        for idx in range(loop_ptr[loop], loop_ptr[loop + 1]):
             j = loop_joint[idx]
             sign = float(loop_sign[idx])
             w = sign * twists[j, 2]
             vx, vy = sign * twists[j, 3], sign * twists[j, 4]
+            # every joint is its own unknown in a dyad plan; a fixed one would add to a scratch column
             g = groups[j]
-            if g >= 0:  # Ad(g) xi: (w, R v + p x (0, 0, w))
-                jac[3 * k, g] += w
-                jac[3 * k + 1, g] += cg * vx - sg * vy + py * w
-                jac[3 * k + 2, g] += sg * vx + cg * vy - px * w
-            theta = q[j]
-            if w != 0.0:  # exp: rotation by w theta, translation (I - R)(w x v) (w . v = 0 in the plane)
-                ce, se = np.cos(w * theta), np.sin(w * theta)
-                ax, ay = -w * vy, w * vx
-                ex = ax - (ce * ax - se * ay)
-                ey = ay - (se * ax + ce * ay)
+            col1, col2 = (jac[3 * loop + 1, g], jac[3 * loop + 2, g]) if g >= 0 else (angle, share)
+            if g >= 0:
+                jac[3 * loop, g, :] += w
+            if w != 0.0:
+                turn_column(product, col1, col2, rel[j], sign, w, vx, vy)
             else:
-                ce, se = 1.0, 0.0
-                ex, ey = vx * theta, vy * theta
-            px += cg * ex - sg * ey
-            py += sg * ex + cg * ey
-            cg, sg = cg * ce - sg * se, sg * ce + cg * se
-        # log of the planar motion (as kernels.log_rigid): angle, then v = p - (w x p)/2 + D w x (w x p)
-        t = np.arctan2(sg, cg)
-        D = log_coefficient(abs(t))
-        residual[3 * k] = t
-        residual[3 * k + 1] = px + 0.5 * t * py - D * t * t * px
-        residual[3 * k + 2] = py - 0.5 * t * px - D * t * t * py
+                slide_column(product, col1, col2, q[j], vx, vy)
+        if loop_log(c, s, px, py, angle, share) > 0:  # a loop that does not close (never after a dyad solve)
+            for k in range(K):
+                t = angle[k]
+                if abs(t) >= 1e-2:
+                    D = log_coefficient(abs(t))
+                    x = px[k] + 0.5 * t * py[k] - D * t * t * px[k]
+                    y = py[k] - 0.5 * t * px[k] - D * t * t * py[k]
+                    share[k] = t * t + x * x + y * y
+        res += share
+    for k in range(K):
+        res[k] = np.sqrt(res[k])
 
 
 @kernel(inline="always")
@@ -423,20 +606,6 @@ def triangle_singular_values(M, W, V, sigma, E):
 
 
 @kernel(inline="always")
-def jacobian_rows(flat, q, work, m, E):
-    """At joint values ``q``: the closure residual and Jacobian, the Householder QR of ``J^T`` and the tangent
-    (``Q``'s last column), into ``work = (res, jac, M, beta, t)``; returns ``det(Q) det(R)`` (``R`` is the
-    upper triangle of ``M[:E]``). ``m, E`` are the sizes (literal constants for one loop: the loops unroll)."""
-    res, jac, M, beta, t = work
-    planar_closure(flat, q, res, jac, m, E)
-    det = qr_of_transpose(jac, M, beta, m, E)
-    null_vector(M, beta, t, m, E)
-    for e in range(E):
-        det *= M[e, e]
-    return det
-
-
-@kernel(inline="always")
 def warm_singular_values(R, W, V, history, sigma, E):
     """:func:`triangle_singular_values` of the triangle ``R`` warm-started from the right singular vectors
     extrapolated from the last three points (``V``, then ``history = (V_1, V_2)`` one and two points back):
@@ -452,7 +621,48 @@ def warm_singular_values(R, W, V, history, sigma, E):
     triangle_singular_values(R, W, V, sigma, E)
 
 
+@kernel(inline="always")
+def rows_at_point(jac, k, M, beta, t, W, V, history, sig, m, E):
+    """At point ``k`` of ``jac (E, m, K)``: the Householder QR of ``J^T`` in ``M``, the tangent ``t`` (``Q``'s last
+    column) and the singular values ``sig`` (warm-started, :func:`warm_singular_values`); returns
+    ``det([J; t^T]) = det(Q) det(R)``. ``m, E``: the sizes (literal constants for one loop: the loops unroll)."""
+    det = qr_of_transpose(jac[:, :, k], M, beta, m, E)
+    null_vector(M, beta, t, m, E)
+    for e in range(E):
+        det *= M[e, e]
+    warm_singular_values(M, W, V, history, sig, E)
+    return det
+
+
 @kernel()
+def rows_at_points(jac, sigma, tangent, raw_tau, begin, state):
+    """The rows of :func:`closed_form_path` from the Jacobians ``jac (E, m, K)``, point by point from ``begin``:
+    ``sigma (E, K)`` descending, ``tangent (m, K)`` a unit null vector (either sign), ``raw_tau (K,) = det([J;
+    t^T])`` for that tangent; returns 0 (the number of points without a clean answer, as the batched one-loop
+    kernel reports).
+
+    The singular values by one-sided Jacobi on the triangle of a Householder QR of ``J^T``, warm-started from the
+    right singular vectors extrapolated from the last three points: ``state = (V, V_1, V_2)`` (the identity at the
+    start), carried from one block of points to the next."""
+    E, m, K = jac.shape[0], jac.shape[1], jac.shape[2]
+    M, beta, t = np.empty((m, E)), np.empty(2 * E), np.empty(m)
+    W = np.empty((E, E))
+    V, V_1, V_2 = state
+    history = (V_1, V_2)
+    sig = np.empty(E)
+    for k in range(begin, K):
+        if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
+            raw_tau[k] = rows_at_point(jac, k, M, beta, t, W, V, history, sig, 4, 3)
+        else:
+            raw_tau[k] = rows_at_point(jac, k, M, beta, t, W, V, history, sig, m, E)
+        for e in range(E):
+            sigma[e, k] = sig[e]
+        for a in range(m):
+            tangent[a, k] = t[a]
+    return 0
+
+
+@kernel(error_model="numpy")
 def closed_form_path(flat, plan, run):
     """The paper-mode path of a driver-and-dyads mechanism from its reference, in closed form, with its rows.
 
@@ -464,12 +674,13 @@ def closed_form_path(flat, plan, run):
     Returns ``(count, status, u, sigma, res, tau, s)``: rows ``0 .. count - 1`` (row 0 the start), status
     :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
 
-    Three passes over the points (the last two a block of :data:`BLOCK` points at a time), each a short loop,
-    give what one pass point by point would: the positions (dyads and joint values, up to the
-    first point where a dyad has no solution or a joint jumps); at each of those points the Jacobian, its QR and
-    the tangent; then, point by point, the singular values (warm-started from the point before), the tangent's
-    orientation, the test function and every check, in the order of the one-pass loop, so the same point ends
-    the path with the same status.
+    Passes over all points, each array indexed by the point last (structure of arrays), each pass a loop over
+    the points with straight-line bodies that vectorise: the drive's poses, each dyad's two bodies, every joint's
+    value (then a scan finds the first point a dyad could not be placed or a joint jumped); the closure residual
+    and Jacobian at those points; the tangent, test function and singular values from the Jacobians; then one
+    scalar pass, point by point, orients the tangent and makes every check in the order of the point-by-point
+    march (``far`` and the tangent's orientation carry from point to point), so the same point ends the path
+    with the same status.
     """
     groups = flat[4]
     joint_int, joint_geo, dyads, modes, head = plan
@@ -481,110 +692,151 @@ def closed_form_path(flat, plan, run):
     h, target, hmax = settings[S_STEP], settings[S_TARGET], settings[S_HMAX]
     min_ratio, min_drive, min_margin = settings[S_MIN_RATIO], settings[S_MIN_DRIVE], settings[S_MIN_MARGIN]
     det_basis = settings[S_DET_BASIS]
-    drive, driven = head[0], head[1]
+    drive = head[0]
     g_drive = groups[drive]
     out_u = np.zeros((steps + 1, m))
     out_sigma = np.zeros((steps + 1, E))
     out_res = np.zeros(steps + 1)
     out_tau = np.zeros(steps + 1)
     out_s = np.zeros(steps + 1)
-    # Pass 1: positions. Rows 0 .. last are placed; ``ended`` says why row last + 1 could not be (CLEAN: none).
-    poses = np.zeros((head[2], 4))
-    for b in range(head[2]):
-        poses[b, 0] = 1.0  # the fixed body keeps the identity; every other body is placed at every point
-    q = np.zeros(n)
-    q_prev = np.zeros(n)
-    last, ended = steps, CLEAN
-    for k in range(1, steps + 1):
-        drive_q = q_prev[drive] + h if k < steps else target
-        place_driven(joint_int, joint_geo, drive, driven, drive_q, poses)
-        for i in range(dyads.shape[0]):
-            status = place_dyad(joint_int, joint_geo, dyads[i], modes[i], poses, min_margin)
-            if status != CLEAN:
-                ended = status
-                break
-        if (
-            ended == CLEAN
-            and joint_values(joint_int, joint_geo, poses, q_prev, q, drive, drive_q) > 0.5 * np.pi
-        ):
-            ended = JUMP
-        if ended != CLEAN:
-            last = k - 1
-            break
-        for j in range(n):
-            out_u[k, groups[j]] = q[j]
-            q_prev[j] = q[j]
-    # Passes 2 and 3, a block of points at a time (the block's scratch stays in the cache).
-    tri = np.empty((BLOCK, E, E))
-    tangents = np.empty((BLOCK, m))
-    work = (np.empty(E), np.empty((E, m)), np.empty((m, E)), np.empty(2 * E), np.empty(m))
-    M, t = work[2], work[4]
-    V = np.eye(E)  # the right singular vectors, carried from point to point
-    history = (np.eye(E), np.eye(E))
-    W = np.empty((E, E))
-    sig = np.empty(E)
-    t_prev = t0.copy()
+    # A block's arrays: column i is point first - 1 + i; column 0 the block before's last point (the start for
+    # the first block), columns 1 .. BLOCK this block's points (past the last point: harmless extrapolation).
+    C = BLOCK + 1
+    drive_q = np.zeros(C)
+    poses = np.zeros((head[2], 4, C))
+    poses[:, 0, :] = 1.0  # the fixed body keeps the identity, every body is the reference at the start
+    status = np.zeros(C, dtype=np.int64)
+    rel = np.empty((n, 2, C))
+    q = np.empty((n, C))
+    jump = np.empty(C)
+    carry = (np.zeros(n), np.zeros(n), np.zeros(C))  # each joint's value at column 0, its whole turns there
+    scratch = (np.empty((4, C)), np.empty(C), np.empty(C))
+    jac = np.empty((E, m, C))
+    res = np.empty(C)
+    sigma = np.empty((E, C))
+    tangent = np.empty((m, C))
+    raw_tau = np.empty(C)
+    measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))
+    align, dist, wrapped, outside = measures
+    flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
+    svd_state = (np.eye(E), np.eye(E), np.eye(E))  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
-    for first in range(0, last + 1, BLOCK):
-        stop = min(first + BLOCK, last + 1)
-        # Pass 2: at every point of the block, the Jacobian's triangle R, the tangent and det(Q) det(R).
-        for k in range(first, stop):
-            i = k - first
-            for j in range(n):
-                q[j] = out_u[k, groups[j]]
-            if E == 3:  # one loop (a four-bar, a slider-crank): sizes known, the small loops unroll
-                out_tau[k] = jacobian_rows(flat, q, work, 4, 3)
-            else:
-                out_tau[k] = jacobian_rows(flat, q, work, m, E)
-            acc = 0.0
-            for e in range(E):
-                acc += work[0][e] * work[0][e]
-                for c in range(E):
-                    tri[i, e, c] = M[e, c]
-            out_res[k] = np.sqrt(acc)
-            for a in range(m):
-                tangents[i, a] = t[a]
-        # Pass 3: point by point, singular values, orientation, test function and the checks.
-        for k in range(first, stop):
-            i = k - first
-            if E == 3:
-                warm_singular_values(tri[i], W, V, history, sig, 3)
-            else:
-                warm_singular_values(tri[i], W, V, history, sig, E)
-            dot = 0.0
-            for a in range(m):
-                dot += tangents[i, a] * t_prev[a]
-            orient = -1.0 if dot < 0.0 else 1.0
-            tau = det_basis * out_tau[k] * orient
-            t_drive = tangents[i, g_drive]
-            # Where the predictor-corrector would do more than step: hand over to it.
-            if sig[E - 1] < min_ratio * sig[0] or abs(t_drive) < min_drive:
-                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-            if k > 0 and (orient * t_drive) * h <= 0.0:
-                return k, NEAR_SINGULAR, out_u, out_sigma, out_res, out_tau, out_s
-            if k > 0 and tau * out_tau[k - 1] < 0.0:
-                return k, SIGN_CHANGE, out_u, out_sigma, out_res, out_tau, out_s
-            dist = 0.0
-            wrapped = 0.0
-            for g in range(m):
-                x = out_u[k, g]
-                if x < lo[g] or x > hi[g]:
-                    return k, LIMIT, out_u, out_sigma, out_res, out_tau, out_s
-                du = x - out_u[k - 1, g] if k > 0 else 0.0
-                dist += du * du
-                x = wrap_angle(x) if periodic[g] else x
-                wrapped += x * x
-            for a in range(m):
-                t_prev[a] = orient * tangents[i, a]
-            for e in range(E):
-                out_sigma[k, e] = sig[e]
-            out_tau[k] = tau
-            out_s[k] = out_s[k - 1] + np.sqrt(dist) if k > 0 else 0.0
+    orient = 1.0
+    for first in range(1, steps + 1, BLOCK):
+        # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
+        for i in range(1, C):
+            k = first - 1 + i
+            drive_q[i] = target if k == steps else drive_q[i - 1] + h
+        status[:] = CLEAN
+        jump[:] = 0.0
+        place_driver(joint_int, joint_geo, head, drive_q, poses)
+        place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
+        joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry)
+        size, ended = min(BLOCK, steps + 1 - first), CLEAN  # points of the block placed; why the next was not
+        for i in range(1, size + 1):
+            code = JUMP if status[i] == CLEAN and jump[i] > 0.5 * np.pi else status[i]
+            if code != CLEAN:
+                size, ended = i - 1, code
+                break
+        for i in range(size + 1, C):  # past the block's last point: its copies (no NaN, no work for the rows)
+            rel[:, :, i] = rel[:, :, size]
+            q[:, i] = q[:, size]
+        # The Jacobians and their rows (the tangent, det([J; t^T]), the singular values), column 0 included.
+        planar_closure(flat, rel, q, jac, res, scratch)
+        if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
+            one_loop_rows(jac, sigma, tangent, raw_tau)
+        else:
+            rows_at_points(jac, sigma, tangent, raw_tau, 0 if first == 1 else 1, svd_state)
+        for x in measures:
+            x[:] = 0.0
+        path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)
+        # The tangent's orientation (continuous from point to point, the start's at row 0), then the test function
+        # and every check at every point, then, point by point, the first point that fails (in the march's order:
+        # a rank or drive check, a sign change, a limit, then the closed path after the point is stored).
+        begin = 0 if first == 1 else 1
+        for i in range(begin, size + 1):
+            orient = -1.0 if align[i] * (orient if first + i > 1 else 1.0) < 0.0 else 1.0
+            flips[i] = orient
+        taus[0] = out_tau[first - 1]
+        for i in range(begin, size + 1):
+            taus[i] = det_basis * raw_tau[i] * flips[i]
+        for i in range(begin, size + 1):
+            later = first + i > 1  # not the start
+            t_drive = tangent[g_drive, i]
+            singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
+            turned = later & ((flips[i] * t_drive) * h <= 0.0)
+            crossed = later & (taus[i] * taus[i - 1] < 0.0)
+            code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
+            status[i] = LIMIT if code == CLEAN and outside[i] > 0.0 else code
+        stop, code = size + 1, ended
+        arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
+        for i in range(begin, size + 1):
+            k = first - 1 + i
+            if status[i] != CLEAN:
+                stop, code = i, status[i]
+                break
+            arc = arc + dist[i] if k > 0 else 0.0
+            out_s[k] = arc
             if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-                d = np.sqrt(wrapped)
-                far = max(far, d)
+                d = wrapped[i]
+                far = far if far >= d else d
                 if far > 4.0 * hmax and d < 1.5 * abs(h):
-                    return k, CLOSED, out_u, out_sigma, out_res, out_tau, out_s
-    if ended != CLEAN:
-        return last + 1, ended, out_u, out_sigma, out_res, out_tau, out_s
+                    stop, code = i, CLOSED  # row k is stored, but the path ends before it
+                    break
+        for j in range(n):
+            g = groups[j]
+            for i in range(begin, stop + 1 if code == CLOSED else stop):
+                out_u[first - 1 + i, g] = q[j, i]
+        for e in range(E):
+            for i in range(begin, stop + 1 if code == CLOSED else stop):
+                out_sigma[first - 1 + i, e] = sigma[e, i]
+        for i in range(begin, stop + 1 if code == CLOSED else stop):
+            out_res[first - 1 + i] = res[i]
+            out_tau[first - 1 + i] = taus[i]
+        if stop <= size:
+            return first - 1 + stop, code, out_u, out_sigma, out_res, out_tau, out_s
+        if ended != CLEAN:
+            return first + size, ended, out_u, out_sigma, out_res, out_tau, out_s
+        # The block's last column is the next block's column 0.
+        poses[:, :, 0] = poses[:, :, BLOCK]
+        drive_q[0] = drive_q[BLOCK]
+        for j in range(n):
+            carry[0][j] = q[j, BLOCK]
+        sigma[:, 0] = sigma[:, BLOCK]
+        tangent[:, 0] = tangent[:, BLOCK]
+        raw_tau[0] = raw_tau[BLOCK]
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
+
+
+@kernel(error_model="numpy")
+def path_measures(q, groups, tangent, t0, bounds, measures):
+    """At every point ``k`` of a path of joint values ``q (n, K)`` with unit tangents ``tangent (m, K)``:
+    ``measures = (align, dist, wrapped, outside)``: ``align[k]`` the tangent's inner product with the one before
+    (``t0`` at ``k = 0``; orientations aside), ``dist[k]`` the step's length from ``k - 1``, ``wrapped[k]`` the
+    distance from the start with periodic unknowns wrapped onto ``[-pi, pi)``, ``outside[k]`` how many unknowns
+    are outside ``bounds = (lo, hi, periodic)``. Loops over the points, one unknown at a time (vectorised)."""
+    lo, hi, periodic = bounds
+    align, dist, wrapped, outside = measures
+    m, K = tangent.shape[0], tangent.shape[1]
+    for a in range(m):
+        align[0] += tangent[a, 0] * t0[a]
+        ta = tangent[a]
+        for k in range(1, K):
+            align[k] += ta[k] * ta[k - 1]
+    for j in range(q.shape[0]):
+        g = groups[j]
+        qj = q[j]
+        low, high, turn = lo[g], hi[g], TWO_PI if periodic[g] else 0.0
+        for k in range(1, K):
+            du = qj[k] - qj[k - 1]
+            dist[k] += du * du
+        for k in range(K):
+            x = qj[k]
+            outside[k] += 1.0 if (x < low) | (x > high) else 0.0
+            x -= turn * np.floor(
+                (x + np.pi) * (1.0 / TWO_PI)
+            )  # periodic: onto [-pi, pi) (geometry.angles.wrap)
+            wrapped[k] += x * x
+    for k in range(K):
+        dist[k] = np.sqrt(dist[k])
+        wrapped[k] = np.sqrt(wrapped[k])

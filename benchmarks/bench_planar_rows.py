@@ -1,0 +1,90 @@
+"""Batched rows of one-loop planar Jacobians: nanoseconds a point of ``planar_rows.one_loop_rows``.
+
+The four-bar and slider-crank built-ins are traced through one turn of the crank in ``--points`` equal steps; their
+closure Jacobians (``closure.jacobian``, outside the timing) are handed to
+:func:`linkwork.kinematics.planar_rows.one_loop_rows` in one call, best of ``--repeats`` calls in-process (goal:
+at most 10 ns a point). Gaussian random Jacobians are timed too (about a third of them fall back to the exact
+second pass: an upper bound of the cost). Printed per set: ns a point, the points the first pass could not certify
+(second pass: the 2x2 compression or the Jacobi SVD), and the largest error of the singular values against numpy's
+SVD relative to sigma_1. Timings on a loaded machine are only indicative (the load average is printed): run it on
+a quiet one. Writes ``benchmarks/results/planar_rows.json``.
+
+Run: ``python benchmarks/bench_planar_rows.py`` (``--points``, ``--repeats``, ``--out``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from threads import single_threaded
+
+import linkwork as lw
+from linkwork.kinematics.closure import jacobian
+from linkwork.kinematics.planar_rows import one_loop_rows
+
+ROOT = Path(__file__).resolve().parent
+RESULTS = ROOT / "results" / "planar_rows.json"
+
+
+def turn_jacobians(name: str, points: int) -> np.ndarray:
+    """``(points, 3, 4)`` closure Jacobians of built-in ``name`` along one turn of its crank."""
+    mech = lw.load(name)
+    trace = lw.trace(mech, until=("A", float(mech.offsets[0] + 2.0 * np.pi)), steps=points)
+    return np.array([jacobian(mech, q) for q in (trace.angles - mech.offsets)[:points]])
+
+
+def measure(J: np.ndarray, repeats: int) -> dict[str, float]:
+    """Best time of ``repeats`` calls on ``J (K, 3, 4)``, the second-pass points and the largest error."""
+    K = J.shape[0]
+    jac = np.ascontiguousarray(J.transpose(1, 2, 0))
+    sigma, tangent, raw_tau = np.empty((3, K)), np.empty((4, K)), np.empty(K)
+    second = one_loop_rows(jac, sigma, tangent, raw_tau)  # compile or load, and the results
+    best = np.inf
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        one_loop_rows(jac, sigma, tangent, raw_tau)
+        best = min(best, time.perf_counter() - t0)
+    s = np.linalg.svd(J, compute_uv=False)
+    error = float(np.max(np.abs(sigma.T - s) / s[:, :1]))
+    return {"points": K, "ns_per_point": best / K * 1e9, "second_pass": int(second), "sigma_error": error}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=3600)
+    parser.add_argument("--repeats", type=int, default=2000)
+    parser.add_argument("--out", type=Path, default=RESULTS)
+    args = parser.parse_args()
+    single_threaded()
+    sets = {
+        "four-bar": turn_jacobians("four-bar", args.points),
+        "slider-crank": turn_jacobians("slider-crank", args.points),
+        "random": np.random.default_rng(1).normal(size=(args.points, 3, 4)),
+    }
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"one_loop_rows, best of {args.repeats} calls (load average {load:.2f}; goal <= 10 ns a point)")
+    results = {}
+    for name, J in sets.items():
+        r = measure(J, args.repeats)
+        results[name] = r
+        print(
+            f"  {name:13s} {r['ns_per_point']:6.2f} ns a point   second pass {r['second_pass']:5d} of "
+            f"{r['points']} ({r['second_pass'] / r['points']:.1%})   sigma error {r['sigma_error']:.1e} sigma_1"
+        )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(
+        json.dumps({"load_average": load, "repeats": args.repeats, "sets": results}, indent=2)
+    )
+
+
+if __name__ == "__main__":
+    main()

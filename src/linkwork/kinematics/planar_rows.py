@@ -1,0 +1,311 @@
+"""Batched rows of one-loop planar Jacobians: at every point of a path, the singular values, a unit tangent and the
+raw test function of the ``3 x 4`` closure Jacobian, in closed form, vectorised across points.
+
+The planar closed-form path (:func:`linkwork.kinematics.dyad_solver.closed_form_path`) evaluates, at each of its
+``K`` points, the closure Jacobian ``J`` of a one-loop mechanism with one degree of freedom (a four-bar, a
+slider-crank): ``E = 3`` rows ``(omega_z, v_x, v_y)`` (G&P Eq. (21)), ``m = 4`` columns. What a trace reports
+from ``J`` (G&P Sec. 4 and 5: the zero-strain motion, the null vector of ``J``, and the singular values that
+measure the distance to a bifurcation) has for a ``3 x 4`` matrix a closed form:
+
+* The four signed ``3 x 3`` minors (cofactors) ``c_i = (-1)^(i+3) det(J without column i)`` span the null space:
+  ``J c = 0`` (each row of ``J`` bordered below ``J`` gives a determinant with two equal rows). So ``t = c / |c|``
+  is a unit tangent and ``det([J; t^T]) = c . t = |c|``: the raw test function.
+* The characteristic polynomial ``f(lambda) = lambda^3 - p1 lambda^2 + p2 lambda - p3`` of ``J J^T`` has ``p1``
+  the sum of the squares of ``J``'s entries, ``p2`` the sum of the squares of its eighteen ``2 x 2`` minors
+  (Lagrange's identity gives them row pair by row pair, ``|J_i|^2 |J_j|^2 - (J_i . J_j)^2``) and ``p3 = |c|^2``
+  (Cauchy-Binet). Its largest root ``lambda_1 = sigma_1^2`` is reached from Samuelson's upper bound of the roots
+  by two steps of Householder's fourth-order method (the same count in every lane, a division each). Dividing ``f`` by ``lambda -
+  lambda_1`` leaves ``x^2 - S x + P`` with ``S = p1 - lambda_1``, ``P = lambda_1 (lambda_1 - p1) + p2``; its
+  larger root is ``lambda_2 = sigma_2^2``, and ``sigma_3 = |c| / (sigma_1 sigma_2)`` (accurate relative to itself
+  however small).
+
+Each lane carries a first-order bound of its rounding errors (running error analysis of every sum, product and
+Horner step; a root's error is the bound of ``f`` there over ``|f'|``, with the residual ``|f|`` counted, so that
+an unconverged iteration is caught too). The first pass certifies the cofactors to :data:`TANGENT_TOL` (relative
+to ``|c|``), ``sigma_1`` to :data:`SIGMA_1_TOL` and ``sigma_2`` to :data:`SIGMA_2_TOL` (relative to ``sigma_1``).
+A second pass recomputes the lanes it could not certify: where only ``sigma_2`` failed (``lambda_2`` nearly
+double with ``lambda_3``: the coefficients' rounding moves such a root far), from the ``2 x 2`` compression of
+``J J^T`` off its top eigenvector (:func:`gap_lane`, no cancellation); elsewhere (``sigma_1 = sigma_2``, a near
+rank drop, a zero Jacobian) by the exact fall-back, a one-sided Jacobi SVD of ``J``
+(:func:`linkwork.kinematics.small_svd.jacobi_svd`, warm-started from the previous fall-back point when it is the
+point before).
+
+The first pass is straight-line code over the points (a fixed number of iterations, conditional expressions, no
+branches and no exceptions: ``error_model="numpy"``), which LLVM vectorises across points (packed ``vsqrtpd``,
+``vdivpd``, ``vfmadd`` on ``ymm`` registers). Every kernel here also runs as plain Python (the twins of
+:mod:`linkwork.kinematics.jit`): the scalars are Python floats and every divisor and square root is guarded, so a
+degenerate lane gives a flagged value, never an exception or a warning.
+
+References
+----------
+W. W. Gan, S. Pellegrino, Proc. IMechE Part C 220 (2006), Eq. (21) and Sec. 4-5 (the Jacobian, its null vector
+and singular values).
+N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM (2002): Sec. 3.1 and 5.1 (running
+error bounds of sums and of Horner's rule), Sec. 1.12 (the conditioning of a root).
+J. Stoer, R. Bulirsch, *Introduction to Numerical Analysis*, 3rd ed., Springer (2002), Sec. 5.5 (Newton's method
+on a polynomial with real roots from an upper bound of the largest root); A. S. Householder, *The Numerical
+Treatment of a Single Nonlinear Equation*, McGraw-Hill (1970), Sec. 4.4 (the methods of order ``d + 1``,
+``x + d (1/f)^(d-1) / (1/f)^(d)``, here ``d = 3``).
+E. Carlen, E. H. Lieb, M. Loss, Methods Appl. Anal. 13 (2006) 1-17 (``per(A) <= n! / n^(n/2) prod |a_i|``, which
+bounds the cofactors' rounding errors).
+G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed., Johns Hopkins (2013), Sec. 8.1.2 (Weyl: a symmetric
+matrix's eigenvalues move by at most the norm of its perturbation), Sec. 8.6.3 (one-sided Jacobi).
+P. A. Samuelson, J. Am. Stat. Assoc. 63 (1968) 1522-1525 (the upper bound ``mean + sqrt(n - 1) std`` of the roots).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from linkwork.kernel_cache import kernel
+from linkwork.kinematics.small_svd import jacobi_svd
+
+U = 2.0**-53
+"""The unit round-off of float64."""
+ROOT_STEPS = 2
+"""Steps of Householder's fourth-order method on the characteristic polynomial, the same in every lane (so that
+the loop vectorises)."""
+SIGMA_1_TOL = 2e-14
+"""A lane is certified when its error bound on ``sigma_1`` is below this times ``sigma_1``, ..."""
+SIGMA_2_TOL = 7e-14
+"""... its bound on ``sigma_2`` below this times ``sigma_1`` (then ``sigma_3``'s is below ``SIGMA_1_TOL +
+SIGMA_2_TOL + TANGENT_TOL < 1e-13`` times ``sigma_1``), ... The bound is mostly the measured residual of
+``lambda_2``, so errors do reach it: a lower value sends more points to the 2x2 compression (accurate to about
+1e-15, some 30 ns a point); 2e-14 gives 9e-15 on a four-bar's turn for about 1.3 ns a point more."""
+TANGENT_TOL = 8e-15
+"""... and its bound on the cofactors' error below this times ``|c|`` (the tangent's residual ``|J t|`` is then
+below this times ``sigma_1``, and the raw test function this relative)."""
+THIRD_UP = (1.0 + 4.0 * U) / 3.0
+"""A third, rounded up (Samuelson's bound, times it, stays above the largest root)."""
+FLOOR = 1e-300
+"""Divisors are at least this (a degenerate lane then gives finite nonsense, flagged, not an exception)."""
+FLAGGED = -np.inf
+"""The first pass's ``raw_tau`` of a lane it could not certify (a certified one is ``|c| > 0``; one whose tangent,
+raw test function and ``sigma_1`` it certified but not ``sigma_2`` is ``-|c|``)."""
+
+
+@kernel(inline="always")
+def fast_lane(jac, k, sigma, tangent, raw_tau):
+    """The closed form at point ``k`` (see the module's docstring) into ``sigma[:, k]``, ``tangent[:, k]`` and
+    ``raw_tau[k]``; ``raw_tau[k] = FLAGGED`` where its error bounds do not certify it.
+
+    The bounds are first-order running error bounds (``u`` the unit round-off): a sum of ``n`` products errs by
+    at most ``n u`` times the sum of their absolute values, bounded by Cauchy-Schwarz through the rows' squared
+    norms ``r_e``; a cofactor by ``5 u`` times the permanent of ``|J|`` without its column, at most ``6 / 3^(3/2)``
+    times the product of its rows' norms (Carlen, Lieb and Loss), so ``|dc|^2 <= 133 u^2 r0 r1 r2``; Horner's rule
+    by ``3 u`` times its intermediate magnitudes, which at a root are at most ``p2``. A root's error is then the
+    polynomial's error bound over ``|f'|`` there, plus the residual ``|f| / |f'|`` (first order).
+    """
+    a0, a1, a2, a3 = float(jac[0, 0, k]), float(jac[0, 1, k]), float(jac[0, 2, k]), float(jac[0, 3, k])
+    b0, b1, b2, b3 = float(jac[1, 0, k]), float(jac[1, 1, k]), float(jac[1, 2, k]), float(jac[1, 3, k])
+    c0, c1, c2, c3 = float(jac[2, 0, k]), float(jac[2, 1, k]), float(jac[2, 2, k]), float(jac[2, 3, k])
+    # Cofactors c_i = (-1)^(i+3) det(J without column i), expanded along row 0 with the 2x2 minors of rows 1, 2.
+    m01, m02, m03 = b0 * c1 - b1 * c0, b0 * c2 - b2 * c0, b0 * c3 - b3 * c0
+    m12, m13, m23 = b1 * c2 - b2 * c1, b1 * c3 - b3 * c1, b2 * c3 - b3 * c2
+    C0 = a2 * m13 - a1 * m23 - a3 * m12
+    C1 = a0 * m23 - a2 * m03 + a3 * m02
+    C2 = a1 * m03 - a0 * m13 - a3 * m01
+    C3 = a0 * m12 - a1 * m02 + a2 * m01
+    # The characteristic polynomial of J J^T (Cauchy-Binet): p1 = |J|_F^2, p2 = the sum of the squared 2x2
+    # minors (Lagrange's identity, row pair by row pair: r_i r_j - (J_i . J_j)^2), p3 = |c|^2.
+    r0 = (a0 * a0 + a1 * a1) + (a2 * a2 + a3 * a3)
+    r1 = (b0 * b0 + b1 * b1) + (b2 * b2 + b3 * b3)
+    r2 = (c0 * c0 + c1 * c1) + (c2 * c2 + c3 * c3)
+    g01 = (a0 * b0 + a1 * b1) + (a2 * b2 + a3 * b3)
+    g02 = (a0 * c0 + a1 * c1) + (a2 * c2 + a3 * c3)
+    g12 = (b0 * c0 + b1 * c1) + (b2 * c2 + b3 * c3)
+    q01, q02, q12 = r0 * r1, r0 * r2, r1 * r2
+    p1 = r0 + r1 + r2
+    p2 = (q01 - g01 * g01) + (q02 - g02 * g02) + (q12 - g12 * g12)
+    p3 = (C0 * C0 + C1 * C1) + (C2 * C2 + C3 * C3)
+    e2 = q01 + q02 + q12
+    hadamard = q01 * r2  # r0 r1 r2 >= |c|^2
+    # Error bounds of the coefficients, Horner's rule's own at a root of the cubic folded in (its intermediates
+    # are then lambda_i (lambda_j + lambda_k) and lambda_j lambda_k, at most p2); |c| dc <= 5.8 u (r0 r1 r2 + p3).
+    dp1 = 4.0 * U * p1
+    dp2 = 14.0 * U * e2 + 7.0 * U * p2
+    dp3 = 11.6 * U * (hadamard + p3) + 3.0 * U * p3
+    # lambda_1 from Samuelson's bound (mean + sqrt(2) std of the three roots) by Householder's fourth-order steps
+    # x - f (f'^2 - f f'' / 2) / (f'^3 - f f' f'' + f^2 f''' / 6), f''' = 6: its error ~1e-2 -> 1e-8 -> round-off.
+    spread = p1 * p1 - 3.0 * p2
+    lam = (p1 + 2.0 * math.sqrt(spread if spread > 0.0 else 0.0)) * THIRD_UP
+    for _ in range(ROOT_STEPS):
+        f = ((lam - p1) * lam + p2) * lam - p3
+        fp = (3.0 * lam - 2.0 * p1) * lam + p2
+        fpp = 6.0 * lam - 2.0 * p1
+        den = (fp * fp - f * fpp) * fp + f * f
+        lam -= f * (fp * fp - 0.5 * f * fpp) / (den if den > FLOOR else FLOOR)
+    t1 = lam - p1
+    t3 = t1 * lam + p2
+    f1 = t3 * lam - p3
+    fp1 = (3.0 * lam - 2.0 * p1) * lam + p2
+    df1 = abs(f1) + (dp1 * lam + dp2) * lam + dp3
+    # lambda_2 and lambda_3 are the roots of the deflated quadratic x^2 - S x + P (synthetic division of the
+    # cubic by x - lambda_1: S = p1 - lambda_1, P = lambda_1 (lambda_1 - p1) + p2); lambda_2, the larger, is
+    # certified by its own residual in the cubic, whatever the errors of lambda_1, S and P.
+    S = -t1
+    D = S * S - 4.0 * t3
+    root = math.sqrt(D if D > 0.0 else 0.0)
+    lam2 = 0.5 * (S + root)
+    t1 = lam2 - p1
+    f2 = ((t1 * lam2) + p2) * lam2 - p3
+    fp2 = abs((3.0 * lam2 - 2.0 * p1) * lam2 + p2)
+    df2 = abs(f2) + (dp1 * lam2 + dp2) * lam2 + dp3
+    s1 = math.sqrt(lam)
+    s2 = math.sqrt(lam2 if lam2 > 0.0 else 0.0)
+    s2 = s2 if s2 < s1 else s1
+    mod = math.sqrt(p3)  # |c|
+    den = s1 * s2 * mod
+    w = 1.0 / (den if den > FLOOR else FLOOR)
+    s3 = p3 * w  # |c| / (sigma_1 sigma_2)
+    s3 = s3 if s3 < s2 else s2
+    inv_mod = s1 * s2 * w
+    # Certified: the cofactors (|J t| and raw_tau; 133 u^2 r0 r1 r2 bounds |dc|^2), lambda_1 (sigma_1 =
+    # sqrt(lambda_1)), lambda_2 (sigma_2, within a quarter of its gap to lambda_3); then sigma_3 = |c| /
+    # (sigma_1 sigma_2) errs by at most sigma_3 (|dc| / |c| + dsigma_1 / sigma_1) + dsigma_2.
+    first = (133.0 * U * U * hadamard < TANGENT_TOL * TANGENT_TOL * p3) & (
+        df1 <= 2.0 * SIGMA_1_TOL * lam * fp1
+    )
+    second = (df2 <= 2.0 * SIGMA_2_TOL * s1 * s2 * fp2) & (4.0 * df2 <= root * fp2)
+    sigma[0, k] = s1
+    sigma[1, k] = s2
+    sigma[2, k] = s3
+    tangent[0, k] = C0 * inv_mod
+    tangent[1, k] = C1 * inv_mod
+    tangent[2, k] = C2 * inv_mod
+    tangent[3, k] = C3 * inv_mod
+    raw_tau[k] = (mod if second else -mod) if first else FLAGGED
+
+
+@kernel(inline="always")
+def gap_lane(jac, k, sigma, raw_tau):
+    """``sigma_2`` and ``sigma_3`` at point ``k`` where the first pass certified ``sigma_1``, the tangent and
+    ``raw_tau = -|c|`` but not ``sigma_2`` (``lambda_2`` close to ``lambda_3``: the cubic's coefficients' errors
+    move a nearly double root far): from the ``2 x 2`` compression ``M`` of ``A = J J^T`` onto the complement of
+    its top eigenvector ``u_1``, whose eigenvalues ``(a + d) / 2 +- sqrt(((a - d) / 2)^2 + b^2)`` lose nothing to
+    cancellation. ``u_1`` is the largest cross product of two rows of ``A - lambda_1 I`` (rank two; ``lambda_1``
+    is well separated, the first pass certified it), the complement spanned by a Householder reflection's columns.
+    Each entry of ``M`` errs by at most ``20 u p1`` (Weyl: so do its eigenvalues). Returns whether that bound
+    certifies ``sigma_2`` (then written, with ``sigma_3 = |c| / (sigma_1 sigma_2)`` and ``raw_tau = |c|``)."""
+    a0, a1, a2, a3 = float(jac[0, 0, k]), float(jac[0, 1, k]), float(jac[0, 2, k]), float(jac[0, 3, k])
+    b0, b1, b2, b3 = float(jac[1, 0, k]), float(jac[1, 1, k]), float(jac[1, 2, k]), float(jac[1, 3, k])
+    c0, c1, c2, c3 = float(jac[2, 0, k]), float(jac[2, 1, k]), float(jac[2, 2, k]), float(jac[2, 3, k])
+    r0 = (a0 * a0 + a1 * a1) + (a2 * a2 + a3 * a3)
+    r1 = (b0 * b0 + b1 * b1) + (b2 * b2 + b3 * b3)
+    r2 = (c0 * c0 + c1 * c1) + (c2 * c2 + c3 * c3)
+    g01 = (a0 * b0 + a1 * b1) + (a2 * b2 + a3 * b3)
+    g02 = (a0 * c0 + a1 * c1) + (a2 * c2 + a3 * c3)
+    g12 = (b0 * c0 + b1 * c1) + (b2 * c2 + b3 * c3)
+    s1 = float(sigma[0, k])
+    mod = -float(raw_tau[k])
+    lam = s1 * s1
+    x0, x1, x2 = r0 - lam, g01, g02  # the rows of A - lambda_1 I
+    y0, y1, y2 = g01, r1 - lam, g12
+    z0, z1, z2 = g02, g12, r2 - lam
+    u0, u1, u2 = x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
+    n = u0 * u0 + u1 * u1 + u2 * u2
+    v0, v1, v2 = x1 * z2 - x2 * z1, x2 * z0 - x0 * z2, x0 * z1 - x1 * z0
+    nv = v0 * v0 + v1 * v1 + v2 * v2
+    if nv > n:
+        u0, u1, u2, n = v0, v1, v2, nv
+    v0, v1, v2 = y1 * z2 - y2 * z1, y2 * z0 - y0 * z2, y0 * z1 - y1 * z0
+    nv = v0 * v0 + v1 * v1 + v2 * v2
+    if nv > n:
+        u0, u1, u2, n = v0, v1, v2, nv
+    if not n > 0.0:
+        return False
+    scale = 1.0 / math.sqrt(n)
+    u0, u1, u2 = u0 * scale, u1 * scale, u2 * scale
+    # Householder reflection taking u_1 to -+e_0: its columns 1 and 2 span the complement.
+    w0 = u0 + (1.0 if u0 >= 0.0 else -1.0)
+    beta = 1.0 / (1.0 + abs(u0))
+    q0, q1, q2 = -beta * w0 * u1, 1.0 - beta * u1 * u1, -beta * u2 * u1
+    h0, h1, h2 = -beta * w0 * u2, -beta * u1 * u2, 1.0 - beta * u2 * u2
+    Aq0, Aq1, Aq2 = (
+        r0 * q0 + g01 * q1 + g02 * q2,
+        g01 * q0 + r1 * q1 + g12 * q2,
+        g02 * q0 + g12 * q1 + r2 * q2,
+    )
+    Ah0, Ah1, Ah2 = (
+        r0 * h0 + g01 * h1 + g02 * h2,
+        g01 * h0 + r1 * h1 + g12 * h2,
+        g02 * h0 + g12 * h1 + r2 * h2,
+    )
+    m_a = q0 * Aq0 + q1 * Aq1 + q2 * Aq2
+    m_b = q0 * Ah0 + q1 * Ah1 + q2 * Ah2
+    m_d = h0 * Ah0 + h1 * Ah1 + h2 * Ah2
+    half = 0.5 * (m_a - m_d)
+    lam2 = 0.5 * (m_a + m_d) + math.sqrt(half * half + m_b * m_b)
+    s2 = math.sqrt(lam2 if lam2 > 0.0 else 0.0)
+    if not (10.0 * U * (r0 + r1 + r2) <= SIGMA_2_TOL * s1 * s2 and s2 <= s1):
+        return False
+    s3 = mod / (s1 * s2)
+    sigma[1, k] = s2
+    sigma[2, k] = s3 if s3 < s2 else s2
+    raw_tau[k] = mod
+    return True
+
+
+@kernel(inline="always")
+def exact_lane(jac, k, sigma, tangent, raw_tau, work, warm):
+    """The exact fall-back at point ``k``: a one-sided Jacobi SVD of ``J`` (``work = (A, V, W, norms, order)``,
+    ``(3, 4)``, ``(4, 4)``, ``(3, 4)``, ``(4,)``, ``(4,)`` int), started from ``V`` when ``warm`` (the previous
+    point's right singular vectors: along a path they change little, and a sweep or two finish), else from the
+    identity. The tangent is the right singular vector of the column of ``W`` left (numerically) zero, and
+    ``det([J; t^T]) = det([W; e_i^T]) det V`` with ``det V = 1`` (rotations only): the cofactor of ``W`` (whose
+    other columns are orthogonal, so that it is accurate relative to itself)."""
+    A, V, W, norms, order = work
+    for e in range(3):
+        for c in range(4):
+            A[e, c] = jac[e, c, k]
+    if not warm:
+        for a in range(4):
+            for c in range(4):
+                V[a, c] = 1.0 if a == c else 0.0
+    jacobi_svd(A, V, W, norms, order)
+    null = order[3]
+    for e in range(3):
+        sigma[e, k] = norms[e]
+    norm = 0.0
+    for a in range(4):
+        norm += V[a, null] * V[a, null]
+    norm = 1.0 / math.sqrt(norm)  # V's columns are unit to a few rotations' rounding: to one rounding here
+    for a in range(4):
+        tangent[a, k] = V[a, null] * norm
+    i, j, l = (1, 2, 3) if null == 0 else (0, 2, 3) if null == 1 else (0, 1, 3) if null == 2 else (0, 1, 2)
+    det = (
+        W[0, i] * (W[1, j] * W[2, l] - W[1, l] * W[2, j])
+        - W[0, j] * (W[1, i] * W[2, l] - W[1, l] * W[2, i])
+        + W[0, l] * (W[1, i] * W[2, j] - W[1, j] * W[2, i])
+    )
+    raw_tau[k] = det if null % 2 == 1 else -det
+
+
+@kernel(error_model="numpy", fastmath={"contract"})
+def one_loop_rows(jac, sigma, tangent, raw_tau):
+    """Singular values, unit tangent and raw test function of ``K`` one-loop planar Jacobians.
+
+    ``jac (3, 4, K)``: ``jac[e, c, k]`` row ``e``, column ``c`` of point ``k``'s Jacobian. Writes ``sigma (3, K)``
+    (descending), ``tangent (4, K)`` (a unit null vector of each; either sign) and ``raw_tau (K,)`` (``det([J;
+    t^T])`` for that ``t``). Returns the number of points recomputed by the exact fall-back.
+
+    Every singular value is within ``1e-13 sigma_1`` of the exact one, ``|J t| <= 1e-14 sigma_1``, ``|t| = 1`` to
+    ``1e-15``, and ``raw_tau`` within ``1e-13 sigma_1^2 sigma_2`` (relative ``1e-13`` unless ``J`` is nearly rank
+    deficient): the closed form where its error bound certifies it, the Jacobi SVD elsewhere.
+    """
+    K = jac.shape[2]
+    for k in range(K):
+        fast_lane(jac, k, sigma, tangent, raw_tau)
+    count = 0
+    work = (np.empty((3, 4)), np.empty((4, 4)), np.empty((3, 4)), np.empty(4), np.empty(4, dtype=np.int64))
+    last = -2
+    for k in range(K):
+        if raw_tau[k] < 0.0:
+            count += 1
+            if raw_tau[k] > FLAGGED and gap_lane(jac, k, sigma, raw_tau):
+                continue
+            exact_lane(jac, k, sigma, tangent, raw_tau, work, last == k - 1)
+            last = k
+    return count

@@ -1,0 +1,263 @@
+"""The closed form's passes over all points against computations outside them: the closure Jacobian and residual
+(built from the poses' relative rotations) against :mod:`linkwork.kinematics.closure` at the reported joint
+values (numpy's sine and cosine), the joint values against the poses, and the first failing point of a path (a
+joint limit, a dyad without a solution) where an independent reading of the rows puts it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import linkwork as lw
+from linkwork.kinematics import dyad_solver
+from linkwork.kinematics.closure import closure_residual, jacobian
+from linkwork.kinematics.mechanism import Mechanism
+
+WATT = Path(__file__).resolve().parents[2] / "examples" / "specs" / "watt-six-bar.toml"
+
+
+@pytest.fixture(autouse=True)
+def compiled(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("LINKWORK_JIT", "compiled")
+
+
+def kernel_call(mech: Mechanism, turn: float, steps: int) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+    """``(arguments, outputs)`` of the closed-form kernel on a paper-mode trace of ``turn`` radians of joint A."""
+    original = dyad_solver.closed_form_path
+    seen: list[tuple[tuple[Any, ...], tuple[Any, ...]]] = []
+
+    def watched(*args: Any) -> Any:
+        out = original(*args)
+        seen.append((args, out))
+        return out
+
+    try:
+        dyad_solver.closed_form_path = watched  # type: ignore[assignment]
+        lw.trace(mech, until=("A", float(mech.offsets[mech.index("A")] + turn)), steps=steps)
+    finally:
+        dyad_solver.closed_form_path = original
+    assert seen, "the closed form was not tried"
+    return seen[-1]
+
+
+def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The positions and closure passes of the kernel on its own arguments: ``(poses, q, jac, res)``."""
+    flat, plan, run = args
+    joint_int, joint_geo, dyads, modes, head = plan
+    settings = run[0]
+    steps = int(settings[dyad_solver.S_STEPS])
+    K = steps + 1
+    # the drive's values as the kernel steps them: a running sum, the target last
+    drive_q = np.concatenate([[0.0], np.cumsum(np.full(steps - 1, settings[dyad_solver.S_STEP]))])
+    drive_q = np.append(drive_q, settings[dyad_solver.S_TARGET])
+    poses = np.zeros((head[2], 4, K))
+    poses[:, 0] = 1.0
+    status = np.zeros(K, dtype=np.int64)
+    dyad_solver.place_driver(joint_int, joint_geo, head, drive_q, poses)
+    dyad_solver.place_dyads(
+        joint_int, joint_geo, dyads, modes, poses, settings[dyad_solver.S_MIN_MARGIN], status
+    )
+    assert not status.any()
+    n, m, E = joint_int.shape[0], run[1].shape[0], 3 * (flat[3].shape[0] - 1)
+    rel, q, jump = np.empty((n, 2, K)), np.empty((n, K)), np.zeros(K)
+    carry = (np.zeros(n), np.zeros(n), np.zeros(K))  # the start: every joint at 0, no turns
+    dyad_solver.joint_values(joint_int, joint_geo, poses, head[0], drive_q, rel, q, jump, carry)
+    jac, res = np.empty((E, m, K)), np.empty(K)
+    dyad_solver.planar_closure(flat, rel, q, jac, res, (np.empty((4, K)), np.empty(K), np.empty(K)))
+    return poses, q, jac, res
+
+
+CASES = {
+    "four-bar": lambda: lw.load("four-bar"),
+    "slider-crank": lambda: lw.load("slider-crank", offset=0.3),
+    "watt": lambda: lw.load(str(WATT)),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_jacobian_and_residual_from_poses_equal_the_closure_at_the_reported_values(name: str) -> None:
+    """The closure pass reads each revolute joint's cosine and sine from the bodies' poses, not from its value:
+    its Jacobian equals :func:`~linkwork.kinematics.closure.jacobian` at the reported values (numpy's sin/cos)
+    to 1e-13 of its size, and its residual norm that of :func:`~linkwork.kinematics.closure.closure_residual`
+    to 1e-13 (both at round-off). Over 350 degrees of the crank (short of the closed path), in more points than
+    two of the kernel's blocks: its rows equal these passes over the whole path exactly."""
+    mech = CASES[name]()
+    steps = 2 * dyad_solver.BLOCK + 7
+    args, (count, status, u, _sigma, out_res, *_rest) = kernel_call(mech, np.radians(350.0), steps)
+    assert status == dyad_solver.CLEAN and count == steps + 1
+    _poses, q, jac, res = passes(args)
+    groups = args[0][4]
+    assert np.array_equal(q[:, :count].T, u[:count][:, groups])  # the rows are these joint values
+    assert np.array_equal(res, out_res)
+    for k in range(0, count, 5):
+        angles = mech.q_from_u(u[k])
+        reference = jacobian(mech, angles)
+        assert np.max(np.abs(jac[:, :, k] - reference)) < 1e-13 * max(1.0, np.max(np.abs(reference))), k
+        independent = float(np.linalg.norm(closure_residual(mech, angles)))
+        assert independent < 1e-13 and abs(res[k] - independent) < 1e-13, k
+
+
+def test_joint_values_match_the_poses_and_continue_through_turns() -> None:
+    """Every revolute joint's value turns its before body's pose into its after body's (to 1e-14), and successive
+    values differ by less than the wrapped step (no spurious 2 pi jumps) over 350 degrees of the crank, in which
+    the crank-coupler angle crosses +-180 degrees."""
+    mech = lw.load("four-bar")
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(350.0), 350)
+    assert count == 351
+    assert status == dyad_solver.CLEAN
+    poses, q, _jac, _res = passes(args)
+    joint_int, joint_geo = args[1][0], args[1][1]
+    for j in range(joint_int.shape[0]):
+        a, b = joint_int[j, 1], joint_int[j, 2]
+        turn = joint_geo[j, 2] * q[j]
+        c = np.cos(turn) * poses[a, 0] - np.sin(turn) * poses[a, 1]  # R_a Rz(omega q)
+        s = np.sin(turn) * poses[a, 0] + np.cos(turn) * poses[a, 1]
+        assert np.max(np.hypot(c - poses[b, 0], s - poses[b, 1])) < 1e-14
+        assert np.max(np.abs(np.diff(q[j]))) < 0.1
+    assert abs(q[0, -1] - np.radians(350.0)) < 1e-12
+    assert np.ptp(q[mech.index("B")]) > np.pi  # the angle read in [-pi, pi] was continued across the cut
+
+
+def test_a_joint_limit_ends_the_path_at_the_first_row_beyond_it() -> None:
+    """With an upper limit on the rocker's joint D inside its range, the kernel stops with LIMIT at exactly the
+    first row whose D exceeds it (read from the unlimited run's rows)."""
+    mech = lw.load("four-bar")
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(300.0), 300)
+    assert status == dyad_solver.CLEAN
+    g = args[0][4][mech.index("D")]
+    limit = 0.5 * (u[:count, g].max() + u[:count, g].min())
+    settings, t0, lo, hi, periodic = args[2]
+    hi = hi.copy()
+    hi[g] = limit
+    out = dyad_solver.closed_form_path(args[0], args[1], (settings, t0, lo, hi, periodic))
+    expected = int(np.argmax(u[:count, g] > limit))
+    assert expected > 0
+    assert out[:2] == (expected, dyad_solver.LIMIT)
+    np.testing.assert_array_equal(out[2][:expected], u[:expected])
+
+
+def test_a_dyad_without_a_solution_ends_the_path_at_the_first_such_row() -> None:
+    """A double rocker driven past its fold: the kernel stops at the first row where the coupler and rocker
+    cannot reach (distance from B to D above their sum, computed here) or hands over just before, near the fold
+    (within its margin)."""
+    mech = lw.load("four-bar", ground=2.0, crank=1.8, coupler=1.0, rocker=1.7, theta=np.radians(60.0))
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(150.0), 150)
+    assert status in (dyad_solver.NO_SOLUTION, dyad_solver.NEAR_SINGULAR)
+    settings = args[2][0]
+    crank_angle = np.radians(60.0) + np.arange(151) * settings[dyad_solver.S_STEP]
+    b = 1.8 * np.stack([np.cos(crank_angle), np.sin(crank_angle)], axis=1)
+    reach = np.linalg.norm(b - np.array([2.0, 0.0]), axis=1)
+    first = int(np.argmax(reach > 1.0 + 1.7))
+    assert first > 0 and count <= first
+    if status == dyad_solver.NO_SOLUTION:
+        assert count == first
+
+
+def test_a_path_back_at_its_start_ends_closed_where_the_march_would_see_it() -> None:
+    """Two turns of a four-bar's crank in 1-degree steps: the kernel stops with CLOSED at the first row (not the
+    last) whose distance from the start (angles wrapped, numpy's reading here) is below 1.5 steps after the path
+    went farther than 4 maximum steps; that row is stored, the ones before are the path."""
+    mech = lw.load("four-bar")
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(720.0), 720)
+    assert status == dyad_solver.CLOSED
+    settings, periodic = args[2][0], args[2][4]
+    h, hmax = settings[dyad_solver.S_STEP], settings[dyad_solver.S_HMAX]
+    rows = u[: count + 1].copy()
+    rows[:, periodic] = (rows[:, periodic] + np.pi) % (2.0 * np.pi) - np.pi
+    distance = np.linalg.norm(rows, axis=1)
+    far = np.maximum.accumulate(distance)
+    closed = [k for k in range(1, count + 1) if far[k] > 4.0 * hmax and distance[k] < 1.5 * abs(h)]
+    assert closed and closed[0] == count
+    assert 350 < count <= 360  # about one turn
+
+
+def test_a_drive_step_over_a_quarter_turn_ends_the_path_at_once() -> None:
+    """Three steps for a full turn (120 degrees each): the march reads a jump of more than 90 degrees at the first
+    step, so the kernel returns row 0 only, with JUMP (the tracer then decides)."""
+    mech = lw.load("four-bar")
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(360.0), 3)
+    assert (count, status) == (1, dyad_solver.JUMP)
+    assert abs(args[2][0][dyad_solver.S_STEP]) > 0.5 * np.pi
+
+
+def slotted_lever() -> Mechanism:
+    """A crank and slotted lever: crank A, a block pinned to it at B sliding in a slot of the lever (P, its line
+    through the lever's pivot D at 10 degrees off the line D-B, so B is off it), the lever pivoted on the ground at D:
+    an RPR dyad on the crank."""
+    b = np.array([np.cos(np.radians(60.0)), np.sin(np.radians(60.0))])
+    d = np.array([0.2, -2.0])
+    toward = (b - d) / np.linalg.norm(b - d)
+    turn = np.radians(10.0)
+    slot = (
+        np.cos(turn) * toward[0] - np.sin(turn) * toward[1],
+        np.sin(turn) * toward[0] + np.cos(turn) * toward[1],
+    )
+    z = (0.0, 0.0, 1.0)
+    joints = [
+        {"name": "A", "bodies": ("ground", "crank"), "point": (0.0, 0.0), "direction": z},
+        {"name": "B", "bodies": ("crank", "block"), "point": b, "direction": z},
+        {"name": "S", "type": "P", "bodies": ("block", "lever"), "point": d, "direction": (*slot, 0.0)},
+        {"name": "D", "bodies": ("lever", "ground"), "point": d, "direction": z},
+    ]
+    return Mechanism.from_joints("slotted lever", joints, planar=True)
+
+
+def cross_slides() -> Mechanism:
+    """A PRP dyad on a crank: a block sliding along x on the ground, pinned at P to a second block that slides
+    along a line fixed in the crank (through P, along y at the start)."""
+    z = (0.0, 0.0, 1.0)
+    p = (1.5, 0.8)
+    joints = [
+        {"name": "A", "bodies": ("ground", "crank"), "point": (0.0, 0.0), "direction": z},
+        {"name": "G", "type": "P", "bodies": ("ground", "runner"), "point": p, "direction": (1.0, 0.0, 0.0)},
+        {"name": "P", "bodies": ("runner", "follower"), "point": p, "direction": z},
+        {"name": "F", "type": "P", "bodies": ("follower", "crank"), "point": p, "direction": (0.0, 1.0, 0.0)},
+    ]
+    return Mechanism.from_joints("cross slides", joints, planar=True)
+
+
+@pytest.mark.parametrize(
+    ("build", "kind", "turn", "steps"), [(slotted_lever, "RPR", 300.0, 300), (cross_slides, "PRP", 60.0, 120)]
+)
+def test_rpr_and_prp_dyads_equal_the_predictor_corrector(
+    build: Any, kind: str, turn: float, steps: int
+) -> None:
+    """The two dyad kinds no built-in has: the closed form takes the path (each dyad one vectorised loop), its
+    rows equal the predictor-corrector's (angles and slides to 1e-10, singular values to 1e-12 of the largest),
+    and it closes to round-off."""
+    from linkwork.kinematics import tracer
+    from linkwork.kinematics.dyads import dyad_plan
+
+    mech = build()
+    plan = dyad_plan(mech, mech.index("A"))
+    assert plan is not None and len(plan.dyads) == 1
+    kinds = "".join("RP"[plan.joint_int[j, 0]] for j in plan.dyads[0][:3])
+    assert kinds == kind
+    until = ("A", float(np.radians(turn)))
+    _args, (count, status, *_rest) = kernel_call(mech, np.radians(turn), steps)
+    assert (count, status) == (steps + 1, dyad_solver.CLEAN)
+    fast = lw.trace(mech, until=until, steps=steps)
+    original = tracer.closed_form_rows
+    try:
+        tracer.closed_form_rows = lambda *args, **kwargs: None  # type: ignore[assignment]
+        general = lw.trace(mech, until=until, steps=steps)
+    finally:
+        tracer.closed_form_rows = original
+    assert fast.angles.shape == general.angles.shape
+    assert np.max(np.abs(fast.angles - general.angles)) < 1e-10
+    assert np.max(np.abs(fast.sigma - general.sigma)) < 1e-12 * float(np.max(general.sigma))
+    assert np.all(fast.residual < 1e-13)
+
+
+def test_a_drive_step_of_whole_turns_is_no_jump() -> None:
+    """One step of two whole turns brings every body back where it was: the march reads the drive's step wrapped
+    (0), so the kernel reaches the target (2 rows) with the crank's value 720 degrees and every other joint at 0."""
+    mech = lw.load("four-bar")
+    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(720.0), 1)
+    assert (count, status) == (2, dyad_solver.CLEAN)
+    g = args[0][4][mech.index("A")]
+    assert abs(u[1, g] - np.radians(720.0)) < 1e-12
+    assert np.max(np.abs(np.delete(u[1], g))) < 1e-12
