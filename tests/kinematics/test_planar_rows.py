@@ -4,8 +4,11 @@ ones (equal singular values, near rank drops, a zero column, scaled by 1e-6 and 
 
 from __future__ import annotations
 
+import platform
+import re
 from fractions import Fraction
 
+import numba
 import numpy as np
 import pytest
 
@@ -273,3 +276,15 @@ def test_raw_tau_against_exact_rational_determinants() -> None:
         exact = float(exact_determinant(bordered))
         scale = abs(exact) if k < len(J) - 4 else sigma[k, 0] ** 2 * sigma[k, 1]
         assert abs(tau[k] - exact) <= 1e-14 * scale, k
+
+
+@pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"), reason="x86 instruction names")
+def test_first_pass_is_vectorised() -> None:
+    """The first pass compiles to packed square roots and divisions (several points an instruction): a branch or
+    an exception path added to it would make LLVM keep it scalar, five to ten times slower. Compiled afresh here
+    (numba does not disassemble cached code)."""
+    fresh = numba.njit(error_model="numpy", fastmath={"contract"})(one_loop_rows.py_func)
+    K = 16
+    fresh(np.ones((3, 4, K)), np.empty((3, K)), np.empty((4, K)), np.empty(K))
+    asm = fresh.inspect_asm(fresh.signatures[0])
+    assert re.search(r"\bv?sqrtpd\b", asm) and re.search(r"\bv?divpd\b", asm)
