@@ -755,7 +755,8 @@ def closed_form_path(flat, plan, run):
     flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
     svd_state = (np.eye(E), np.eye(E), np.eye(E))  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
-    orient = 1.0
+    flipped = 0  # the tangent's orientation is -1 (the one before the block's first point)
+    turn_bits = np.empty(C, dtype=np.int64)
     near_start = 1.5 * abs(h)  # a path closes where it comes back this near its start
     for first in range(1, steps + 1, BLOCK):
         # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
@@ -789,11 +790,20 @@ def closed_form_path(flat, plan, run):
         # and every check at every point, then, point by point, the first point that fails (in the march's order:
         # a rank or drive check, a sign change, a limit, then the closed path after the point is stored).
         begin = 0 if first == 1 else 1
+        # orient = -1 where align * (the orientation before) < 0, else 1 (at the start, the one before is 1): as
+        # bits, flipped = (align < 0) xor (flipped before) where align is neither 0 nor NaN, else 0. The bits in a
+        # vectorised loop, the recurrence (two integer operations a point) in a scalar one.
+        for i in range(begin, size + 1):
+            a = align[i]
+            turn_bits[i] = (1 if a < 0.0 else 0) | (2 if (a < 0.0) | (a > 0.0) else 0)
+        for i in range(begin, size + 1):
+            bits = turn_bits[i]
+            flipped = ((bits & 1) ^ flipped) & (bits >> 1)
+            turn_bits[i] = flipped
         taus[0] = out_tau[first - 1]
-        for i in range(begin, size + 1):  # a recurrence: one scalar loop
-            orient = -1.0 if align[i] * (orient if first + i > 1 else 1.0) < 0.0 else 1.0
-            flips[i] = orient
-            taus[i] = det_basis * raw_tau[i] * orient
+        for i in range(begin, size + 1):
+            flips[i] = -1.0 if turn_bits[i] else 1.0
+            taus[i] = det_basis * raw_tau[i] * flips[i]
         # Every check at every point (vectorised); a clean point that could close the path (near the start, not
         # the start or the target) is marked NEAR_START for the scan below.
         for i in range(begin, size + 1):
