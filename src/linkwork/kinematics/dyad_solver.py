@@ -827,9 +827,16 @@ def closed_form_path(flat, plan, run):
             for p in range(i, j):  # a running sum, in the march's order
                 arc = arc + dist[p] if first - 1 + p > 0 else 0.0
                 out_s[first - 1 + p] = arc
-            for p in range(i, j):  # the march's closed-path test keeps the largest distance from the start
-                d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
-                far = far if far >= d else d
+            # The march's closed-path test keeps the largest distance from the start, and only compares it with
+            # 4 hmax: once above, it stays above (unless a NaN comes, which the march's select keeps too).
+            odd = 0
+            if far > 4.0 * hmax:
+                for p in range(i, j):
+                    odd += 0 if wrapped[p] == wrapped[p] else 1
+            if odd > 0 or not far > 4.0 * hmax:
+                for p in range(i, j):
+                    d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
+                    far = far if far >= d else d
             if j > size:
                 break
             if status[j] != NEAR_START:
