@@ -760,9 +760,10 @@ def closed_form_path(flat, plan, run):
     near_start = 1.5 * abs(h)  # a path closes where it comes back this near its start
     for first in range(1, steps + 1, BLOCK):
         # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
+        value = drive_q[0]  # carried in a register, not reloaded from the store before
         for i in range(1, C):
-            k = first - 1 + i
-            drive_q[i] = target if k == steps else drive_q[i - 1] + h
+            value = target if first - 1 + i == steps else value + h
+            drive_q[i] = value
         status[:] = CLEAN
         jump[:] = 0.0
         place_driver(joint_int, joint_geo, head, drive_q, poses)
