@@ -709,10 +709,13 @@ def closed_form_path(flat, plan, run):
     Passes over all points, each array indexed by the point last (structure of arrays), each pass a loop over
     the points with straight-line bodies that vectorise: the drive's poses, each dyad's two bodies, every joint's
     value (then a scan finds the first point a dyad could not be placed or a joint jumped); the closure residual
-    and Jacobian at those points; the tangent, test function and singular values from the Jacobians; then one
-    scalar pass, point by point, orients the tangent and makes every check in the order of the point-by-point
-    march (``far`` and the tangent's orientation carry from point to point), so the same point ends the path
-    with the same status.
+    and Jacobian at those points; the tangent, test function and singular values from the Jacobians; then the
+    tangent's orientation (a recurrence: a scalar loop of two integer operations a point), every check at every
+    point (vectorised, marking the points near the start where the path may close), and a scan in the order of the
+    point-by-point march that runs the arclength's sum and the largest distance from the start and stops at the
+    first failing or closing point (``far``, the arclength and the orientation carry from point to point), so
+    the same point ends the path with the same status. The outputs' rows are written once each (not zero-filled
+    first); those after the count are zeroed on an early return.
     """
     groups = flat[4]
     joint_int, joint_geo, dyads, modes, head = plan
