@@ -69,6 +69,24 @@ def test_atan2_within_an_ulp_of_numpy(rng: np.random.Generator) -> None:
     assert np.all(np.isnan(out[~number]))
 
 
+def test_atan2_of_a_near_identity_rotation_is_the_quotient(rng: np.random.Generator) -> None:
+    """Where ``c > 0`` and ``|s| < 1e-9 c`` (a closed loop's product, turned by round-off), ``atan2(s, c)`` is
+    ``s / c`` to the last bit: ``atan z = z (1 - z^2/3 + ...)`` rounds to ``z`` below ``sqrt(3) 2^-27``. The planar
+    closure's loop log (:func:`linkwork.kinematics.dyad_solver.loop_log`) divides instead there; both the
+    branch-free arctangent and numpy's must agree exactly."""
+    c = np.concatenate(
+        [rng.uniform(0.5, 2.0, 100_000), 1.0 - rng.uniform(0.0, 1e-12, 10_000), [1.0, 1e-3, 1e3]]
+    )
+    z = rng.uniform(-1.0, 1.0, c.size) * 10.0 ** rng.uniform(-300.0, -9.0, c.size)
+    s = np.concatenate([z[:-3] * c[:-3], [0.0, -0.0, 5e-324]])
+    assert np.all(np.abs(s) < 1e-9 * c)
+    out = np.empty_like(s)
+    trig.atan2_into(s, c, out)
+    quotient = s / c
+    assert np.array_equal(out, quotient) and np.array_equal(np.signbit(out), np.signbit(quotient))
+    assert np.array_equal(np.arctan2(s, c), quotient)
+
+
 @pytest.mark.parametrize("name", ["sincos_into", "atan2_into"])
 def test_loops_use_packed_instructions(name: str) -> None:
     """The point of these kernels: their loops compile to packed (ymm / zmm) arithmetic, no C library call in the

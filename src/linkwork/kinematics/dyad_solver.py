@@ -48,6 +48,8 @@ from linkwork.kinematics.trig import SINCOS_LIMIT, atan2, sincos
 REVOLUTE, PRISMATIC = 0, 1
 #: Statuses returned by :func:`closed_form_path` (0: the target reached cleanly).
 CLEAN, NO_SOLUTION, NEAR_SINGULAR, SIGN_CHANGE, CLOSED, LIMIT, JUMP, UNSUPPORTED = 0, 1, 2, 3, 4, 5, 6, 7
+#: Internal mark of :func:`closed_form_path`'s scan: a clean point near the start, where the path may close.
+NEAR_START = -1
 #: Settings array layout of :func:`closed_form_path`.
 S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_MARGIN = (
     0,
@@ -393,7 +395,23 @@ def loop_log(c, s, px, py, angle, share):
     ``v = p - (w x p)/2 + D w x (w x p)`` with ``D`` by its Taylor series (a closed loop turns by round-off);
     ``share[k]`` its squared norm, ``angle[k] = t``. Returns the number of points where ``|t| >= 1e-2`` (there
     the series does not hold: the caller uses :func:`~linkwork.kinematics.kernels.log_coefficient`)."""
+    # A closed loop's product turns by round-off: there atan2(s, c) = s / c to the last bit (fdlibm's atan(z) is
+    # z for |z| < 2^-27 and the branch-free atan2 returns it so), one division instead of the arctangent. The
+    # arctangent only where some point turns more (a loop that does not close: never after a dyad solve).
     wide = 0
+    far = 0
+    for k in range(c.shape[0]):
+        ck, sk = c[k], s[k]
+        far += 0 if (ck > 0.0) & (abs(sk) < 1e-9 * ck) else 1
+        t = sk / ck
+        t2 = t * t
+        D = 1.0 / 12.0 + t2 * (1.0 / 720.0) + t2 * t2 * (1.0 / 30240.0) + t2 * t2 * t2 * (1.0 / 1209600.0)
+        x = px[k] + 0.5 * t * py[k] - D * t2 * px[k]
+        y = py[k] - 0.5 * t * px[k] - D * t2 * py[k]
+        angle[k] = t
+        share[k] = t2 + x * x + y * y
+    if far == 0:
+        return 0
     for k in range(c.shape[0]):
         t = atan2(s[k], c[k])
         t2 = t * t
@@ -662,6 +680,20 @@ def rows_at_points(jac, sigma, tangent, raw_tau, begin, state):
     return 0
 
 
+@kernel(inline="always")
+def zero_tail(count, code, outs):
+    """``(count, code, *outs)`` with every output's rows not written set to zero: those after ``count`` (after
+    ``count + 1`` for :data:`CLOSED`, whose row ``count`` is stored though the path ends before it)."""
+    out_u, out_sigma, out_res, out_tau, out_s = outs
+    tail = count + 1 if code == CLOSED else count
+    out_u[tail:] = 0.0
+    out_sigma[tail:] = 0.0
+    out_res[tail:] = 0.0
+    out_tau[tail:] = 0.0
+    out_s[tail:] = 0.0
+    return count, code, out_u, out_sigma, out_res, out_tau, out_s
+
+
 @kernel(error_model="numpy")
 def closed_form_path(flat, plan, run):
     """The paper-mode path of a driver-and-dyads mechanism from its reference, in closed form, with its rows.
@@ -677,10 +709,13 @@ def closed_form_path(flat, plan, run):
     Passes over all points, each array indexed by the point last (structure of arrays), each pass a loop over
     the points with straight-line bodies that vectorise: the drive's poses, each dyad's two bodies, every joint's
     value (then a scan finds the first point a dyad could not be placed or a joint jumped); the closure residual
-    and Jacobian at those points; the tangent, test function and singular values from the Jacobians; then one
-    scalar pass, point by point, orients the tangent and makes every check in the order of the point-by-point
-    march (``far`` and the tangent's orientation carry from point to point), so the same point ends the path
-    with the same status.
+    and Jacobian at those points; the tangent, test function and singular values from the Jacobians; then the
+    tangent's orientation (a recurrence: a scalar loop of two integer operations a point), every check at every
+    point (vectorised, marking the points near the start where the path may close), and a scan in the order of the
+    point-by-point march that runs the arclength's sum and the largest distance from the start and stops at the
+    first failing or closing point (``far``, the arclength and the orientation carry from point to point), so
+    the same point ends the path with the same status. The outputs' rows are written once each (not zero-filled
+    first); those after the count are zeroed on an early return.
     """
     groups = flat[4]
     joint_int, joint_geo, dyads, modes, head = plan
@@ -694,11 +729,13 @@ def closed_form_path(flat, plan, run):
     det_basis = settings[S_DET_BASIS]
     drive = head[0]
     g_drive = groups[drive]
-    out_u = np.zeros((steps + 1, m))
-    out_sigma = np.zeros((steps + 1, E))
-    out_res = np.zeros(steps + 1)
-    out_tau = np.zeros(steps + 1)
-    out_s = np.zeros(steps + 1)
+    # Not zero-filled: every row up to the count is written; the rows after it are zeroed on return.
+    out_u = np.empty((steps + 1, m))
+    out_sigma = np.empty((steps + 1, E))
+    out_res = np.empty(steps + 1)
+    out_tau = np.empty(steps + 1)
+    out_s = np.empty(steps + 1)
+    outs = (out_u, out_sigma, out_res, out_tau, out_s)
     # A block's arrays: column i is point first - 1 + i; column 0 the block before's last point (the start for
     # the first block), columns 1 .. BLOCK this block's points (past the last point: harmless extrapolation).
     C = BLOCK + 1
@@ -721,12 +758,15 @@ def closed_form_path(flat, plan, run):
     flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
     svd_state = (np.eye(E), np.eye(E), np.eye(E))  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
-    orient = 1.0
+    flipped = 0  # the tangent's orientation is -1 (the one before the block's first point)
+    turn_bits = np.empty(C, dtype=np.int64)
+    near_start = 1.5 * abs(h)  # a path closes where it comes back this near its start
     for first in range(1, steps + 1, BLOCK):
         # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
+        value = drive_q[0]  # carried in a register, not reloaded from the store before
         for i in range(1, C):
-            k = first - 1 + i
-            drive_q[i] = target if k == steps else drive_q[i - 1] + h
+            value = target if first - 1 + i == steps else value + h
+            drive_q[i] = value
         status[:] = CLEAN
         jump[:] = 0.0
         place_driver(joint_int, joint_geo, head, drive_q, poses)
@@ -754,35 +794,68 @@ def closed_form_path(flat, plan, run):
         # and every check at every point, then, point by point, the first point that fails (in the march's order:
         # a rank or drive check, a sign change, a limit, then the closed path after the point is stored).
         begin = 0 if first == 1 else 1
+        # orient = -1 where align * (the orientation before) < 0, else 1 (at the start, the one before is 1): as
+        # bits, flipped = (align < 0) xor (flipped before) where align is neither 0 nor NaN, else 0. The bits in a
+        # vectorised loop, the recurrence (two integer operations a point) in a scalar one.
         for i in range(begin, size + 1):
-            orient = -1.0 if align[i] * (orient if first + i > 1 else 1.0) < 0.0 else 1.0
-            flips[i] = orient
+            a = align[i]
+            turn_bits[i] = (1 if a < 0.0 else 0) | (2 if (a < 0.0) | (a > 0.0) else 0)
+        for i in range(begin, size + 1):
+            bits = turn_bits[i]
+            flipped = ((bits & 1) ^ flipped) & (bits >> 1)
+            turn_bits[i] = flipped
         taus[0] = out_tau[first - 1]
         for i in range(begin, size + 1):
+            flips[i] = -1.0 if turn_bits[i] else 1.0
             taus[i] = det_basis * raw_tau[i] * flips[i]
+        # Every check at every point (vectorised); a clean point that could close the path (near the start, not
+        # the start or the target) is marked NEAR_START for the scan below.
         for i in range(begin, size + 1):
-            later = first + i > 1  # not the start
+            k = first - 1 + i
+            later = k > 0  # not the start
             t_drive = tangent[g_drive, i]
             singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
             turned = later & ((flips[i] * t_drive) * h <= 0.0)
             crossed = later & (taus[i] * taus[i - 1] < 0.0)
             code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
-            status[i] = LIMIT if code == CLEAN and outside[i] > 0.0 else code
+            code = LIMIT if code == CLEAN and outside[i] > 0.0 else code
+            near = later & (k < steps) & (wrapped[i] < near_start)
+            status[i] = NEAR_START if code == CLEAN and near else code
         stop, code = size + 1, ended
         arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
-        for i in range(begin, size + 1):
-            k = first - 1 + i
-            if status[i] != CLEAN:
-                stop, code = i, status[i]
+        i = begin
+        while i <= size:  # the marked points one by one, the runs of clean points between them in loops
+            j = i
+            while j <= size and status[j] == CLEAN:
+                j += 1
+            for p in range(i, j):  # a running sum, in the march's order
+                arc = arc + dist[p] if first - 1 + p > 0 else 0.0
+                out_s[first - 1 + p] = arc
+            # The march's closed-path test keeps the largest distance from the start, and only compares it with
+            # 4 hmax: once above, it stays above (unless a NaN comes, which the march's select keeps too).
+            odd = 0
+            if far > 4.0 * hmax:
+                for p in range(i, j):
+                    odd += 0 if wrapped[p] == wrapped[p] else 1
+            if odd > 0 or not far > 4.0 * hmax:
+                for p in range(i, j):
+                    d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
+                    far = far if far >= d else d
+            if j > size:
                 break
-            arc = arc + dist[i] if k > 0 else 0.0
+            if status[j] != NEAR_START:
+                stop, code = j, status[j]
+                break
+            # Near the start: the march's closed-path test (the target's step ends the march before it).
+            k = first - 1 + j
+            arc = arc + dist[j]
             out_s[k] = arc
-            if 0 < k < steps:  # the march's closed-path test (the target's step ends the march before it)
-                d = wrapped[i]
-                far = far if far >= d else d
-                if far > 4.0 * hmax and d < 1.5 * abs(h):
-                    stop, code = i, CLOSED  # row k is stored, but the path ends before it
-                    break
+            d = wrapped[j]
+            far = far if far >= d else d
+            if far > 4.0 * hmax:
+                stop, code = j, CLOSED  # row k is stored, but the path ends before it
+                break
+            i = j + 1
         for j in range(n):
             g = groups[j]
             for i in range(begin, stop + 1 if code == CLOSED else stop):
@@ -794,9 +867,9 @@ def closed_form_path(flat, plan, run):
             out_res[first - 1 + i] = res[i]
             out_tau[first - 1 + i] = taus[i]
         if stop <= size:
-            return first - 1 + stop, code, out_u, out_sigma, out_res, out_tau, out_s
+            return zero_tail(first - 1 + stop, code, outs)
         if ended != CLEAN:
-            return first + size, ended, out_u, out_sigma, out_res, out_tau, out_s
+            return zero_tail(first + size, ended, outs)
         # The block's last column is the next block's column 0.
         poses[:, :, 0] = poses[:, :, BLOCK]
         drive_q[0] = drive_q[BLOCK]
