@@ -40,7 +40,7 @@ import numpy as np
 
 from linkwork.kernel_cache import kernel
 from linkwork.kinematics.kernels import log_coefficient
-from linkwork.kinematics.planar_rows import one_loop_rows
+from linkwork.kinematics.planar_rows import multi_loop_rows, multi_loop_state, one_loop_rows
 from linkwork.kinematics.small_svd import orthonormalise
 from linkwork.kinematics.trig import SINCOS_LIMIT, atan2, sincos
 
@@ -756,7 +756,7 @@ def closed_form_path(flat, plan, run):
     measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))
     align, dist, wrapped, outside = measures
     flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
-    svd_state = (np.eye(E), np.eye(E), np.eye(E))  # the Jacobi warm start, from block to block (more loops)
+    svd_state = multi_loop_state(E)  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
     flipped = 0  # the tangent's orientation is -1 (the one before the block's first point)
     turn_bits = np.empty(C, dtype=np.int64)
@@ -786,7 +786,7 @@ def closed_form_path(flat, plan, run):
         if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
             one_loop_rows(jac, sigma, tangent, raw_tau)
         else:
-            rows_at_points(jac, sigma, tangent, raw_tau, 0 if first == 1 else 1, svd_state)
+            multi_loop_rows(jac, sigma, tangent, raw_tau, 0 if first == 1 else 1, svd_state)
         for x in measures:
             x[:] = 0.0
         path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)

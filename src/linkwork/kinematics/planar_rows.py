@@ -309,3 +309,354 @@ def one_loop_rows(jac, sigma, tangent, raw_tau):
             exact_lane(jac, k, sigma, tangent, raw_tau, work, last == k - 1)
             last = k
     return count
+
+
+LANES = 16
+"""Points of a multi-loop Jacobian solved side by side by :func:`multi_loop_rows` (each a lane of its packed
+operations: four ``ymm`` registers). Fewer lanes leave the loops' set-up and the rotations' latency exposed, more
+warm-start each point from one further back (more sweeps): on the Watt six-bar's turn 4, 8, 16, 32, 64 lanes cost
+about 1500, 900, 560, 590, 630 ns a point (loaded machine)."""
+LOCKSTEP_SWEEPS = 12
+"""Jacobi sweeps the lanes make together before a lane still not finished falls back to the exact routine."""
+WIDE = 1e-16
+"""A sweep in which some pair's squared cosine exceeds this did not finish (after one in which none did, the
+columns are orthogonal to about ``1e-16``: Jacobi converges quadratically)."""
+TINY = 1e-30
+"""A pair whose squared cosine is below this is not rotated."""
+EXTRAPOLATE = 0.1
+"""A lane's warm start is extrapolated only where that moves no entry of its last ``V`` by more than this (then
+the guess is well conditioned and one Gram-Schmidt pass makes it orthogonal to round-off); elsewhere (unrelated
+points, a jump) it is its last ``V``, orthogonal already."""
+
+
+@kernel(inline="always")
+def lane_rows(m, E):
+    """The rows of :func:`multi_loop_rows`'s work array (each row ``LANES`` doubles, one a lane): where ``M`` (``J^T``
+    and its QR, ``m x E``), the reflectors' first entries and factors (``E`` each), ``det``, the tangent
+    (``m``), ``W`` (``E x E``), the sweep's flags, three temporaries, then the warm start ``V``, ``V_1``, ``V_2``
+    (``E x E`` each) and its depth begin, and the total. One array, indexed by constants once the sizes are
+    literal, so that LLVM sees that the lanes' loops carry no dependence and vectorises them without checks."""
+    M = 0
+    VH = M + m * E
+    BETA = VH + E
+    DET = BETA + E
+    T = DET + 1
+    W = T + m
+    WIDE_ROW = W + E * E
+    TMP = WIDE_ROW + 1
+    V = TMP + 3
+    V1 = V + E * E
+    V2 = V1 + E * E
+    DEPTH = V2 + E * E
+    return M, VH, BETA, DET, T, W, WIDE_ROW, TMP, V, V1, V2, DEPTH, DEPTH + 1
+
+
+@kernel()
+def multi_loop_state(E):
+    """The warm start of :func:`multi_loop_rows`, carried from one call to the next along a path: each lane's
+    right singular vectors at its last point and the two before (``3 x E x E`` rows of ``LANES``) and how many of
+    them are set (one row; fresh: the identity, none)."""
+    state = np.zeros((3 * E * E + 1) * LANES)
+    for a in range(E):
+        for l in range(LANES):
+            state[(a * E + a) * LANES + l] = 1.0
+    return state
+
+
+@kernel(inline="always")
+def lanes_qr(S, L, m, E):
+    """Householder QR of the ``LANES`` matrices ``M`` (``J^T``, ``m x E``) of the work array ``S`` in place, side
+    by side: ``R`` on and above the diagonal, the reflectors below it with their first entries in ``VH`` and
+    their ``2 / |v|^2`` in ``BETA``; ``DET`` the ``det(Q)`` of each (``-1`` a reflection). A zero column is left
+    as it is (its factor 0; ``R`` then has a zero on its diagonal). Every loop has the lane innermost."""
+    M, VH, BETA, DET, _, _, _, TMP, _, _, _, _, _ = lane_rows(m, E)
+    for l in range(L):
+        S[DET * L + l] = 1.0
+    for k in range(E):
+        for l in range(L):
+            S[TMP * L + l] = 0.0
+        for a in range(k, m):
+            for l in range(L):
+                x = S[(M + a * E + k) * L + l]
+                S[TMP * L + l] += x * x
+        for l in range(L):
+            norm = math.sqrt(S[TMP * L + l])
+            x = S[(M + k * E + k) * L + l]
+            alpha = -norm if x >= 0.0 else norm
+            vv = norm * (norm + abs(x))  # |x - alpha e_k|^2 / 2
+            b = 1.0 / vv if vv > FLOOR else 0.0
+            S[(VH + k) * L + l] = x - alpha
+            S[(BETA + k) * L + l] = b
+            S[(M + k * E + k) * L + l] = alpha
+            S[DET * L + l] = -S[DET * L + l] if b > 0.0 else S[DET * L + l]
+        for c in range(k + 1, E):
+            for l in range(L):
+                S[(TMP + 1) * L + l] = S[(VH + k) * L + l] * S[(M + k * E + c) * L + l]
+            for a in range(k + 1, m):
+                for l in range(L):
+                    S[(TMP + 1) * L + l] += S[(M + a * E + k) * L + l] * S[(M + a * E + c) * L + l]
+            for l in range(L):
+                d = S[(TMP + 1) * L + l] * S[(BETA + k) * L + l]
+                S[(TMP + 1) * L + l] = d
+                S[(M + k * E + c) * L + l] -= d * S[(VH + k) * L + l]
+            for a in range(k + 1, m):
+                for l in range(L):
+                    S[(M + a * E + c) * L + l] -= S[(TMP + 1) * L + l] * S[(M + a * E + k) * L + l]
+
+
+@kernel(inline="always")
+def lanes_tangent(S, L, m, E):
+    """``T = Q e_m`` (normalised: a unit null vector of ``J`` where it has full row rank) from
+    :func:`lanes_qr`'s reflectors, applied last to first."""
+    M, VH, BETA, _, T, _, _, TMP, _, _, _, _, _ = lane_rows(m, E)
+    for a in range(m):
+        for l in range(L):
+            S[(T + a) * L + l] = 1.0 if a == m - 1 else 0.0
+    for k in range(E - 1, -1, -1):
+        for l in range(L):
+            S[(TMP + 1) * L + l] = S[(VH + k) * L + l] * S[(T + k) * L + l]
+        for a in range(k + 1, m):
+            for l in range(L):
+                S[(TMP + 1) * L + l] += S[(M + a * E + k) * L + l] * S[(T + a) * L + l]
+        for l in range(L):
+            d = S[(TMP + 1) * L + l] * S[(BETA + k) * L + l]
+            S[(TMP + 1) * L + l] = d
+            S[(T + k) * L + l] -= d * S[(VH + k) * L + l]
+        for a in range(k + 1, m):
+            for l in range(L):
+                S[(T + a) * L + l] -= S[(TMP + 1) * L + l] * S[(M + a * E + k) * L + l]
+    for l in range(L):
+        S[TMP * L + l] = 0.0
+    for a in range(m):
+        for l in range(L):
+            x = S[(T + a) * L + l]
+            S[TMP * L + l] += x * x
+    for l in range(L):
+        S[TMP * L + l] = 1.0 / math.sqrt(S[TMP * L + l])  # 1 to a few rounding errors
+    for a in range(m):
+        for l in range(L):
+            S[(T + a) * L + l] *= S[TMP * L + l]
+
+
+@kernel(inline="always")
+def lanes_warm_start(S, L, m, E):
+    """Each lane's start ``V``: its right singular vectors extrapolated from its last three points (``3 V - 3
+    V_1 + V_2``, off by their third difference) once it has three and the extrapolation moves no entry by more
+    than :data:`EXTRAPOLATE`, else its last (the identity when fresh);
+    orthonormalised (modified Gram-Schmidt); then ``W = R V``, ``R`` the upper triangle of ``M[:E]``. The
+    history moves back one point."""
+    M, _, _, _, _, W, _, TMP, V, V1, V2, DEPTH, _ = lane_rows(m, E)
+    for l in range(L):
+        S[TMP * L + l] = 0.0
+    for i in range(E * E):
+        for l in range(L):
+            step = 2.0 * S[(V + i) * L + l] - 3.0 * S[(V1 + i) * L + l] + S[(V2 + i) * L + l]
+            S[TMP * L + l] = max(S[TMP * L + l], abs(step))
+    for l in range(
+        L
+    ):  # extrapolate where the correction is small (a smooth path), so V stays well conditioned
+        S[TMP * L + l] = 1.0 if (S[DEPTH * L + l] >= 3.0) & (S[TMP * L + l] <= EXTRAPOLATE) else 0.0
+    for i in range(E * E):
+        for l in range(L):
+            x, x1 = S[(V + i) * L + l], S[(V1 + i) * L + l]
+            S[(V + i) * L + l] = 3.0 * (x - x1) + S[(V2 + i) * L + l] if S[TMP * L + l] > 0.0 else x
+            S[(V2 + i) * L + l] = x1
+            S[(V1 + i) * L + l] = x
+    for l in range(L):
+        depth = S[DEPTH * L + l]
+        S[DEPTH * L + l] = depth + 1.0 if depth < 3.0 else 3.0
+    for c in range(E):
+        for b in range(c):
+            for l in range(L):
+                S[TMP * L + l] = 0.0
+            for a in range(E):
+                for l in range(L):
+                    S[TMP * L + l] += S[(V + a * E + b) * L + l] * S[(V + a * E + c) * L + l]
+            for a in range(E):
+                for l in range(L):
+                    S[(V + a * E + c) * L + l] -= S[TMP * L + l] * S[(V + a * E + b) * L + l]
+        for l in range(L):
+            S[TMP * L + l] = 0.0
+        for a in range(E):
+            for l in range(L):
+                x = S[(V + a * E + c) * L + l]
+                S[TMP * L + l] += x * x
+        for l in range(L):
+            S[TMP * L + l] = 1.0 / math.sqrt(S[TMP * L + l])
+        for a in range(E):
+            for l in range(L):
+                S[(V + a * E + c) * L + l] *= S[TMP * L + l]
+    for a in range(E):
+        for c in range(E):
+            for l in range(L):
+                S[TMP * L + l] = 0.0
+            for b in range(a, E):
+                for l in range(L):
+                    S[TMP * L + l] += S[(M + a * E + b) * L + l] * S[(V + b * E + c) * L + l]
+            for l in range(L):
+                S[(W + a * E + c) * L + l] = S[TMP * L + l]
+
+
+@kernel(inline="always")
+def lanes_sweep(S, L, m, E):
+    """One cyclic sweep of one-sided Jacobi rotations (Hestenes) on the columns of every lane's ``W (E, E)``
+    (and ``V``), side by side: the rotation of :func:`linkwork.kinematics.dyad_solver.jacobi_sweeps`, made as
+    the identity where a pair's squared cosine is below :data:`TINY`; a lane's ``WIDE_ROW`` entry set to 1
+    where some pair's squared cosine exceeded :data:`WIDE` (that lane's sweep did not finish)."""
+    _, _, _, _, _, W, WIDE_ROW, TMP, V, _, _, _, _ = lane_rows(m, E)
+    for p in range(E - 1):
+        for r in range(p + 1, E):
+            for l in range(L):
+                S[TMP * L + l] = 0.0
+                S[(TMP + 1) * L + l] = 0.0
+                S[(TMP + 2) * L + l] = 0.0
+            for a in range(E):
+                for l in range(L):
+                    wp, wr = S[(W + a * E + p) * L + l], S[(W + a * E + r) * L + l]
+                    S[TMP * L + l] += wp * wp
+                    S[(TMP + 1) * L + l] += wr * wr
+                    S[(TMP + 2) * L + l] += wp * wr
+            for l in range(L):
+                alpha, beta, gamma = S[TMP * L + l], S[(TMP + 1) * L + l], S[(TMP + 2) * L + l]
+                gg, ab = gamma * gamma, alpha * beta
+                S[WIDE_ROW * L + l] = 1.0 if gg > WIDE * ab else S[WIDE_ROW * L + l]
+                d = beta - alpha
+                root = math.sqrt(d * d + 4.0 * gg)
+                big = abs(d) + root
+                den = 2.0 * root * big
+                turn = (gg > TINY * ab) & (den > FLOOR)
+                inv = 1.0 / math.sqrt(den) if turn else 0.0
+                S[TMP * L + l] = big * inv if turn else 1.0
+                S[(TMP + 1) * L + l] = (2.0 * gamma if d >= 0.0 else -2.0 * gamma) * inv
+            for a in range(E):
+                for l in range(L):
+                    cos, sin = S[TMP * L + l], S[(TMP + 1) * L + l]
+                    wp, wr = S[(W + a * E + p) * L + l], S[(W + a * E + r) * L + l]
+                    S[(W + a * E + p) * L + l] = cos * wp - sin * wr
+                    S[(W + a * E + r) * L + l] = sin * wp + cos * wr
+                    vp, vr = S[(V + a * E + p) * L + l], S[(V + a * E + r) * L + l]
+                    S[(V + a * E + p) * L + l] = cos * vp - sin * vr
+                    S[(V + a * E + r) * L + l] = sin * vp + cos * vr
+
+
+@kernel(inline="always")
+def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
+    """The rows at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side by side (see
+    :func:`multi_loop_rows`; ``S`` the work array, :func:`lane_rows`); returns how many lanes fell back to the
+    exact routine. ``m, E``: the sizes (literal constants at a call site, so that the loops over them unroll and
+    the lanes' loops vectorise)."""
+    M, _, _, DET, T, W, WIDE_ROW, TMP, _, _, _, DEPTH, _ = lane_rows(m, E)
+    L = points.shape[0]  # LANES at run time: a loop of a known count of eight LLVM unrolls, not vectorises
+    for a in range(m):
+        for e in range(E):
+            for l in range(L):
+                S[(M + a * E + e) * L + l] = jac[e, a, points[l]]
+    lanes_qr(S, L, m, E)
+    lanes_tangent(S, L, m, E)
+    for k in range(E):
+        for l in range(L):
+            S[DET * L + l] *= S[(M + k * E + k) * L + l]
+    lanes_warm_start(S, L, m, E)
+    for _ in range(LOCKSTEP_SWEEPS):
+        for l in range(L):
+            S[WIDE_ROW * L + l] = 0.0
+        lanes_sweep(S, L, m, E)
+        left = 0.0
+        for l in range(L):
+            left += S[WIDE_ROW * L + l]
+        if left == 0.0:
+            break
+    # The singular values: the columns' norms, into row 0 of W (free now), sorted descending (odd-even
+    # transposition sort: E rounds of compare-exchanges, the same in every lane).
+    for c in range(E):
+        for l in range(L):
+            S[TMP * L + l] = 0.0
+        for a in range(E):
+            for l in range(L):
+                x = S[(W + a * E + c) * L + l]
+                S[TMP * L + l] += x * x
+        for l in range(L):
+            S[(W + c) * L + l] = math.sqrt(S[TMP * L + l])
+    for rnd in range(E):
+        for c in range(rnd % 2, E - 1, 2):
+            for l in range(L):
+                x, y = S[(W + c) * L + l], S[(W + c + 1) * L + l]
+                S[(W + c) * L + l] = x if x >= y else y
+                S[(W + c + 1) * L + l] = y if x >= y else x
+    count = 0
+    for l in range(L):
+        k = points[l]
+        for e in range(E):
+            sigma[e, k] = S[(W + e) * L + l]
+        for a in range(m):
+            tangent[a, k] = S[(T + a) * L + l]
+        raw_tau[k] = S[DET * L + l]
+        if S[WIDE_ROW * L + l] > 0.0:  # not finished in LOCKSTEP_SWEEPS: the exact routine, cold
+            A, Vx, Wx, norms, order = fallback
+            for e in range(E):
+                for c in range(m):
+                    A[e, c] = jac[e, c, k]
+            for a in range(m):
+                for c in range(m):
+                    Vx[a, c] = 1.0 if a == c else 0.0
+            jacobi_svd(A, Vx, Wx, norms, order)
+            for e in range(E):
+                sigma[e, k] = norms[e]
+            S[DEPTH * L + l] = 0.0  # its warm start was no good: the next point starts from its last V alone
+            count += 1
+    return count
+
+
+@kernel(inline="always")
+def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
+    """:func:`multi_loop_rows` with the sizes ``m, E`` given (literal at a call site)."""
+    K = jac.shape[2]
+    _, _, _, _, _, _, _, _, V, _, _, _, total = lane_rows(m, E)
+    L = state.shape[0] // (3 * E * E + 1)  # LANES, but read at run time (see lanes_at)
+    S = np.empty(total * L)
+    for i in range(state.shape[0]):
+        S[V * L + i] = state[i]
+    fallback = (
+        np.empty((E, m)),
+        np.empty((m, m)),
+        np.empty((E, m)),
+        np.empty(m),
+        np.empty(m, dtype=np.int64),
+    )
+    points = np.empty(L, dtype=np.int64)
+    groups = (K - begin + L - 1) // L
+    first = K - groups * L
+    count = 0
+    for g in range(groups):
+        for l in range(L):
+            k = first + g * L + l
+            points[l] = k if k >= begin else begin
+        count += lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E)
+    for i in range(state.shape[0]):
+        state[i] = S[V * L + i]
+    return count
+
+
+@kernel(error_model="numpy", fastmath={"contract"})
+def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
+    """Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
+    (``m = E + 1``, one degree of freedom) at points ``begin .. K - 1``, :data:`LANES` points side by side.
+
+    Writes ``sigma (E, K)`` (descending), ``tangent (m, K)`` (a unit null vector; either sign) and ``raw_tau
+    (K,)`` (``det([J; t^T])`` for that ``t``); returns the number of points whose singular values the lanes did
+    not finish (recomputed by :func:`linkwork.kinematics.small_svd.jacobi_svd`, cold).
+
+    At each point a Householder QR of ``J^T = Q R``: the tangent is ``Q e_m`` and ``det([J; t^T]) = det(Q)
+    det(R)``; the singular values are ``R``'s, by one-sided Jacobi on ``W = R V``, ``V`` the right singular
+    vectors extrapolated from the lane's last three points (``state``, :func:`multi_loop_state`, carried from
+    call to call along a path). Lane ``l`` takes points ``k0 + l``: each lane's previous point is ``LANES``
+    points back (the groups are aligned on the last point, so that from one call to the next every lane
+    continues its own stretch). The sweeps go on, all lanes together, until none has a pair left wider than
+    :data:`WIDE` (after one sweep from a warm start, mostly two); the lanes' rotations are independent, so they
+    run as packed operations instead of waiting on each other. Every singular value is within ``1e-13
+    sigma_1``, ``|J t| <= 1e-14 sigma_1`` (Householder QR is backward stable), ``|t| = 1`` to ``1e-15``.
+    """
+    E, m = jac.shape[0], jac.shape[1]
+    if E == 6 and m == 7:  # two loops (a Watt or a Stephenson six-bar): sizes known, the loops unroll
+        return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, 7, 6)
+    return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E)
