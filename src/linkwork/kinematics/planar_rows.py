@@ -323,6 +323,13 @@ WIDE = 1e-16
 columns are orthogonal to about ``1e-16``: Jacobi converges quadratically)."""
 TINY = 1e-30
 """A pair whose squared cosine is below this is not rotated."""
+SEPARATED = 1e-17
+"""A sweep leaves a pair as it is in every lane when, in each, ``gamma^2 <= SEPARATED |alpha - beta| min(alpha,
+beta)`` (``alpha, beta`` the columns' squared norms, ``gamma`` their dot product): the eigenvalues of the pair's
+``2 x 2`` Gram matrix are then its diagonal moved by at most ``gamma^2 / |alpha - beta| <= SEPARATED min(alpha,
+beta)`` (relative ``1e-17``), so the column norms are the singular values as accurately as after the rotation. Such
+a pair's squared cosine is below ``WIDE`` (``|alpha - beta| min <= alpha beta``): it is a finished sweep's pair,
+whose rotation (a few hundred flops) the check alone now replaces."""
 EXTRAPOLATE = 0.1
 """A lane's warm start is extrapolated only where that moves no entry of its last ``V`` by more than this (then
 the guess is well conditioned and one Gram-Schmidt pass makes it orthogonal to round-off); elsewhere (unrelated
@@ -516,10 +523,18 @@ def lanes_sweep(S, L, m, E):
                     S[TMP * L + l] += wp * wp
                     S[(TMP + 1) * L + l] += wr * wr
                     S[(TMP + 2) * L + l] += wp * wr
+            wide, keep = 0, 0
             for l in range(L):
                 alpha, beta, gamma = S[TMP * L + l], S[(TMP + 1) * L + l], S[(TMP + 2) * L + l]
                 gg, ab = gamma * gamma, alpha * beta
+                wide += 1 if gg > WIDE * ab else 0
+                keep += 1 if gg > SEPARATED * abs(alpha - beta) * min(alpha, beta) else 0
                 S[WIDE_ROW * L + l] = 1.0 if gg > WIDE * ab else S[WIDE_ROW * L + l]
+            if keep == 0:
+                continue  # in every lane, leaving the pair as it is moves its squared norms by < 1e-17 relative
+            for l in range(L):
+                alpha, beta, gamma = S[TMP * L + l], S[(TMP + 1) * L + l], S[(TMP + 2) * L + l]
+                gg, ab = gamma * gamma, alpha * beta
                 d = beta - alpha
                 root = math.sqrt(d * d + 4.0 * gg)
                 big = abs(d) + root
@@ -534,6 +549,11 @@ def lanes_sweep(S, L, m, E):
                     wp, wr = S[(W + a * E + p) * L + l], S[(W + a * E + r) * L + l]
                     S[(W + a * E + p) * L + l] = cos * wp - sin * wr
                     S[(W + a * E + r) * L + l] = sin * wp + cos * wr
+            if wide == 0:
+                continue  # every lane's rotation is within 1e-8 of the identity: V (a warm start) keeps it
+            for a in range(E):
+                for l in range(L):
+                    cos, sin = S[TMP * L + l], S[(TMP + 1) * L + l]
                     vp, vr = S[(V + a * E + p) * L + l], S[(V + a * E + r) * L + l]
                     S[(V + a * E + p) * L + l] = cos * vp - sin * vr
                     S[(V + a * E + r) * L + l] = sin * vp + cos * vr
