@@ -509,7 +509,9 @@ def lanes_sweep(S, L, m, E):
     """One cyclic sweep of one-sided Jacobi rotations (Hestenes) on the columns of every lane's ``W (E, E)``
     (and ``V``), side by side: the rotation of :func:`linkwork.kinematics.dyad_solver.jacobi_sweeps`, made as
     the identity where a pair's squared cosine is below :data:`TINY`; a lane's ``WIDE_ROW`` entry set to 1
-    where some pair's squared cosine exceeded :data:`WIDE` (that lane's sweep did not finish)."""
+    where some pair's squared cosine exceeded :data:`WIDE` (that lane's sweep did not finish). A pair that is
+    :data:`SEPARATED` in every lane is left as it is, and ``V`` (only the next point's warm start) is not rotated
+    where every lane's rotation is within ``1e-8`` of the identity: a finished sweep is then mostly a check."""
     _, _, _, _, _, W, WIDE_ROW, TMP, V, _, _, _, _ = lane_rows(m, E)
     for p in range(E - 1):
         for r in range(p + 1, E):
