@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from closed_form_probe import kernel_rows
 
 import linkwork as lw
 from linkwork.kinematics import dyad_solver
@@ -26,21 +27,7 @@ def compiled(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def kernel_call(mech: Mechanism, turn: float, steps: int) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
     """``(arguments, outputs)`` of the closed-form kernel on a paper-mode trace of ``turn`` radians of joint A."""
-    original = dyad_solver.closed_form_path
-    seen: list[tuple[tuple[Any, ...], tuple[Any, ...]]] = []
-
-    def watched(*args: Any) -> Any:
-        out = original(*args)
-        seen.append((args, out))
-        return out
-
-    try:
-        dyad_solver.closed_form_path = watched  # type: ignore[assignment]
-        lw.trace(mech, until=("A", float(mech.offsets[mech.index("A")] + turn)), steps=steps)
-    finally:
-        dyad_solver.closed_form_path = original
-    assert seen, "the closed form was not tried"
-    return seen[-1]
+    return kernel_rows(mech, ("A", float(mech.offsets[mech.index("A")] + turn)), steps)
 
 
 def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from closed_form_probe import kernel_rows
 
 import linkwork as lw
 from linkwork.kinematics import tracer
@@ -209,30 +210,6 @@ def test_stephenson_six_bar_driven_by_its_crank_or_through_a_triad() -> None:
         fast, general, taken = traced_both_ways(mech, (drive, np.radians(turn)), 60)
         assert taken == expect
         assert_same_trace(fast, general)
-
-
-def kernel_rows(
-    mech: Mechanism, until: tuple[str, float], steps: int
-) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
-    """``(arguments, outputs)`` of the compiled closed-form kernel on one paper-mode trace, whatever its status
-    (rows ``0 .. count - 1`` are the closed form's, also where it then handed the path over)."""
-    from linkwork.kinematics import dyad_solver
-
-    original = dyad_solver.closed_form_path
-    seen: list[tuple[tuple[Any, ...], tuple[Any, ...]]] = []
-
-    def watched(*args: Any) -> Any:
-        out = original(*args)
-        seen.append((args, out))
-        return out
-
-    try:
-        dyad_solver.closed_form_path = watched  # type: ignore[assignment]
-        lw.trace(mech, until=until, steps=steps)
-    finally:
-        dyad_solver.closed_form_path = original
-    assert seen, "the closed form was not tried"
-    return seen[-1]
 
 
 NEAR_SINGULAR = {

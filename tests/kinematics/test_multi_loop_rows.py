@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from bookkeeping_reference import stephenson_six_bar
+from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
 from linkwork.kinematics.closure import jacobian
@@ -38,21 +39,7 @@ def rows(J: np.ndarray, kernel=multi_loop_rows) -> tuple[np.ndarray, np.ndarray,
 def check_rows(J: np.ndarray, kernel=multi_loop_rows) -> int:  # type: ignore[no-untyped-def]
     """Assert the accuracy contract on every point of ``J (K, E, m)``; returns the number of fall-backs."""
     sigma, t, tau, count = rows(J, kernel)
-    s = np.linalg.svd(J, compute_uv=False)
-    s1 = s[:, :1]
-    assert np.all(np.abs(sigma - s) <= SIGMA_TOL * s1), np.max(np.abs(sigma - s) / s1)
-    assert np.all(sigma[:, :-1] >= sigma[:, 1:])
-    residual = np.linalg.norm(np.einsum("kec,kc->ke", J, t), axis=1)
-    assert np.all(residual <= RESIDUAL_TOL * s[:, 0]), np.max(residual / s[:, 0])
-    assert np.all(np.abs(np.linalg.norm(t, axis=1) - 1.0) <= UNIT_TOL)
-    # LAPACK's determinant of [J; t^T], J scaled by a power of two near 1 / sigma_1 (exactly: the bordered rows
-    # then have one scale), relative where J is well conditioned.
-    E = J.shape[1]
-    exponent = np.frexp(np.maximum(s[:, 0], 1e-300))[1]
-    scaled = np.ldexp(J, -exponent[:, None, None])
-    det = np.ldexp(np.linalg.det(np.concatenate([scaled, t[:, None, :]], axis=1)), E * exponent)
-    conditioned = s[:, -1] > 1e-2 * s[:, 0]
-    assert np.all(np.abs(tau - det)[conditioned] <= TAU_TOL * np.abs(det[conditioned]))
+    assert_rows_contract(J, (sigma, t, tau), (SIGMA_TOL, RESIDUAL_TOL, UNIT_TOL, TAU_TOL))
     return count
 
 

@@ -11,6 +11,7 @@ from fractions import Fraction
 import numba
 import numpy as np
 import pytest
+from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
 from linkwork.kinematics import planar_rows
@@ -37,24 +38,7 @@ def rows(J: np.ndarray, kernel=one_loop_rows) -> tuple[np.ndarray, np.ndarray, n
 def check_rows(J: np.ndarray, kernel=one_loop_rows) -> int:  # type: ignore[no-untyped-def]
     """Assert the accuracy contract on every point of ``J (K, 3, 4)``; returns the number of fall-backs."""
     sigma, t, tau, count = rows(J, kernel)
-    s = np.linalg.svd(J, compute_uv=False)
-    s1 = s[:, :1]
-    assert np.all(np.abs(sigma - s) <= SIGMA_TOL * s1), np.max(np.abs(sigma - s) / s1)
-    assert np.all(sigma[:, :-1] >= sigma[:, 1:])
-    residual = np.linalg.norm(np.einsum("kec,kc->ke", J, t), axis=1)
-    assert np.all(residual <= RESIDUAL_TOL * s[:, 0]), np.max(residual / s[:, 0])
-    assert np.all(np.abs(np.linalg.norm(t, axis=1) - 1.0) <= UNIT_TOL)
-    # LAPACK's determinant of [J; t^T], J scaled by a power of two near 1 / sigma_1 (exactly; unscaled, the
-    # bordered matrix's rows differ in scale by sigma_1 and LU loses that much), is accurate to about eps sigma_1
-    # / sigma_3 relative: compare relative where J is well conditioned, else with the product of LAPACK's
-    # singular values (accurate to eps sigma_1^2 sigma_2) and the sign of the determinant.
-    exponent = np.frexp(np.maximum(s[:, 0], 1e-300))[1]
-    scaled = np.ldexp(J, -exponent[:, None, None])
-    det = np.ldexp(np.linalg.det(np.concatenate([scaled, t[:, None, :]], axis=1)), 3 * exponent)
-    conditioned = s[:, 2] > 1e-2 * s[:, 0]
-    assert np.all(np.abs(tau - det)[conditioned] <= TAU_TOL * np.abs(det[conditioned]))
-    product = np.sign(det) * np.prod(s, axis=1)
-    assert np.all(np.abs(tau - product) <= TAU_TOL * s[:, 0] ** 2 * s[:, 1])
+    assert_rows_contract(J, (sigma, t, tau), (SIGMA_TOL, RESIDUAL_TOL, UNIT_TOL, TAU_TOL), product_bound=True)
     return count
 
 
