@@ -95,7 +95,7 @@ def work_rows(m, E):
     the left reflectors below the diagonal, the right ones right of the superdiagonal), the reflectors' first
     entries and factors (left and right, ``E`` each), ``det(U) det(V)``, the tangent (``m``), ``T``'s diagonal and
     squared off-diagonal (``E`` each), ``prod d_i``, ``|B|_F^2``, the roots, their bounds, their Laguerre steps,
-    the cold roots (``E`` each), the singular values (``E``), the certified flag, four temporaries, then the state:
+    whether each is converged, the cold roots (``E`` each), the singular values (``E``), the certified flag, four temporaries, then the state:
     the previous roots (``E - 1``) and whether they are set. Returns their offsets and the total."""
     M = 0
     VH = M + m * E
@@ -111,13 +111,37 @@ def work_rows(m, E):
     X = P1 + 1
     DX = X + E
     STEP = DX + E
-    XC = STEP + E
+    CONV = STEP + E
+    XC = CONV + E
     SIG = XC + E
     OK = SIG + E
     TMP = OK + 1
     PREV = TMP + 4
     SET = PREV + E - 1
-    return M, VH, BETA, VR, BR, DET, T, A, W, PROD, P1, X, DX, STEP, XC, SIG, OK, TMP, PREV, SET, SET + 1
+    return (
+        M,
+        VH,
+        BETA,
+        VR,
+        BR,
+        DET,
+        T,
+        A,
+        W,
+        PROD,
+        P1,
+        X,
+        DX,
+        STEP,
+        CONV,
+        XC,
+        SIG,
+        OK,
+        TMP,
+        PREV,
+        SET,
+        SET + 1,
+    )
 
 
 @kernel()
@@ -145,7 +169,7 @@ def lanes_bidiagonal(S, L, m, E):
     (Golub & Van Loan Alg. 5.4.2): for each column ``k`` a reflection from the left zeroes ``M[k+1:, k]``, then one
     from the right zeroes ``M[k, k+2:]``. ``DET`` collects ``-1`` for each reflection made (a zero vector's is the
     identity)."""
-    M, VH, BETA, VR, BR, DET, _, _, _, _, _, _, _, _, _, _, _, TMP, _, _, _ = work_rows(m, E)
+    M, VH, BETA, VR, BR, DET, _, _, _, _, _, _, _, _, _, _, _, _, TMP, _, _, _ = work_rows(m, E)
     for l in range(L):
         S[DET * L + l] = 1.0
     for k in range(E):
@@ -217,7 +241,7 @@ def lanes_bidiagonal(S, L, m, E):
 def lanes_tangent(S, L, m, E):
     """``t = U e_m`` (normalised: a unit null vector of ``J`` where it has full row rank) from the left
     reflectors, applied last to first."""
-    M, VH, BETA, _, _, _, T, _, _, _, _, _, _, _, _, _, _, TMP, _, _, _ = work_rows(m, E)
+    M, VH, BETA, _, _, _, T, _, _, _, _, _, _, _, _, _, _, _, TMP, _, _, _ = work_rows(m, E)
     for a in range(m):
         for l in range(L):
             S[(T + a) * L + l] = 1.0 if a == m - 1 else 0.0
@@ -251,7 +275,7 @@ def lanes_tangent(S, L, m, E):
 def lanes_tridiagonal(S, L, m, E):
     """``T = B^T B / |B|_F^2`` (diagonal into ``A``, squared off-diagonal into ``W``), ``|B|_F^2`` into ``P1`` and
     ``prod d_i`` into ``PROD``; ``DET`` becomes ``det(U) det(V) prod d_i``."""
-    M, _, _, _, _, DET, _, A, W, PROD, P1, _, _, _, _, _, _, _, _, _, _ = work_rows(m, E)
+    M, _, _, _, _, DET, _, A, W, PROD, P1, _, _, _, _, _, _, _, _, _, _, _ = work_rows(m, E)
     for l in range(L):
         total, prod = 0.0, 1.0
         for k in range(E):
@@ -281,7 +305,7 @@ def characteristic(S, L, E, l, x):
     """``p(x) = det(T - x I)``, ``p'(x)``, ``p''(x)`` at lane ``l`` by the three-term recurrence of the leading
     minors, and ``mu``, a first-order bound of ``|fl(p) - p|`` for the exact ``T`` of ``B`` (running error
     analysis: ``a_i`` errs by ``4 u a_i``, ``w_i`` by ``5 u w_i``, each product and difference by ``u``)."""
-    _, _, _, _, _, _, _, A, W, _, _, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
+    _, _, _, _, _, _, _, A, W, _, _, _, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
     a = S[A * L + l]
     c = a - x
     pm, p = 1.0, c
@@ -303,8 +327,10 @@ def characteristic(S, L, E, l, x):
 @kernel(inline="always")
 def lanes_bounds(S, L, E):
     """At each lane's roots ``X``: their error bounds ``(|p| + mu) / |p'|`` into ``DX`` and Laguerre's steps
-    ``n p / (p' +- sqrt((n - 1)^2 p'^2 - n (n - 1) p p''))`` (``n = E``, the sign of ``p'``) into ``STEP``."""
-    _, _, _, _, _, _, _, _, _, _, _, X, DX, STEP, _, _, _, _, _, _, _ = work_rows(E + 1, E)
+    ``n p / (p' +- sqrt((n - 1)^2 p'^2 - n (n - 1) p p''))`` (``n = E``, the sign of ``p'``) into ``STEP``, and
+    into ``CONV`` whether the root is converged to round-off (``|p| <= mu``: the residual is within the
+    evaluation's own error bound)."""
+    _, _, _, _, _, _, _, _, _, _, _, X, DX, STEP, CONV, _, _, _, _, _, _, _ = work_rows(E + 1, E)
     n = float(E)
     for r in range(E - 1):
         for l in range(L):
@@ -316,29 +342,28 @@ def lanes_bounds(S, L, E):
             root = math.sqrt(disc if disc > 0.0 else 0.0)
             den = dp + root if dp >= 0.0 else dp - root
             S[(STEP + r) * L + l] = n * p / (den if abs(den) > FLOOR else FLOOR)
+            S[(CONV + r) * L + l] = 1.0 if abs(p) <= mu else 0.0
 
 
 @kernel(inline="always")
-def lanes_check(S, L, m, E):
+def lanes_check(S, L, m, E, strict):
     """The singular values of every lane from its roots ``X`` and bounds ``DX`` into ``SIG`` (``sigma_E = |prod
     d_i| / prod sigma_i``), and whether they are certified into ``OK`` (see the module's docstring: every root
     within ``dx_i`` of an eigenvalue of ``T``, the intervals disjoint and descending, ``sigma_E <= sigma_(E-1)``,
     the trace, and every singular value within ``SIGMA_TOL sigma_1`` of ``J``'s). Returns the lanes not
-    certified. The budget: each of ``sigma_1 .. sigma_(E-1)`` errs by at most ``beta / (E - 1)`` from its root
-    (``beta = SIGMA_TOL sigma_1`` less the reduction's and the roundings' share), ``sigma_E`` by their sum (its
-    relative error is the sum of theirs, and ``sigma_E <= sigma_i``)."""
-    _, _, _, _, _, _, _, A, _, PROD, P1, X, DX, _, _, SIG, OK, _, _, _, _ = work_rows(m, E)
+    certified (with ``strict``, also not converged to round-off: stopping there makes the values independent of
+    the starts, to round-off). The budget ``beta`` (``SIGMA_TOL sigma_1`` less the reduction's and the roundings' share): each
+    ``sigma_i`` (``i < E``) errs by at most ``dsigma_i = dlambda_i / sigma_i <= beta sigma_i / ((E - 1) sigma_E +
+    sigma_i)``, so that ``dsigma_i <= beta`` and ``sigma_E``'s error, ``sigma_E sum_i dsigma_i / sigma_i`` (its
+    relative error is the sum of theirs), is at most ``beta`` too; no division."""
+    _, _, _, _, _, _, _, A, _, PROD, P1, X, DX, _, CONV, _, SIG, OK, _, _, _, _ = work_rows(m, E)
     c = reduction_bound(m, E)
-    share = 1.0 / (E - 1.0)
     bad = 0
     for l in range(L):
         p1 = S[P1 * L + l]
         trace, found, width = 0.0, 0.0, 0.0
         ok = True
         product = 1.0
-        top = S[X * L + l] * p1
-        s1 = math.sqrt(top if top > 0.0 else 0.0)
-        beta = SIGMA_TOL * s1 - c * U * math.sqrt(p1) - 8.0 * E * U * s1
         last = 2.0
         for r in range(E - 1):
             x = S[(X + r) * L + l]
@@ -346,7 +371,7 @@ def lanes_check(S, L, m, E):
             s = math.sqrt(x * p1 if x > 0.0 else 0.0)
             S[(SIG + r) * L + l] = s
             product *= s
-            ok = ok & (x > 0.0) & (x + dx < last) & (dx * p1 <= beta * share * s)
+            ok = ok & (x > 0.0) & (x + dx < last) & ((S[(CONV + r) * L + l] > 0.0) | (not strict))
             last = x - dx
             found += x
             width += dx
@@ -354,6 +379,12 @@ def lanes_check(S, L, m, E):
         trace += S[(A + E - 1) * L + l]
         low = abs(S[PROD * L + l]) / (product if product > FLOOR else FLOOR)
         S[(SIG + E - 1) * L + l] = low
+        s1 = S[SIG * L + l]
+        beta = SIGMA_TOL * s1 - c * U * math.sqrt(p1) - 8.0 * E * U * s1
+        spread = (E - 1.0) * low
+        for r in range(E - 1):
+            s = S[(SIG + r) * L + l]
+            ok = ok & (S[(DX + r) * L + l] * p1 * (spread + s) <= beta * s * s)
         x_low = low * low / (p1 if p1 > FLOOR else FLOOR)
         ok = ok & (low <= S[(SIG + E - 2) * L + l])
         ok = ok & (abs(found + x_low - trace) <= 2.0 * width + 4.0 * E * U + 2.0 * x_low * SIGMA_TOL)
@@ -370,7 +401,7 @@ def lanes_cold(S, L, m, E):
     roots found (Maehly's deflation), in the homogeneous form ``f = p Q^2``, ``f' = (p' Q - p Q') Q``, ``f'' = p''
     Q^2 - 2 p' Q' Q - p Q'' Q + 2 p Q'^2`` (Laguerre's step is unchanged when ``f, f', f''`` are scaled
     together): no division but the step's."""
-    _, _, _, _, _, _, _, A, W, _, _, _, _, _, XC, _, _, _, _, _, _ = work_rows(m, E)
+    _, _, _, _, _, _, _, A, W, _, _, _, _, _, _, XC, _, _, _, _, _, _ = work_rows(m, E)
     for l in range(L):
         sq = 0.0
         for k in range(E):
@@ -405,10 +436,32 @@ def lanes_cold(S, L, m, E):
 
 
 @kernel(inline="always")
+def lanes_refine(S, L, m, E):
+    """Laguerre's steps from the roots ``X`` (:data:`WARM_EVALUATIONS` evaluations, a step after each but the last on
+    the lanes not yet certified and converged), all lanes stopping together when every lane is; returns the lanes
+    not certified (converged or not) at the end."""
+    _, _, _, _, _, _, _, _, _, _, _, X, _, STEP, _, _, _, OK, _, _, _, _ = work_rows(m, E)
+    bad = L
+    for it in range(WARM_EVALUATIONS):
+        lanes_bounds(S, L, E)
+        bad = lanes_check(S, L, m, E, True)
+        if bad == 0:
+            break
+        if it == WARM_EVALUATIONS - 1:
+            bad = lanes_check(S, L, m, E, False)  # certified, if not to round-off
+            break
+        for r in range(E - 1):
+            for l in range(L):
+                x = S[(X + r) * L + l]
+                S[(X + r) * L + l] = x if S[OK * L + l] > 0.0 else x - S[(STEP + r) * L + l]
+    return bad
+
+
+@kernel(inline="always")
 def lanes_roots(S, L, m, E):
-    """The roots of every lane, certified where possible (``OK``): warm from the state's previous roots
-    (:data:`WARM_EVALUATIONS`), then, if any lane is fresh or not certified, from the bounds for those lanes."""
-    _, _, _, _, _, _, _, _, _, _, _, X, _, STEP, XC, _, OK, _, PREV, SET, _ = work_rows(m, E)
+    """The roots of every lane, certified where possible (``OK``): refined from the state's previous roots; if any
+    lane is fresh or not certified, the roots from the bounds for those lanes, refined again."""
+    _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, XC, _, OK, _, PREV, SET, _ = work_rows(m, E)
     fresh = 0
     for l in range(L):
         fresh += 1 if S[SET * L + l] == 0.0 else 0
@@ -417,15 +470,7 @@ def lanes_roots(S, L, m, E):
         for r in range(E - 1):
             for l in range(L):
                 S[(X + r) * L + l] = S[(PREV + r) * L + l]
-        for it in range(WARM_EVALUATIONS):
-            lanes_bounds(S, L, E)
-            bad = lanes_check(S, L, m, E)
-            if bad == 0 or it == WARM_EVALUATIONS - 1:
-                break
-            for r in range(E - 1):
-                for l in range(L):
-                    x = S[(X + r) * L + l]
-                    S[(X + r) * L + l] = x if S[OK * L + l] > 0.0 else x - S[(STEP + r) * L + l]
+        bad = lanes_refine(S, L, m, E)
     else:
         for l in range(L):
             S[OK * L + l] = 0.0
@@ -435,8 +480,7 @@ def lanes_roots(S, L, m, E):
             for l in range(L):
                 x = S[(X + r) * L + l]
                 S[(X + r) * L + l] = x if S[OK * L + l] > 0.0 else S[(XC + r) * L + l]
-        lanes_bounds(S, L, E)
-        bad = lanes_check(S, L, m, E)
+        bad = lanes_refine(S, L, m, E)
     return bad
 
 
@@ -445,7 +489,7 @@ def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
     """The rows at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side by side; returns how many lanes fell
     back to the exact routine. ``m, E``: the sizes (literal at a call site, so that the loops over them unroll and
     the lanes' loops vectorise)."""
-    M, _, _, _, _, DET, T, _, _, _, P1, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
+    M, _, _, _, _, DET, T, _, _, _, P1, _, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
     L = LANES  # a constant: LLVM proves the rows' ranges disjoint and vectorises without run-time checks
     for a in range(m):
         for e in range(E):
@@ -489,7 +533,7 @@ def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
 def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     """:func:`bidiagonal_rows` with the sizes ``m, E`` given (literal at a call site)."""
     K = jac.shape[2]
-    _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, PREV, _, total = work_rows(m, E)
+    _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, PREV, _, total = work_rows(m, E)
     L = LANES
     S = np.zeros(total * L)
     for i in range(state.shape[0]):
