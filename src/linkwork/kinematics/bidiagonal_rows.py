@@ -77,10 +77,10 @@ LANES = 16
 """Points solved side by side (each a lane of the packed operations)."""
 SIGMA_TOL = 1e-13
 """A lane is certified when every singular value's error bound is below this times ``sigma_1``."""
-WARM_EVALUATIONS = 4
-"""Evaluations of the characteristic polynomial at each root from a warm start (a Laguerre step after each but the
-last, on the lanes not yet certified); the lanes stop together when every lane is certified (on the Watt six-bar's
-turn in 3600 steps: after the third, lanes 16 points apart)."""
+WARM_EVALUATIONS = 3
+"""Evaluations of the characteristic polynomial and its error bound at each root after a first Laguerre step from a
+warm start (a step after each but the last, on the lanes not yet certified); the lanes stop together when every
+lane is certified (on the Watt six-bar's turn in 3600 steps, lanes 16 points apart: after the second)."""
 COLD_STEPS = 6
 """Laguerre steps for each root from the bounds (Maehly's deflation): enough for Gaussian Jacobians."""
 BELOW = 1e-3
@@ -346,6 +346,22 @@ def lanes_bounds(S, L, E):
 
 
 @kernel(inline="always")
+def lanes_step(S, L, E):
+    """One Laguerre step (see :func:`lanes_bounds`) at every lane's roots ``X``, without their bounds: from a warm
+    start, the first evaluation never certifies (a lane's last point is ``LANES`` points back)."""
+    _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
+    n = float(E)
+    for r in range(E - 1):
+        for l in range(L):
+            x = S[(X + r) * L + l]
+            p, dp, hp, _ = characteristic(S, L, E, l, x)
+            disc = (n - 1.0) * ((n - 1.0) * dp * dp - n * p * hp)
+            root = math.sqrt(disc if disc > 0.0 else 0.0)
+            den = dp + root if dp >= 0.0 else dp - root
+            S[(X + r) * L + l] = x - n * p / (den if abs(den) > FLOOR else FLOOR)
+
+
+@kernel(inline="always")
 def lanes_check(S, L, m, E, strict):
     """The singular values of every lane from its roots ``X`` and bounds ``DX`` into ``SIG`` (``sigma_E = |prod
     d_i| / prod sigma_i``), and whether they are certified into ``OK`` (see the module's docstring: every root
@@ -437,11 +453,12 @@ def lanes_cold(S, L, m, E):
 
 @kernel(inline="always")
 def lanes_refine(S, L, m, E):
-    """Laguerre's steps from the roots ``X`` (:data:`WARM_EVALUATIONS` evaluations, a step after each but the last on
-    the lanes not yet certified and converged), all lanes stopping together when every lane is; returns the lanes
-    not certified (converged or not) at the end."""
+    """Laguerre's steps from the roots ``X``: one on every lane (:func:`lanes_step`), then :data:`WARM_EVALUATIONS`
+    evaluations with their bounds, a step after each but the last on the lanes not yet certified and converged, all
+    lanes stopping together when every lane is; returns the lanes not certified (converged or not) at the end."""
     _, _, _, _, _, _, _, _, _, _, _, X, _, STEP, _, _, _, OK, _, _, _, _ = work_rows(m, E)
     bad = L
+    lanes_step(S, L, E)
     for it in range(WARM_EVALUATIONS):
         lanes_bounds(S, L, E)
         bad = lanes_check(S, L, m, E, True)
