@@ -533,7 +533,7 @@ def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
             jacobi_svd(A, Vx, Wx, norms, order)
             for e in range(E):
                 S[(SIG + e) * L + l] = norms[e]
-            count += 1
+            count += 1 if l == 0 or k != points[l - 1] else 0  # a repeated point (before ``begin``) once
         for e in range(E):
             sigma[e, k] = S[(SIG + e) * L + l]
     for r in range(E - 1):
