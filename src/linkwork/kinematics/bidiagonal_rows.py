@@ -78,9 +78,12 @@ LANES = 16
 SIGMA_TOL = 1e-13
 """A lane is certified when every singular value's error bound is below this times ``sigma_1``."""
 WARM_EVALUATIONS = 3
-"""Evaluations of the characteristic polynomial and its error bound at each root after a first Laguerre step from a
-warm start (a step after each but the last, on the lanes not yet certified); the lanes stop together when every
-lane is certified (on the Watt six-bar's turn in 3600 steps, lanes 16 points apart: after the second)."""
+"""Evaluations of the characteristic polynomial and its error bound at each root after :data:`BLIND_STEPS` (a
+Laguerre step after each but the last, on the lanes not yet certified); the lanes stop together when every lane is
+certified."""
+BLIND_STEPS = 2
+"""Laguerre steps from a warm start before the first evaluation of the bounds (without them: on the Watt six-bar's
+turn in 3600 steps, lanes 16 points apart, two leave every root within a few rounding errors)."""
 COLD_STEPS = 6
 """Laguerre steps for each root from the bounds (Maehly's deflation): enough for Gaussian Jacobians."""
 BELOW = 1e-3
@@ -347,8 +350,8 @@ def lanes_bounds(S, L, E):
 
 @kernel(inline="always")
 def lanes_step(S, L, E):
-    """One Laguerre step (see :func:`lanes_bounds`) at every lane's roots ``X``, without their bounds: from a warm
-    start, the first evaluation never certifies (a lane's last point is ``LANES`` points back)."""
+    """One Laguerre step (see :func:`lanes_bounds`) at every lane's roots ``X``, without their bounds (from a warm
+    start, a lane's last point ``LANES`` points back, the first evaluations would not certify)."""
     _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
     n = float(E)
     for r in range(E - 1):
@@ -453,12 +456,14 @@ def lanes_cold(S, L, m, E):
 
 @kernel(inline="always")
 def lanes_refine(S, L, m, E):
-    """Laguerre's steps from the roots ``X``: one on every lane (:func:`lanes_step`), then :data:`WARM_EVALUATIONS`
-    evaluations with their bounds, a step after each but the last on the lanes not yet certified and converged, all
-    lanes stopping together when every lane is; returns the lanes not certified (converged or not) at the end."""
+    """Laguerre's steps from the roots ``X``: :data:`BLIND_STEPS` on every lane (:func:`lanes_step`), then
+    :data:`WARM_EVALUATIONS` evaluations with their bounds, a step after each but the last on the lanes not yet
+    certified and converged, all lanes stopping together when every lane is; returns the lanes not certified
+    (converged or not) at the end."""
     _, _, _, _, _, _, _, _, _, _, _, X, _, STEP, _, _, _, OK, _, _, _, _ = work_rows(m, E)
     bad = L
-    lanes_step(S, L, E)
+    for _ in range(BLIND_STEPS):
+        lanes_step(S, L, E)
     for it in range(WARM_EVALUATIONS):
         lanes_bounds(S, L, E)
         bad = lanes_check(S, L, m, E, True)
