@@ -139,3 +139,44 @@ def test_plain_python_twin_keeps_the_contract() -> None:
     np.testing.assert_allclose(plain[0], compiled[0], rtol=0.0, atol=1e-14 * np.max(compiled[0]))
     np.testing.assert_allclose(plain[1][:56], compiled[1][:56], rtol=0.0, atol=1e-14)
     assert plain[3] == compiled[3]
+
+
+def test_lanes_not_certified_fall_back_and_are_right() -> None:
+    """Cases built to fail the certification: equal singular values (the roots' intervals overlap), one double pair
+    among distinct ones (the same), a fifth singular value 1e-7 sigma_1 (``d sigma = d lambda / sigma`` exceeds the
+    budget): every point falls back to the exact routine (counted once, also where a group is padded with
+    repeats of the first point), and the rows keep the contract."""
+    for values in [
+        (1.0, 1.0, 1.0, 1.0, 1.0, 1.0),
+        (1.0, 0.7, 0.5, 0.5, 0.3, 0.1),
+        (1.0, 0.8, 0.6, 0.4, 1e-7, 1e-8),
+    ]:
+        assert check_rows(with_singular_values(np.array(values), 20)) == 20  # 2 groups, one padded
+
+
+def test_certified_lanes_are_most_and_right() -> None:
+    """Where the certification can hold it does: Gaussian 6x7 Jacobians and ones with a near rank drop
+    (sigma_6 = 1e-10 sigma_1, measured as |det B| over the others' product: right to 1e-5 relative, where
+    LAPACK's own is right to about 1e-6) are mostly certified, and right (numpy's SVD, the contract)."""
+    J = RNG.normal(size=(320, 6, 7))
+    assert check_rows(J) < 32
+    near = with_singular_values(np.array([1.0, 0.8, 0.6, 0.4, 0.2, 1e-10]), 64)
+    assert check_rows(near) == 0
+    sigma = rows(near)[0]
+    np.testing.assert_allclose(sigma[:, -1], np.linalg.svd(near, compute_uv=False)[:, -1], rtol=1e-5)
+
+
+def test_a_wrong_warm_start_is_caught() -> None:
+    """A state whose previous roots are nonsense (random, or every lane's the same value: Laguerre's steps then
+    converge to the wrong roots or to one root twice) is caught by the certification and redone from the bounds:
+    no fall-back, the contract kept."""
+    J = turn_jacobians(lw.load(str(WATT)))
+    jac = np.ascontiguousarray(J.transpose(1, 2, 0))
+    for previous in (RNG.uniform(size=(5, 16)), np.full((5, 16), 0.3)):
+        state = multi_loop_state(6)
+        state[: 5 * 16] = previous.ravel()
+        state[5 * 16 :] = 1.0  # set
+        K = len(J)
+        sigma, tangent, tau = np.empty((6, K)), np.empty((7, K)), np.empty(K)
+        assert multi_loop_rows(jac, sigma, tangent, tau, 0, state) == 0
+        assert_rows_contract(J, (sigma.T, tangent.T, tau), (SIGMA_TOL, RESIDUAL_TOL, UNIT_TOL, TAU_TOL))

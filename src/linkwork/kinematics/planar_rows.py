@@ -60,6 +60,7 @@ import math
 import numpy as np
 
 from linkwork.kernel_cache import kernel
+from linkwork.kinematics.bidiagonal_rows import bidiagonal_rows, bidiagonal_state
 from linkwork.kinematics.small_svd import jacobi_svd
 
 U = 2.0**-53
@@ -312,7 +313,7 @@ def one_loop_rows(jac, sigma, tangent, raw_tau):
 
 
 LANES = 16
-"""Points of a multi-loop Jacobian solved side by side by :func:`multi_loop_rows` (each a lane of its packed
+"""Points of a multi-loop Jacobian solved side by side by :func:`jacobi_loop_rows` (each a lane of its packed
 operations: four ``ymm`` registers). Fewer lanes leave the loops' set-up and the rotations' latency exposed, more
 warm-start each point from one further back (more sweeps): on the Watt six-bar's turn 4, 8, 16, 32, 64 lanes cost
 about 1500, 900, 560, 590, 630 ns a point (loaded machine)."""
@@ -338,7 +339,7 @@ points, a jump) it is its last ``V``, orthogonal already."""
 
 @kernel(inline="always")
 def lane_rows(m, E):
-    """The rows of :func:`multi_loop_rows`'s work array (each row ``LANES`` doubles, one a lane): where ``M`` (``J^T``
+    """The rows of :func:`jacobi_loop_rows`'s work array (each row ``LANES`` doubles, one a lane): where ``M`` (``J^T``
     and its QR, ``m x E``), the reflectors' first entries and factors (``E`` each), ``det``, the tangent
     (``m``), ``W`` (``E x E``), the sweep's flags, three temporaries, then the warm start ``V``, ``V_1``, ``V_2``
     (``E x E`` each) and its depth begin, and the total. One array, indexed by constants once the sizes are
@@ -359,8 +360,8 @@ def lane_rows(m, E):
 
 
 @kernel()
-def multi_loop_state(E):
-    """The warm start of :func:`multi_loop_rows`, carried from one call to the next along a path: each lane's
+def jacobi_loop_state(E):
+    """The warm start of :func:`jacobi_loop_rows`, carried from one call to the next along a path: each lane's
     right singular vectors at its last point and the two before (``3 x E x E`` rows of ``LANES``) and how many of
     them are set (one row; fresh: the identity, none)."""
     state = np.zeros((3 * E * E + 1) * LANES)
@@ -564,7 +565,7 @@ def lanes_sweep(S, L, m, E):
 @kernel(inline="always")
 def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
     """The rows at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side by side (see
-    :func:`multi_loop_rows`; ``S`` the work array, :func:`lane_rows`); returns how many lanes fell back to the
+    :func:`jacobi_loop_rows`; ``S`` the work array, :func:`lane_rows`); returns how many lanes fell back to the
     exact routine. ``m, E``: the sizes (literal constants at a call site, so that the loops over them unroll and
     the lanes' loops vectorise)."""
     M, _, _, DET, T, W, WIDE_ROW, TMP, _, _, _, DEPTH, _ = lane_rows(m, E)
@@ -631,7 +632,7 @@ def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
 
 @kernel(inline="always")
 def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
-    """:func:`multi_loop_rows` with the sizes ``m, E`` given (literal at a call site)."""
+    """:func:`jacobi_loop_rows` with the sizes ``m, E`` given (literal at a call site)."""
     K = jac.shape[2]
     _, _, _, _, _, _, _, _, V, _, _, _, total = lane_rows(m, E)
     L = state.shape[0] // (3 * E * E + 1)  # LANES, but read at run time (see lanes_at)
@@ -660,8 +661,10 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
 
 
 @kernel(error_model="numpy", fastmath={"contract"})
-def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
-    """Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
+def jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
+    """The route :func:`multi_loop_rows` took before its certified bidiagonal one (kept as the benchmark's
+    baseline, ``benchmarks/bench_planar_rows.py``; its singular values are not certified lane by lane, only their
+    sweeps' convergence). Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
     (``m = E + 1``, one degree of freedom) at points ``begin .. K - 1``, :data:`LANES` points side by side.
 
     Writes ``sigma (E, K)`` (descending), ``tangent (m, K)`` (a unit null vector; either sign) and ``raw_tau
@@ -670,7 +673,7 @@ def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
 
     At each point a Householder QR of ``J^T = Q R``: the tangent is ``Q e_m`` and ``det([J; t^T]) = det(Q)
     det(R)``; the singular values are ``R``'s, by one-sided Jacobi on ``W = R V``, ``V`` the right singular
-    vectors extrapolated from the lane's last three points (``state``, :func:`multi_loop_state`, carried from
+    vectors extrapolated from the lane's last three points (``state``, :func:`jacobi_loop_state`, carried from
     call to call along a path). Lane ``l`` takes points ``k0 + l``: each lane's previous point is ``LANES``
     points back (the groups are aligned on the last point, so that from one call to the next every lane
     continues its own stretch). The sweeps go on, all lanes together, until none has a pair left wider than
@@ -682,3 +685,31 @@ def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     if E == 6 and m == 7:  # two loops (a Watt or a Stephenson six-bar): sizes known, the loops unroll
         return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, 7, 6)
     return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E)
+
+
+@kernel()
+def multi_loop_state(E):
+    """The warm start of :func:`multi_loop_rows`, carried from one call to the next along a path
+    (:func:`linkwork.kinematics.bidiagonal_rows.bidiagonal_state`: each lane's squared singular values at its last
+    point)."""
+    return bidiagonal_state(E)
+
+
+@kernel(error_model="numpy", fastmath={"contract"})
+def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
+    """Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
+    (``m = E + 1``, one degree of freedom) at points ``begin .. K - 1``.
+
+    Writes ``sigma (E, K)`` (descending), ``tangent (m, K)`` (a unit null vector; either sign) and ``raw_tau
+    (K,)`` (``det([J; t^T])`` for that ``t``); returns the number of points whose singular values the certified
+    route could not certify (recomputed by :func:`linkwork.kinematics.small_svd.jacobi_svd`, cold). ``state``
+    (:func:`multi_loop_state`) is carried from call to call along a path.
+
+    The route (:mod:`linkwork.kinematics.bidiagonal_rows`): a Householder bidiagonalisation of ``J^T``, 16 points
+    side by side, gives the tangent, ``det([J; t^T])`` and a bidiagonal ``B``; the squared singular values are the
+    roots of ``B^T B``'s characteristic polynomial (Laguerre's method from the lane's previous point's, else from
+    the bounds), the smallest ``|det B|`` over the others' product; every lane carries a first-order error bound
+    and is certified to ``1e-13 sigma_1`` for every singular value, or falls back. ``|J t| <= 1e-14 sigma_1``
+    (Householder reflections are backward stable), ``|t| = 1`` to ``1e-15``.
+    """
+    return bidiagonal_rows(jac, sigma, tangent, raw_tau, begin, state)
