@@ -761,23 +761,16 @@ def closed_form_path(flat, plan, run):
     flipped = 0  # the tangent's orientation is -1 (the one before the block's first point)
     turn_bits = np.empty(C, dtype=np.int64)
     near_start = 1.5 * abs(h)  # a path closes where it comes back this near its start
+    limits = (min_ratio, min_drive, near_start, hmax, det_basis)
     for first in range(1, steps + 1, BLOCK):
         # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
-        value = drive_q[0]  # carried in a register, not reloaded from the store before
-        for i in range(1, C):
-            value = target if first - 1 + i == steps else value + h
-            drive_q[i] = value
+        drive_values(drive_q, first, steps, h, target)
         status[:] = CLEAN
         jump[:] = 0.0
         place_driver(joint_int, joint_geo, head, drive_q, poses)
         place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
         joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry)
-        size, ended = min(BLOCK, steps + 1 - first), CLEAN  # points of the block placed; why the next was not
-        for i in range(1, size + 1):
-            code = JUMP if status[i] == CLEAN and jump[i] > 0.5 * np.pi else status[i]
-            if code != CLEAN:
-                size, ended = i - 1, code
-                break
+        size, ended = first_failure(status, jump, min(BLOCK, steps + 1 - first))
         for i in range(size + 1, C):  # past the block's last point: its copies (no NaN, no work for the rows)
             rel[:, :, i] = rel[:, :, size]
             q[:, i] = q[:, size]
@@ -790,82 +783,14 @@ def closed_form_path(flat, plan, run):
         for x in measures:
             x[:] = 0.0
         path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)
-        # The tangent's orientation (continuous from point to point, the start's at row 0), then the test function
-        # and every check at every point, then, point by point, the first point that fails (in the march's order:
-        # a rank or drive check, a sign change, a limit, then the closed path after the point is stored).
         begin = 0 if first == 1 else 1
-        # orient = -1 where align * (the orientation before) < 0, else 1 (at the start, the one before is 1): as
-        # bits, flipped = (align < 0) xor (flipped before) where align is neither 0 nor NaN, else 0. The bits in a
-        # vectorised loop, the recurrence (two integer operations a point) in a scalar one.
-        for i in range(begin, size + 1):
-            a = align[i]
-            turn_bits[i] = (1 if a < 0.0 else 0) | (2 if (a < 0.0) | (a > 0.0) else 0)
-        for i in range(begin, size + 1):
-            bits = turn_bits[i]
-            flipped = ((bits & 1) ^ flipped) & (bits >> 1)
-            turn_bits[i] = flipped
         taus[0] = out_tau[first - 1]
-        for i in range(begin, size + 1):
-            flips[i] = -1.0 if turn_bits[i] else 1.0
-            taus[i] = det_basis * raw_tau[i] * flips[i]
-        # Every check at every point (vectorised); a clean point that could close the path (near the start, not
-        # the start or the target) is marked NEAR_START for the scan below.
-        for i in range(begin, size + 1):
-            k = first - 1 + i
-            later = k > 0  # not the start
-            t_drive = tangent[g_drive, i]
-            singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
-            turned = later & ((flips[i] * t_drive) * h <= 0.0)
-            crossed = later & (taus[i] * taus[i - 1] < 0.0)
-            code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
-            code = LIMIT if code == CLEAN and outside[i] > 0.0 else code
-            near = later & (k < steps) & (wrapped[i] < near_start)
-            status[i] = NEAR_START if code == CLEAN and near else code
-        stop, code = size + 1, ended
-        arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
-        i = begin
-        while i <= size:  # the marked points one by one, the runs of clean points between them in loops
-            j = i
-            while j <= size and status[j] == CLEAN:
-                j += 1
-            for p in range(i, j):  # a running sum, in the march's order
-                arc = arc + dist[p] if first - 1 + p > 0 else 0.0
-                out_s[first - 1 + p] = arc
-            # The march's closed-path test keeps the largest distance from the start, and only compares it with
-            # 4 hmax: once above, it stays above (unless a NaN comes, which the march's select keeps too).
-            odd = 0
-            if far > 4.0 * hmax:
-                for p in range(i, j):
-                    odd += 0 if wrapped[p] == wrapped[p] else 1
-            if odd > 0 or not far > 4.0 * hmax:
-                for p in range(i, j):
-                    d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
-                    far = far if far >= d else d
-            if j > size:
-                break
-            if status[j] != NEAR_START:
-                stop, code = j, status[j]
-                break
-            # Near the start: the march's closed-path test (the target's step ends the march before it).
-            k = first - 1 + j
-            arc = arc + dist[j]
-            out_s[k] = arc
-            d = wrapped[j]
-            far = far if far >= d else d
-            if far > 4.0 * hmax:
-                stop, code = j, CLOSED  # row k is stored, but the path ends before it
-                break
-            i = j + 1
-        for j in range(n):
-            g = groups[j]
-            for i in range(begin, stop + 1 if code == CLOSED else stop):
-                out_u[first - 1 + i, g] = q[j, i]
-        for e in range(E):
-            for i in range(begin, stop + 1 if code == CLOSED else stop):
-                out_sigma[first - 1 + i, e] = sigma[e, i]
-        for i in range(begin, stop + 1 if code == CLOSED else stop):
-            out_res[first - 1 + i] = res[i]
-            out_tau[first - 1 + i] = taus[i]
+        flipped = check_points(
+            (sigma, tangent, raw_tau, measures), (flips, taus, turn_bits), status, (first, begin, size, steps),
+            g_drive, h, limits, flipped,
+        )  # fmt: skip
+        stop, code, far = scan_points(status, measures, out_s, (first, begin, size, steps), far, hmax, ended)
+        store_rows((q, sigma, res, taus), groups, outs, first, begin, stop + 1 if code == CLOSED else stop)
         if stop <= size:
             return zero_tail(first - 1 + stop, code, outs)
         if ended != CLEAN:
@@ -879,6 +804,140 @@ def closed_form_path(flat, plan, run):
         tangent[:, 0] = tangent[:, BLOCK]
         raw_tau[0] = raw_tau[BLOCK]
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
+
+
+@kernel(inline="always")
+def drive_values(drive_q, first, steps, h, target):
+    """The drive's values at the block of points from ``first``: ``drive_q[i]`` at point ``first - 1 + i``, a
+    running sum of the step ``h`` from ``drive_q[0]`` (as the march steps), ``target`` at point ``steps``."""
+    value = drive_q[0]  # carried in a register, not reloaded from the store before
+    for i in range(1, drive_q.shape[0]):
+        value = target if first - 1 + i == steps else value + h
+        drive_q[i] = value
+
+
+@kernel(inline="always")
+def first_failure(status, jump, size):
+    """``(placed, code)``: how many of the block's first ``size`` points were placed cleanly (a dyad solved, no
+    joint stepping by more than a quarter turn), and why the next one was not (:data:`CLEAN` if all were)."""
+    for i in range(1, size + 1):
+        code = JUMP if status[i] == CLEAN and jump[i] > 0.5 * np.pi else status[i]
+        if code != CLEAN:
+            return i - 1, code
+    return size, CLEAN
+
+
+@kernel(inline="always")
+def check_points(rows, orient, status, span, g_drive, h, limits, flipped):
+    """Every check at every point of the block, in ``status`` (vectorised); returns the orientation of the
+    tangent at the block's last point (1 for -1).
+
+    ``rows = (sigma, tangent, raw_tau, measures)``, ``orient = (flips, taus, turn_bits)`` (written: each point's
+    tangent orientation and test function; ``taus[0]`` the point before's), ``span = (first, begin, size,
+    steps)``, ``limits = (min_ratio, min_drive, near_start, hmax, det_basis)``.
+
+    The tangent's orientation (continuous from point to point, the start's at row 0), then the test function
+    and every check (in the march's order: a rank or drive check, a sign change, a limit); a clean point that
+    could close the path (near the start, not the start or the target) is marked :data:`NEAR_START`.
+    """
+    sigma, tangent, raw_tau, measures = rows
+    flips, taus, turn_bits = orient
+    first, begin, size, steps = span
+    min_ratio, min_drive, near_start, _hmax, det_basis = limits
+    align, _dist, wrapped, outside = measures
+    E = sigma.shape[0]
+    # orient = -1 where align * (the orientation before) < 0, else 1 (at the start, the one before is 1): as
+    # bits, flipped = (align < 0) xor (flipped before) where align is neither 0 nor NaN, else 0. The bits in a
+    # vectorised loop, the recurrence (two integer operations a point) in a scalar one.
+    for i in range(begin, size + 1):
+        a = align[i]
+        turn_bits[i] = (1 if a < 0.0 else 0) | (2 if (a < 0.0) | (a > 0.0) else 0)
+    for i in range(begin, size + 1):
+        bits = turn_bits[i]
+        flipped = ((bits & 1) ^ flipped) & (bits >> 1)
+        turn_bits[i] = flipped
+    for i in range(begin, size + 1):
+        flips[i] = -1.0 if turn_bits[i] else 1.0
+        taus[i] = det_basis * raw_tau[i] * flips[i]
+    for i in range(begin, size + 1):
+        k = first - 1 + i
+        later = k > 0  # not the start
+        t_drive = tangent[g_drive, i]
+        singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
+        turned = later & ((flips[i] * t_drive) * h <= 0.0)
+        crossed = later & (taus[i] * taus[i - 1] < 0.0)
+        code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
+        code = LIMIT if code == CLEAN and outside[i] > 0.0 else code
+        near = later & (k < steps) & (wrapped[i] < near_start)
+        status[i] = NEAR_START if code == CLEAN and near else code
+    return flipped
+
+
+@kernel(inline="always")
+def scan_points(status, measures, out_s, span, far, hmax, ended):
+    """``(stop, code, far)``: the block's first point that ends the path (``size + 1`` and ``ended`` if none) and
+    why, point by point in the march's order, running the arclength's sum into ``out_s`` and the largest distance
+    from the start ``far`` (carried from block to block). ``span = (first, begin, size, steps)``.
+
+    The marked points one by one, the runs of clean points between them in loops. A point near the start
+    (:data:`NEAR_START`) closes the path once ``far`` exceeds ``4 hmax`` (the march's test: its row is stored, but
+    the path ends before it)."""
+    _align, dist, wrapped, _outside = measures
+    first, begin, size, steps = span
+    stop, code = size + 1, ended
+    arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
+    i = begin
+    while i <= size:
+        j = i
+        while j <= size and status[j] == CLEAN:
+            j += 1
+        for p in range(i, j):  # a running sum, in the march's order
+            arc = arc + dist[p] if first - 1 + p > 0 else 0.0
+            out_s[first - 1 + p] = arc
+        # The march's closed-path test keeps the largest distance from the start, and only compares it with
+        # 4 hmax: once above, it stays above (unless a NaN comes, which the march's select keeps too).
+        odd = 0
+        if far > 4.0 * hmax:
+            for p in range(i, j):
+                odd += 0 if wrapped[p] == wrapped[p] else 1
+        if odd > 0 or not far > 4.0 * hmax:
+            for p in range(i, j):
+                d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
+                far = far if far >= d else d
+        if j > size:
+            break
+        if status[j] != NEAR_START:
+            stop, code = j, status[j]
+            break
+        # Near the start: the march's closed-path test (the target's step ends the march before it).
+        k = first - 1 + j
+        arc = arc + dist[j]
+        out_s[k] = arc
+        d = wrapped[j]
+        far = far if far >= d else d
+        if far > 4.0 * hmax:
+            stop, code = j, CLOSED  # row k is stored, but the path ends before it
+            break
+        i = j + 1
+    return stop, code, far
+
+
+@kernel(inline="always")
+def store_rows(block, groups, outs, first, begin, end):
+    """The block's rows ``begin .. end - 1`` into the outputs at rows ``first - 1 + i``: ``block = (q, sigma, res,
+    taus)``, ``outs = (out_u, out_sigma, out_res, out_tau, out_s)`` (the arclength is written by the scan)."""
+    q, sigma, res, taus = block
+    out_u, out_sigma, out_res, out_tau, _out_s = outs
+    for j in range(q.shape[0]):
+        g = groups[j]
+        for i in range(begin, end):
+            out_u[first - 1 + i, g] = q[j, i]
+    for e in range(sigma.shape[0]):
+        for i in range(begin, end):
+            out_sigma[first - 1 + i, e] = sigma[e, i]
+    for i in range(begin, end):
+        out_res[first - 1 + i] = res[i]
+        out_tau[first - 1 + i] = taus[i]
 
 
 @kernel(error_model="numpy")
