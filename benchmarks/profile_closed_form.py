@@ -142,7 +142,9 @@ class Block:
         if self.E == 3 and self.m == 4:
             one_loop_rows(self.jac, self.sigma, self.tangent, self.raw_tau)
         else:
-            multi_loop_rows(self.jac, self.sigma, self.tangent, self.raw_tau, 0 if first == 1 else 1, self.svd_state)
+            multi_loop_rows(
+                self.jac, self.sigma, self.tangent, self.raw_tau, 0 if first == 1 else 1, self.svd_state
+            )
         bounds = (self.run[2], self.run[3], self.run[4])
         for x in self.measures:
             x[:] = 0.0
@@ -165,7 +167,7 @@ def recorded_rows(call: tuple[Any, ...]) -> tuple[tuple[np.ndarray, ...], Block,
     block = Block(call)
     B, P = dyad_solver.BLOCK, block.steps + dyad_solver.BLOCK + 1
     sigma, tangent, raw_tau = np.zeros((block.E, P)), np.zeros((block.m, P)), np.zeros(P)
-    middle = 1 + B * max(0, (block.steps // B) // 2)
+    middle = 1 + B * max(0, (block.steps // B) // 2 - 1)
     saved: Block | None = None
     for first in range(1, block.steps + 1, B):
         if first == middle:
@@ -216,8 +218,10 @@ def _repeat_joints(R, joint_int, joint_geo, poses, drive, drive_q, rel, q, jump,
 
 @numba.njit
 def _repeat_closure(R, flat, rel, q, jac, res, scratch):  # type: ignore[no-untyped-def]
+    fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
+    dyad_solver.closure_constants(flat, jac, fresh)
     for _ in range(R):
-        dyad_solver.planar_closure(flat, rel, q, jac, res, scratch)
+        dyad_solver.closure_columns(flat, rel, q, jac, res, scratch, fresh)
 
 
 @numba.njit
@@ -281,11 +285,21 @@ def pass_timers(block: Block) -> dict[str, Callable[[int], None]]:
     status = b.status.copy()
     timers: dict[str, Callable[[int], None]] = {
         "driver": lambda R: _repeat_driver(R, joint_int, joint_geo, head, b.drive_q.copy(), b.poses.copy()),
-        "dyads": lambda R: _repeat_dyads(R, joint_int, joint_geo, dyads, modes, b.poses.copy(), margin, status),
+        "dyads": lambda R: _repeat_dyads(
+            R, joint_int, joint_geo, dyads, modes, b.poses.copy(), margin, status
+        ),
         "joint values": lambda R: _repeat_joints(
-            R, joint_int, joint_geo, b.poses, head[0], b.drive_q, b.rel.copy(), b.q.copy(), b.jump.copy(),
+            R,
+            joint_int,
+            joint_geo,
+            b.poses,
+            head[0],
+            b.drive_q,
+            b.rel.copy(),
+            b.q.copy(),
+            b.jump.copy(),
             tuple(x.copy() for x in b.carry),
-        ),  # fmt: skip
+        ),
         "closure": lambda R: _repeat_closure(R, b.flat, b.rel, b.q, b.jac.copy(), b.res.copy(), b.scratch),
         "measures": lambda R: _repeat_measures(
             R, b.q, b.flat[4], b.tangent, t0, (lo, hi, periodic), tuple(np.zeros(b.C) for _ in range(4))
@@ -312,7 +326,9 @@ def pass_timers(block: Block) -> dict[str, Callable[[int], None]]:
         R, (b.q, b.sigma, b.res, orient[1]), b.flat[4], outs, first, 1, B + 1
     )
     if b.E == 3 and b.m == 4:
-        timers["(rows)"] = lambda R: _repeat_one_rows(R, b.jac, b.sigma.copy(), b.tangent.copy(), b.raw_tau.copy())
+        timers["(rows)"] = lambda R: _repeat_one_rows(
+            R, b.jac, b.sigma.copy(), b.tangent.copy(), b.raw_tau.copy()
+        )
     else:
         timers["(rows)"] = lambda R: _repeat_multi_rows(
             R, b.jac, b.sigma.copy(), b.tangent.copy(), b.raw_tau.copy(), b.svd_state.copy()
@@ -340,7 +356,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--positions", type=int, default=3600)
     parser.add_argument("--repeats", type=int, default=30, help="rounds (best of)")
     parser.add_argument("--inner", type=int, default=400, help="block passes per timing (per-pass part)")
-    parser.add_argument("--against", default=None, help="also time this git revision's kernel (replayed rows)")
+    parser.add_argument(
+        "--against", default=None, help="also time this git revision's kernel (replayed rows)"
+    )
     args = parser.parse_args(argv)
     single_threaded()
     call = kernel_arguments(LINKAGES[args.linkage], args.positions)
@@ -359,7 +377,9 @@ def main(argv: list[str] | None = None) -> None:
             variants[f"{args.against}, rows replayed"] = lambda: theirs.closed_form_path(*call)
             checks[f"{args.against}, rows replayed"] = same_rows(expected, theirs.closed_form_path(*call))
         sig, tan, tau = (x.copy() for x in (block.sigma, block.tangent, block.raw_tau))
-        variants["(the replay's copying alone)"] = lambda: ours.replay_all(sig, tan, tau, points, dyad_solver.BLOCK)
+        variants["(the replay's copying alone)"] = lambda: ours.replay_all(
+            sig, tan, tau, points, dyad_solver.BLOCK
+        )
         timers = pass_timers(block)
         for run in (*variants.values(), *(lambda t=t: t(1) for t in timers.values())):
             run()  # compile

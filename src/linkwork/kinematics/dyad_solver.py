@@ -354,14 +354,27 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carr
 
 
 @kernel(error_model="numpy")
-def turn_column(product, col1, col2, rel, sign, w, vx, vy):
+def turn_column(product, col1, col2, rel, sign, w, vx, vy, fresh=False):
     """A revolute loop joint at every point: rows 2 and 3 of its Jacobian column ``Ad(g) xi = (w, R v + p x (0,
-    0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2``, with ``g = product = (cos, sin, p_x, p_y)`` the loop's
-    product before the joint, then ``g <- g exp(xi q)``: the rotation ``rel = (c, sign s)``, the translation
-    ``(I - R)(w x v)`` (``w . v = 0`` in the plane)."""
+    0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2`` (``fresh``: written, as added to zeros), with ``g =
+    product = (cos, sin, p_x, p_y)`` the loop's product before the joint, then ``g <- g exp(xi q)``: the rotation
+    ``rel = (c, sign s)``, the translation ``(I - R)(w x v)`` (``w . v = 0`` in the plane)."""
     c, s, px, py = product[0], product[1], product[2], product[3]
     rc, rs = rel[0], rel[1]
     ax, ay = -w * vy, w * vx
+    if fresh:  # 0 + x, as the sum into zeros gives (a zero's sign included), without reading the column
+        for k in range(c.shape[0]):
+            ck, sk, xk, yk = c[k], s[k], px[k], py[k]
+            col1[k] = 0.0 + (ck * vx - sk * vy + yk * w)
+            col2[k] = 0.0 + (sk * vx + ck * vy - xk * w)
+            cr, sr = rc[k], sign * rs[k]
+            ex = ax - (cr * ax - sr * ay)
+            ey = ay - (sr * ax + cr * ay)
+            px[k] = xk + (ck * ex - sk * ey)
+            py[k] = yk + (sk * ex + ck * ey)
+            c[k] = ck * cr - sk * sr
+            s[k] = sk * cr + ck * sr
+        return
     for k in range(c.shape[0]):
         ck, sk, xk, yk = c[k], s[k], px[k], py[k]
         col1[k] += ck * vx - sk * vy + yk * w
@@ -376,10 +389,19 @@ def turn_column(product, col1, col2, rel, sign, w, vx, vy):
 
 
 @kernel(error_model="numpy")
-def slide_column(product, col1, col2, q, vx, vy):
+def slide_column(product, col1, col2, q, vx, vy, fresh=False):
     """A prismatic loop joint at every point: its Jacobian column's rows 2 and 3 (``R v``) added to ``col1``,
-    ``col2``, then ``g <- g exp(xi q)``: the translation ``v q``."""
+    ``col2`` (``fresh``: written, as added to zeros), then ``g <- g exp(xi q)``: the translation ``v q``."""
     c, s, px, py = product[0], product[1], product[2], product[3]
+    if fresh:
+        for k in range(c.shape[0]):
+            ck, sk = c[k], s[k]
+            col1[k] = 0.0 + (ck * vx - sk * vy)
+            col2[k] = 0.0 + (sk * vx + ck * vy)
+            ex, ey = vx * q[k], vy * q[k]
+            px[k] += ck * ex - sk * ey
+            py[k] += sk * ex + ck * ey
+        return
     for k in range(c.shape[0]):
         ck, sk = c[k], s[k]
         col1[k] += ck * vx - sk * vy
@@ -438,13 +460,45 @@ def planar_closure(flat, rel, q, jac, res, scratch):
     revolute joint's ``exp`` uses the cosine and sine of its relative rotation as the bodies' poses give them,
     which equal those of its reported value to an ulp (the value is read back from them by an ``atan2``): no
     sine or cosine is evaluated here. Each step is one loop over the points on 1-d arrays (straight-line code
-    that vectorises).
+    that vectorises). The entries that do not depend on the point (row ``omega_z`` and the zeros) are written by
+    :func:`closure_constants`, the others by :func:`closure_columns`.
     """
+    fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
+    closure_constants(flat, jac, fresh)
+    closure_columns(flat, rel, q, jac, res, scratch, fresh)
+
+
+@kernel(error_model="numpy")
+def closure_constants(flat, jac, fresh):
+    """The entries of the planar closure Jacobian ``jac (E, m, K)`` that are the same at every point: each loop's
+    ``omega_z`` row (``s w`` summed over the loop's joints of each unknown) and zero everywhere else, for
+    :func:`closure_columns` to fill in the rest (its rows ``v_x, v_y`` of each loop's columns) at every block of
+    points; ``fresh[idx]`` whether loop entry ``idx`` is the first of its loop with its unknown (its column is
+    written, the others' added)."""
+    twists, loop_joint, loop_sign, loop_ptr, groups = flat
+    E = jac.shape[0]
+    jac[:] = 0.0
+    for loop in range(E // 3):
+        for idx in range(loop_ptr[loop], loop_ptr[loop + 1]):
+            j = loop_joint[idx]
+            g = groups[j]
+            seen = False
+            for before in range(loop_ptr[loop], idx):
+                seen = seen or groups[loop_joint[before]] == g
+            fresh[idx] = g >= 0 and not seen
+            if g >= 0:
+                jac[3 * loop, g, :] += float(loop_sign[idx]) * twists[j, 2]
+
+
+@kernel(error_model="numpy")
+def closure_columns(flat, rel, q, jac, res, scratch, fresh):
+    """:func:`planar_closure` at a block of points into a ``jac`` whose constant entries
+    :func:`closure_constants` wrote (once, for every block): each loop's rows ``v_x, v_y`` (the loop's columns
+    only) and the residual ``res``."""
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
     E, K = jac.shape[0], jac.shape[2]
     # the loop product's partial (cos, sin, p_x, p_y); its log's angle and norm
     product, angle, share = scratch
-    jac[:] = 0.0
     res[:] = 0.0
     for loop in range(E // 3):
         c, s, px, py = product[0], product[1], product[2], product[3]
@@ -460,12 +514,10 @@ def planar_closure(flat, rel, q, jac, res, scratch):
             # every joint is its own unknown in a dyad plan; a fixed one would add to a scratch column
             g = groups[j]
             col1, col2 = (jac[3 * loop + 1, g], jac[3 * loop + 2, g]) if g >= 0 else (angle, share)
-            if g >= 0:
-                jac[3 * loop, g, :] += w
             if w != 0.0:
-                turn_column(product, col1, col2, rel[j], sign, w, vx, vy)
+                turn_column(product, col1, col2, rel[j], sign, w, vx, vy, fresh[idx])
             else:
-                slide_column(product, col1, col2, q[j], vx, vy)
+                slide_column(product, col1, col2, q[j], vx, vy, fresh[idx])
         if loop_log(c, s, px, py, angle, share) > 0:  # a loop that does not close (never after a dyad solve)
             for k in range(K):
                 t = angle[k]
@@ -749,12 +801,13 @@ def closed_form_path(flat, plan, run):
     carry = (np.zeros(n), np.zeros(n), np.zeros(C))  # each joint's value at column 0, its whole turns there
     scratch = (np.empty((4, C)), np.empty(C), np.empty(C))
     jac = np.empty((E, m, C))
+    fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
+    closure_constants(flat, jac, fresh)  # the entries the same at every point, once for every block
     res = np.empty(C)
     sigma = np.empty((E, C))
     tangent = np.empty((m, C))
     raw_tau = np.empty(C)
-    measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))
-    align, dist, wrapped, outside = measures
+    measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))  # align, dist, wrapped, outside
     flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
     svd_state = multi_loop_state(E)  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
@@ -775,7 +828,7 @@ def closed_form_path(flat, plan, run):
             rel[:, :, i] = rel[:, :, size]
             q[:, i] = q[:, size]
         # The Jacobians and their rows (the tangent, det([J; t^T]), the singular values), column 0 included.
-        planar_closure(flat, rel, q, jac, res, scratch)
+        closure_columns(flat, rel, q, jac, res, scratch, fresh)
         if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
             one_loop_rows(jac, sigma, tangent, raw_tau)
         else:
@@ -925,16 +978,30 @@ def scan_points(status, measures, out_s, span, far, hmax, ended):
 @kernel(inline="always")
 def store_rows(block, groups, outs, first, begin, end):
     """The block's rows ``begin .. end - 1`` into the outputs at rows ``first - 1 + i``: ``block = (q, sigma, res,
-    taus)``, ``outs = (out_u, out_sigma, out_res, out_tau, out_s)`` (the arclength is written by the scan)."""
+    taus)``, ``outs = (out_u, out_sigma, out_res, out_tau, out_s)`` (the arclength is written by the scan). Row by
+    row (each output row's entries side by side in memory), the block's arrays read along their columns; for the
+    usual sizes (one loop of four joints, two of seven) with the sizes as literal constants, so that the loops
+    over a row unroll."""
+    n, E = block[0].shape[0], block[1].shape[0]
+    if n == 4 and E == 3:
+        store_sized(block, groups, outs, first, begin, end, 4, 3)
+    elif n == 7 and E == 6:
+        store_sized(block, groups, outs, first, begin, end, 7, 6)
+    else:
+        store_sized(block, groups, outs, first, begin, end, n, E)
+
+
+@kernel(inline="always")
+def store_sized(block, groups, outs, first, begin, end, n, E):
+    """:func:`store_rows` with ``n`` joints and ``E`` singular values (literal constants where it is called)."""
     q, sigma, res, taus = block
     out_u, out_sigma, out_res, out_tau, _out_s = outs
-    for j in range(q.shape[0]):
-        g = groups[j]
-        for i in range(begin, end):
-            out_u[first - 1 + i, g] = q[j, i]
-    for e in range(sigma.shape[0]):
-        for i in range(begin, end):
-            out_sigma[first - 1 + i, e] = sigma[e, i]
+    for i in range(begin, end):
+        row = first - 1 + i
+        for j in range(n):
+            out_u[row, groups[j]] = q[j, i]
+        for e in range(E):
+            out_sigma[row, e] = sigma[e, i]
     for i in range(begin, end):
         out_res[first - 1 + i] = res[i]
         out_tau[first - 1 + i] = taus[i]
