@@ -146,8 +146,6 @@ class Block:
                 self.jac, self.sigma, self.tangent, self.raw_tau, 0 if first == 1 else 1, self.svd_state
             )
         bounds = (self.run[2], self.run[3], self.run[4])
-        for x in self.measures:
-            x[:] = 0.0
         dyad_solver.path_measures(self.q, self.flat[4], self.tangent, self.run[1], bounds, self.measures)
 
     def next_block(self) -> None:
@@ -227,8 +225,6 @@ def _repeat_closure(R, flat, rel, q, jac, res, scratch):  # type: ignore[no-unty
 @numba.njit
 def _repeat_measures(R, q, groups, tangent, t0, bounds, measures):  # type: ignore[no-untyped-def]
     for _ in range(R):
-        for x in measures:
-            x[:] = 0.0
         dyad_solver.path_measures(q, groups, tangent, t0, bounds, measures)
 
 

@@ -833,8 +833,6 @@ def closed_form_path(flat, plan, run):
             one_loop_rows(jac, sigma, tangent, raw_tau)
         else:
             multi_loop_rows(jac, sigma, tangent, raw_tau, 0 if first == 1 else 1, svd_state)
-        for x in measures:
-            x[:] = 0.0
         path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)
         begin = 0 if first == 1 else 1
         taus[0] = out_tau[first - 1]
@@ -1010,25 +1008,52 @@ def store_sized(block, groups, outs, first, begin, end, n, E):
 @kernel(error_model="numpy")
 def path_measures(q, groups, tangent, t0, bounds, measures):
     """At every point ``k`` of a path of joint values ``q (n, K)`` with unit tangents ``tangent (m, K)``:
-    ``measures = (align, dist, wrapped, outside)``: ``align[k]`` the tangent's inner product with the one before
-    (``t0`` at ``k = 0``; orientations aside), ``dist[k]`` the step's length from ``k - 1``, ``wrapped[k]`` the
-    distance from the start with periodic unknowns wrapped onto ``[-pi, pi)``, ``outside[k]`` how many unknowns
-    are outside ``bounds = (lo, hi, periodic)``. Loops over the points, one unknown at a time (vectorised)."""
+    ``measures = (align, dist, wrapped, outside)`` (written): ``align[k]`` the tangent's inner product with the one
+    before (``t0`` at ``k = 0``; orientations aside), ``dist[k]`` the step's length from ``k - 1`` (0 at ``k =
+    0``), ``wrapped[k]`` the distance from the start with periodic unknowns wrapped onto ``[-pi, pi)``,
+    ``outside[k]`` how many unknowns are outside ``bounds = (lo, hi, periodic)``.
+
+    The inner products and step lengths point by point, the sums over the unknowns in registers (for the usual
+    sizes, four and seven unknowns, with the sizes as literal constants: the sums unroll and the loop over the
+    points vectorises); the distances from the start and the bounds one unknown at a time (vectorised)."""
+    n, m = q.shape[0], tangent.shape[0]
+    if n == 4 and m == 4:
+        measures_sized(q, groups, tangent, t0, bounds, measures, 4, 4)
+    elif n == 7 and m == 7:
+        measures_sized(q, groups, tangent, t0, bounds, measures, 7, 7)
+    else:
+        measures_sized(q, groups, tangent, t0, bounds, measures, n, m)
+
+
+@kernel(inline="always")
+def measures_sized(q, groups, tangent, t0, bounds, measures, n, m):
+    """:func:`path_measures` with ``n`` joints and ``m`` unknowns (literal constants where it is called); every
+    sum in the order of the unknowns from 0.0, as one sum into zeroed arrays gives it."""
     lo, hi, periodic = bounds
     align, dist, wrapped, outside = measures
-    m, K = tangent.shape[0], tangent.shape[1]
+    K = tangent.shape[1]
+    acc = 0.0
     for a in range(m):
-        align[0] += tangent[a, 0] * t0[a]
-        ta = tangent[a]
-        for k in range(1, K):
-            align[k] += ta[k] * ta[k - 1]
-    for j in range(q.shape[0]):
+        acc += tangent[a, 0] * t0[a]
+    align[0] = acc
+    for k in range(1, K):
+        acc = 0.0
+        for a in range(m):
+            acc += tangent[a, k] * tangent[a, k - 1]
+        align[k] = acc
+    dist[0] = 0.0
+    for k in range(1, K):
+        acc = 0.0
+        for j in range(n):
+            du = q[j, k] - q[j, k - 1]
+            acc += du * du
+        dist[k] = np.sqrt(acc)
+    wrapped[:] = 0.0
+    outside[:] = 0.0
+    for j in range(n):
         g = groups[j]
         qj = q[j]
         low, high, turn = lo[g], hi[g], TWO_PI if periodic[g] else 0.0
-        for k in range(1, K):
-            du = qj[k] - qj[k - 1]
-            dist[k] += du * du
         for k in range(K):
             x = qj[k]
             outside[k] += 1.0 if (x < low) | (x > high) else 0.0
@@ -1037,5 +1062,4 @@ def path_measures(q, groups, tangent, t0, bounds, measures):
             )  # periodic: onto [-pi, pi) (geometry.angles.wrap)
             wrapped[k] += x * x
     for k in range(K):
-        dist[k] = np.sqrt(dist[k])
         wrapped[k] = np.sqrt(wrapped[k])
