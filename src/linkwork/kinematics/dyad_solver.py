@@ -109,7 +109,7 @@ def first_status(status: np.ndarray, k: int, code: int) -> None:
     status[k] = code if status[k] == CLEAN else status[k]
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_driver(joint_int, joint_geo, head, drive_q, poses):
     """Pose of the body the drive joint moves at every point ``k >= 1`` (the other body of the drive joint is
     fixed: identity pose), the drive's values ``drive_q``; the rotation by the branch-free
@@ -133,7 +133,7 @@ def place_driver(joint_int, joint_geo, head, drive_q, poses):
             set_pose(poses, driven, k, 1.0, 0.0, 0.0, 0.0, drive_q[k] * dx, drive_q[k] * dy)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
     """An RRR dyad ``(j1, j2, j3, K1, B1, B2, K2)`` at every point ``k >= 1``: two circles about the placed
     pivots, the root on the side ``mode``; ``status[k]`` set where there is none or it is within ``min_margin``
@@ -161,7 +161,7 @@ def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
         set_pose_turning(poses, B2, k, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_prp(joint_geo, dyad, poses, min_margin, status):
     """A PRP dyad at every point ``k >= 1``: the middle pivot where the two guide lines cross."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
@@ -181,7 +181,7 @@ def place_prp(joint_geo, dyad, poses, min_margin, status):
         set_pose(poses, B2, k, c3, s3, p2x, p2y, X2, Y2)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_rrp(joint_int, joint_geo, dyad, mode, poses, min_margin, status):
     """An RRP or PRR dyad at every point ``k >= 1``: a circle about the revolute side's pivot and the prismatic
     side's line."""
@@ -207,7 +207,7 @@ def place_rrp(joint_int, joint_geo, dyad, mode, poses, min_margin, status):
         set_pose(poses, Bp, k, poses[Kp, 0, k], poses[Kp, 1, k], p2x, p2y, X2, Y2)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
     """An RPR dyad at every point ``k >= 1``: ``B1`` and ``B2`` turn together, ``B2``'s pivot on ``B1``'s line."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
@@ -236,7 +236,7 @@ def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
         set_pose(poses, B2, k, c, s, p3x, p3y, X3, Y3)
 
 
-@kernel()
+@kernel(inline="always", error_model="numpy")
 def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
     """Every dyad of the plan at every point ``k >= 1``, in solving order (each a loop over the points); sets
     ``status[k]`` to the first dyad's failure at point ``k`` (:data:`UNSUPPORTED` for a dyad of no solved kind)."""
@@ -256,7 +256,7 @@ def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
                 first_status(status, k, UNSUPPORTED)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def read_angles(ca, sa, cb, sb, rel, omega, q):
     """A revolute joint between bodies of rotations ``(ca, sa)`` and ``(cb, sb)`` at every point: ``rel = (c,
     s)`` of ``R_a^T R_b``, and (unless ``q`` is empty) ``q[k] = omega atan2(s[k], c[k])`` by the branch-free
@@ -275,7 +275,7 @@ def read_angles(ca, sa, cb, sb, rel, omega, q):
         q[k] = omega * atan2(sk, ck)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def angle_steps(q, turns, jump):
     """The step of an angle read in ``[-pi, pi]`` into each point ``k >= 1``, wrapped onto ``[-pi, pi)``: ``turns[k]``
     the whole turns the wrapping added (-1, 0, 1), ``jump[k]`` raised to the wrapped step's size where larger;
@@ -291,7 +291,7 @@ def angle_steps(q, turns, jump):
     return count
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def slide_values(ca, sa, ta, tb, dx, dy, q):
     """``q[k] = d . R_a^T (t_b - t_a)``: a prismatic joint's value along its unit direction ``d = (dx, dy)`` from
     the rotation ``(ca, sa)`` of its before body and both bodies' translations ``ta``, ``tb`` (``(2, K)``)."""
@@ -300,7 +300,7 @@ def slide_values(ca, sa, ta, tb, dx, dy, q):
         q[k] = dx * (ca[k] * tx + sa[k] * ty) + dy * (-sa[k] * tx + ca[k] * ty)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry):
     """Every joint's value at every point from its bodies' poses: ``q[j, k]``; revolute ones continued from
     point to point (each point's step wrapped onto ``[-pi, pi)``), the drive's ``drive_q``. ``rel[j] = (cos,
@@ -353,7 +353,7 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carr
         q[j, 0] = start[j]
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def turn_column(product, col1, col2, rel, sign, w, vx, vy, fresh=False):
     """A revolute loop joint at every point: rows 2 and 3 of its Jacobian column ``Ad(g) xi = (w, R v + p x (0,
     0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2`` (``fresh``: written, as added to zeros), with ``g =
@@ -388,7 +388,7 @@ def turn_column(product, col1, col2, rel, sign, w, vx, vy, fresh=False):
         s[k] = sk * cr + ck * sr
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def slide_column(product, col1, col2, q, vx, vy, fresh=False):
     """A prismatic loop joint at every point: its Jacobian column's rows 2 and 3 (``R v``) added to ``col1``,
     ``col2`` (``fresh``: written, as added to zeros), then ``g <- g exp(xi q)``: the translation ``v q``."""
@@ -411,7 +411,7 @@ def slide_column(product, col1, col2, q, vx, vy, fresh=False):
         py[k] += sk * ex + ck * ey
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def loop_log(c, s, px, py, angle, share):
     """The twist ``log(g)`` of the loop product at every point (as ``kernels.log_rigid``): the angle ``t``, then
     ``v = p - (w x p)/2 + D w x (w x p)`` with ``D`` by its Taylor series (a closed loop turns by round-off);
@@ -490,7 +490,7 @@ def closure_constants(flat, jac, fresh):
                 jac[3 * loop, g, :] += float(loop_sign[idx]) * twists[j, 2]
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def closure_columns(flat, rel, q, jac, res, scratch, fresh):
     """:func:`planar_closure` at a block of points into a ``jac`` whose constant entries
     :func:`closure_constants` wrote (once, for every block): each loop's rows ``v_x, v_y`` (the loop's columns
@@ -1005,7 +1005,7 @@ def store_sized(block, groups, outs, first, begin, end, n, E):
         out_tau[first - 1 + i] = taus[i]
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def path_measures(q, groups, tangent, t0, bounds, measures):
     """At every point ``k`` of a path of joint values ``q (n, K)`` with unit tangents ``tangent (m, K)``:
     ``measures = (align, dist, wrapped, outside)`` (written): ``align[k]`` the tangent's inner product with the one
