@@ -10,7 +10,8 @@ in ``--positions`` equal steps are recorded, and:
   same replayed copy of git revision ``REV``'s ``dyad_solver.py`` is timed in alternation with this tree's
   (an A/B of the non-rows kernel in one process), and both copies' rows are checked to be bit-identical.
 - **per pass**: each pass of one block of :data:`~linkwork.kinematics.dyad_solver.BLOCK` points in the middle
-  of the path, repeated over the same block data inside a compiled loop (no dispatch), in ns a point.
+  of the path, repeated over the same block data inside a compiled loop (no dispatch; ``error_model="numpy"``
+  as in the kernel, into which the passes are inlined), in ns a point.
 
 Best of ``--repeats`` rounds, all variants in alternation in each round; the load average is printed (timings on a
 loaded machine are only indicative). Run ``linkwork compile`` first after editing a kernel.
@@ -51,7 +52,7 @@ LINKAGES = {"watt-six-bar": str(WATT), "four-bar": "four-bar", "slider-crank": "
 ROWS_CALL = re.compile(r"(one_loop_rows|multi_loop_rows)\(\s*jac,\s*sigma,\s*tangent,\s*raw_tau[^)]*\)")
 REPLAY = '''
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def replay_rows(sigma, tangent, raw_tau, first):
     """The rows of the block starting at point ``first``, from the recorded ones (a copy, no computation)."""
     E, m = sigma.shape[0], tangent.shape[0]
@@ -65,7 +66,7 @@ def replay_rows(sigma, tangent, raw_tau, first):
     return 0
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def replay_all(sigma, tangent, raw_tau, points, block):
     """Every block's replay (the copying alone, as the path's blocks do it)."""
     for first in range(1, points, block):
@@ -192,19 +193,19 @@ def _copied(value: Any) -> Any:
     return value
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_driver(R, joint_int, joint_geo, head, drive_q, poses):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.place_driver(joint_int, joint_geo, head, drive_q, poses)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_dyads(R, joint_int, joint_geo, dyads, modes, poses, margin, status):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.place_dyads(joint_int, joint_geo, dyads, modes, poses, margin, status)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_joints(R, joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry):  # type: ignore[no-untyped-def]
     start = carry[0].copy()
     total = carry[1].copy()
@@ -214,7 +215,7 @@ def _repeat_joints(R, joint_int, joint_geo, poses, drive, drive_q, rel, q, jump,
         dyad_solver.joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_closure(R, flat, rel, q, jac, res, scratch):  # type: ignore[no-untyped-def]
     fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
     dyad_solver.closure_constants(flat, jac, fresh)
@@ -222,19 +223,19 @@ def _repeat_closure(R, flat, rel, q, jac, res, scratch):  # type: ignore[no-unty
         dyad_solver.closure_columns(flat, rel, q, jac, res, scratch, fresh)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_measures(R, q, groups, tangent, t0, bounds, measures):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.path_measures(q, groups, tangent, t0, bounds, measures)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_drive_values(R, drive_q, first, steps, h, target):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.drive_values(drive_q, first, steps, h, target)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_first_failure(R, status, jump, size):  # type: ignore[no-untyped-def]
     for _ in range(R):
         status[:] = 0
@@ -242,31 +243,31 @@ def _repeat_first_failure(R, status, jump, size):  # type: ignore[no-untyped-def
         dyad_solver.first_failure(status, jump, size)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_checks(R, rows, orient, status, span, g_drive, h, limits):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.check_points(rows, orient, status, span, g_drive, h, limits, 0)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_scan(R, status, measures, out_s, span, far, hmax):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.scan_points(status, measures, out_s, span, far, hmax, 0)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_store(R, block, groups, outs, first, begin, end):  # type: ignore[no-untyped-def]
     for _ in range(R):
         dyad_solver.store_rows(block, groups, outs, first, begin, end)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_multi_rows(R, jac, sigma, tangent, raw_tau, state):  # type: ignore[no-untyped-def]
     for _ in range(R):
         multi_loop_rows(jac, sigma, tangent, raw_tau, 1, state)
 
 
-@numba.njit
+@numba.njit(error_model="numpy")
 def _repeat_one_rows(R, jac, sigma, tangent, raw_tau):  # type: ignore[no-untyped-def]
     for _ in range(R):
         one_loop_rows(jac, sigma, tangent, raw_tau)
