@@ -4,7 +4,8 @@ and goes on a shared machine hits both alike. Also checks that both return the s
 
 The other revision's ``kinematics/dyad_solver.py`` is taken from git (``git show REV:...``) into a temporary folder
 and compiled with plain ``numba.njit`` (the other kernels it calls are this tree's). The arguments are those that
-``lw.trace`` passes for one full turn of the crank in ``--positions`` steps (four-bar, slider-crank).
+``lw.trace`` passes for one full turn of the crank in ``--positions`` steps (four-bar, slider-crank, the Watt II
+six-bar of ``examples/specs``).
 
 Run: ``python benchmarks/ab_closed_form.py --against main`` (``--positions``, ``--repeats``).
 """
@@ -28,6 +29,7 @@ from linkwork.kinematics import dyad_solver
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCE = "src/linkwork/kinematics/dyad_solver.py"
+WATT = ROOT / "examples" / "specs" / "watt-six-bar.toml"
 
 
 def other_kernel(rev: str, folder: Path) -> ModuleType:
@@ -75,8 +77,12 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as folder:
         other = other_kernel(args.against, Path(folder))
-        for name in ("four-bar", "slider-crank"):
-            call = kernel_arguments(name, args.positions)
+        for name, source in (
+            ("four-bar", "four-bar"),
+            ("slider-crank", "slider-crank"),
+            ("watt-six-bar", str(WATT)),
+        ):
+            call = kernel_arguments(source, args.positions)
             theirs, ours = other.closed_form_path(*call), dyad_solver.closed_form_path(*call)
             same = theirs[:2] == ours[:2] and all(
                 np.array_equal(a, b) for a, b in zip(theirs[2:], ours[2:], strict=True)

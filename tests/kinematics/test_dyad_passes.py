@@ -248,3 +248,80 @@ def test_a_drive_step_of_whole_turns_is_no_jump() -> None:
     g = args[0][4][mech.index("A")]
     assert abs(u[1, g] - np.radians(720.0)) < 1e-12
     assert np.max(np.abs(np.delete(u[1], g))) < 1e-12
+
+
+def block_inputs(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """``(rel, q)`` of every point of the kernel's path (as :func:`passes` computes them)."""
+    _flat, plan, run = args
+    joint_int, joint_geo, dyads, modes, head = plan
+    settings = run[0]
+    steps = int(settings[dyad_solver.S_STEPS])
+    drive_q = np.append(np.arange(steps) * settings[dyad_solver.S_STEP], settings[dyad_solver.S_TARGET])
+    K, n = steps + 1, joint_int.shape[0]
+    poses = np.zeros((head[2], 4, K))
+    poses[:, 0] = 1.0
+    status = np.zeros(K, dtype=np.int64)
+    dyad_solver.place_driver(joint_int, joint_geo, head, drive_q, poses)
+    dyad_solver.place_dyads(
+        joint_int, joint_geo, dyads, modes, poses, settings[dyad_solver.S_MIN_MARGIN], status
+    )
+    rel, q = np.empty((n, 2, K)), np.empty((n, K))
+    carry = (np.zeros(n), np.zeros(n), np.zeros(K))
+    dyad_solver.joint_values(joint_int, joint_geo, poses, head[0], drive_q, rel, q, np.zeros(K), carry)
+    return rel, q
+
+
+def random_four_bars(count: int, seed: int) -> list[Mechanism]:
+    """Grashof crank-rockers of random proportions (the crank the shortest link, with a margin), open and
+    crossed, at a random start angle."""
+    from linkwork.linkages.four_bar import four_bar
+
+    rng = np.random.default_rng(seed)
+    out: list[Mechanism] = []
+    while len(out) < count:
+        crank, coupler, rocker, ground = 0.3 + rng.random(), *(1.5 + 2.0 * rng.random(3))
+        if crank + max(coupler, rocker, ground) > sum(sorted((coupler, rocker, ground))[:2]) - 0.1:
+            continue  # not Grashof with a margin
+        theta = float(2.0 * np.pi * rng.random())
+        out.append(four_bar(ground, crank, coupler, rocker, theta, bool(len(out) % 2)))
+    return out
+
+
+@pytest.mark.parametrize("jit", ["compiled", "python"])
+def test_closure_columns_on_a_reused_jacobian_equal_the_full_closure(jit: str) -> None:
+    """The kernel writes the Jacobian's constant entries (each loop's omega_z row, the structural zeros) once a
+    path and only the loop columns' v rows at each block (``closure_constants``, ``closure_columns``): on every
+    built-in planar linkage, the two dyad kinds no built-in has (prismatic columns) and random four-bars, blocks
+    computed one after another in one array equal :func:`planar_closure` on each block alone, bit for bit, also
+    when the block before held other points (nothing of one block leaks into the next); compiled and as the
+    plain-Python twins."""
+    from linkwork.kinematics.jit import python_twin
+
+    kernels: Any = dyad_solver
+    if jit == "python":
+        kernels = python_twin(
+            {
+                name: getattr(dyad_solver, name)
+                for name in ("planar_closure", "closure_constants", "closure_columns")
+            }
+        )
+    mechanisms = [CASES[name]() for name in sorted(CASES)] + [slotted_lever(), cross_slides()]
+    mechanisms += random_four_bars(4, seed=11)
+    for mech in mechanisms:
+        args, (count, status, *_rest) = kernel_call(mech, np.radians(60.0), 30)
+        assert (count, status) == (31, dyad_solver.CLEAN), mech.name
+        flat = args[0]
+        rel, q = block_inputs(args)
+        E, m, K = 3 * (flat[3].shape[0] - 1), args[2][1].shape[0], q.shape[1]
+        scratch = (np.empty((4, K)), np.empty(K), np.empty(K))
+        jac = np.full((E, m, K), np.nan)
+        fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
+        kernels.closure_constants(flat, jac, fresh)
+        res = np.empty(K)
+        other = (rel[:, :, ::-1].copy(), q[:, ::-1].copy())  # the block before: other points
+        kernels.closure_columns(flat, *other, jac, res, scratch, fresh)
+        kernels.closure_columns(flat, rel, q, jac, res, scratch, fresh)
+        full, full_res = np.full((E, m, K), np.nan), np.empty(K)
+        kernels.planar_closure(flat, rel, q, full, full_res, scratch)
+        assert np.array_equal(jac, full) and np.array_equal(res, full_res), mech.name
+        assert np.array_equal(np.signbit(jac), np.signbit(full)), mech.name  # zeros' signs too

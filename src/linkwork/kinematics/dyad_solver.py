@@ -109,7 +109,7 @@ def first_status(status: np.ndarray, k: int, code: int) -> None:
     status[k] = code if status[k] == CLEAN else status[k]
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_driver(joint_int, joint_geo, head, drive_q, poses):
     """Pose of the body the drive joint moves at every point ``k >= 1`` (the other body of the drive joint is
     fixed: identity pose), the drive's values ``drive_q``; the rotation by the branch-free
@@ -133,7 +133,7 @@ def place_driver(joint_int, joint_geo, head, drive_q, poses):
             set_pose(poses, driven, k, 1.0, 0.0, 0.0, 0.0, drive_q[k] * dx, drive_q[k] * dy)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
     """An RRR dyad ``(j1, j2, j3, K1, B1, B2, K2)`` at every point ``k >= 1``: two circles about the placed
     pivots, the root on the side ``mode``; ``status[k]`` set where there is none or it is within ``min_margin``
@@ -161,7 +161,7 @@ def place_rrr(joint_geo, dyad, mode, poses, min_margin, status):
         set_pose_turning(poses, B2, k, p3x, p3y, X3, Y3, p2x - p3x, p2y - p3y, X2 - X3, Y2 - Y3)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_prp(joint_geo, dyad, poses, min_margin, status):
     """A PRP dyad at every point ``k >= 1``: the middle pivot where the two guide lines cross."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
@@ -181,7 +181,7 @@ def place_prp(joint_geo, dyad, poses, min_margin, status):
         set_pose(poses, B2, k, c3, s3, p2x, p2y, X2, Y2)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_rrp(joint_int, joint_geo, dyad, mode, poses, min_margin, status):
     """An RRP or PRR dyad at every point ``k >= 1``: a circle about the revolute side's pivot and the prismatic
     side's line."""
@@ -207,7 +207,7 @@ def place_rrp(joint_int, joint_geo, dyad, mode, poses, min_margin, status):
         set_pose(poses, Bp, k, poses[Kp, 0, k], poses[Kp, 1, k], p2x, p2y, X2, Y2)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
     """An RPR dyad at every point ``k >= 1``: ``B1`` and ``B2`` turn together, ``B2``'s pivot on ``B1``'s line."""
     j1, j2, j3, K1, B1, B2, K2 = dyad[0], dyad[1], dyad[2], dyad[3], dyad[4], dyad[5], dyad[6]
@@ -236,7 +236,7 @@ def place_rpr(joint_geo, dyad, mode, poses, min_margin, status):
         set_pose(poses, B2, k, c, s, p3x, p3y, X3, Y3)
 
 
-@kernel()
+@kernel(inline="always", error_model="numpy")
 def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
     """Every dyad of the plan at every point ``k >= 1``, in solving order (each a loop over the points); sets
     ``status[k]`` to the first dyad's failure at point ``k`` (:data:`UNSUPPORTED` for a dyad of no solved kind)."""
@@ -256,7 +256,7 @@ def place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status):
                 first_status(status, k, UNSUPPORTED)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def read_angles(ca, sa, cb, sb, rel, omega, q):
     """A revolute joint between bodies of rotations ``(ca, sa)`` and ``(cb, sb)`` at every point: ``rel = (c,
     s)`` of ``R_a^T R_b``, and (unless ``q`` is empty) ``q[k] = omega atan2(s[k], c[k])`` by the branch-free
@@ -275,7 +275,7 @@ def read_angles(ca, sa, cb, sb, rel, omega, q):
         q[k] = omega * atan2(sk, ck)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def angle_steps(q, turns, jump):
     """The step of an angle read in ``[-pi, pi]`` into each point ``k >= 1``, wrapped onto ``[-pi, pi)``: ``turns[k]``
     the whole turns the wrapping added (-1, 0, 1), ``jump[k]`` raised to the wrapped step's size where larger;
@@ -291,7 +291,7 @@ def angle_steps(q, turns, jump):
     return count
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def slide_values(ca, sa, ta, tb, dx, dy, q):
     """``q[k] = d . R_a^T (t_b - t_a)``: a prismatic joint's value along its unit direction ``d = (dx, dy)`` from
     the rotation ``(ca, sa)`` of its before body and both bodies' translations ``ta``, ``tb`` (``(2, K)``)."""
@@ -300,7 +300,7 @@ def slide_values(ca, sa, ta, tb, dx, dy, q):
         q[k] = dx * (ca[k] * tx + sa[k] * ty) + dy * (-sa[k] * tx + ca[k] * ty)
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry):
     """Every joint's value at every point from its bodies' poses: ``q[j, k]``; revolute ones continued from
     point to point (each point's step wrapped onto ``[-pi, pi)``), the drive's ``drive_q``. ``rel[j] = (cos,
@@ -353,15 +353,28 @@ def joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carr
         q[j, 0] = start[j]
 
 
-@kernel(error_model="numpy")
-def turn_column(product, col1, col2, rel, sign, w, vx, vy):
+@kernel(inline="always", error_model="numpy")
+def turn_column(product, col1, col2, rel, sign, w, vx, vy, fresh=False):
     """A revolute loop joint at every point: rows 2 and 3 of its Jacobian column ``Ad(g) xi = (w, R v + p x (0,
-    0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2``, with ``g = product = (cos, sin, p_x, p_y)`` the loop's
-    product before the joint, then ``g <- g exp(xi q)``: the rotation ``rel = (c, sign s)``, the translation
-    ``(I - R)(w x v)`` (``w . v = 0`` in the plane)."""
+    0, w))`` (G&P Eq. (21)) added to ``col1``, ``col2`` (``fresh``: written, as added to zeros), with ``g =
+    product = (cos, sin, p_x, p_y)`` the loop's product before the joint, then ``g <- g exp(xi q)``: the rotation
+    ``rel = (c, sign s)``, the translation ``(I - R)(w x v)`` (``w . v = 0`` in the plane)."""
     c, s, px, py = product[0], product[1], product[2], product[3]
     rc, rs = rel[0], rel[1]
     ax, ay = -w * vy, w * vx
+    if fresh:  # 0 + x, as the sum into zeros gives (a zero's sign included), without reading the column
+        for k in range(c.shape[0]):
+            ck, sk, xk, yk = c[k], s[k], px[k], py[k]
+            col1[k] = 0.0 + (ck * vx - sk * vy + yk * w)
+            col2[k] = 0.0 + (sk * vx + ck * vy - xk * w)
+            cr, sr = rc[k], sign * rs[k]
+            ex = ax - (cr * ax - sr * ay)
+            ey = ay - (sr * ax + cr * ay)
+            px[k] = xk + (ck * ex - sk * ey)
+            py[k] = yk + (sk * ex + ck * ey)
+            c[k] = ck * cr - sk * sr
+            s[k] = sk * cr + ck * sr
+        return
     for k in range(c.shape[0]):
         ck, sk, xk, yk = c[k], s[k], px[k], py[k]
         col1[k] += ck * vx - sk * vy + yk * w
@@ -375,11 +388,20 @@ def turn_column(product, col1, col2, rel, sign, w, vx, vy):
         s[k] = sk * cr + ck * sr
 
 
-@kernel(error_model="numpy")
-def slide_column(product, col1, col2, q, vx, vy):
+@kernel(inline="always", error_model="numpy")
+def slide_column(product, col1, col2, q, vx, vy, fresh=False):
     """A prismatic loop joint at every point: its Jacobian column's rows 2 and 3 (``R v``) added to ``col1``,
-    ``col2``, then ``g <- g exp(xi q)``: the translation ``v q``."""
+    ``col2`` (``fresh``: written, as added to zeros), then ``g <- g exp(xi q)``: the translation ``v q``."""
     c, s, px, py = product[0], product[1], product[2], product[3]
+    if fresh:
+        for k in range(c.shape[0]):
+            ck, sk = c[k], s[k]
+            col1[k] = 0.0 + (ck * vx - sk * vy)
+            col2[k] = 0.0 + (sk * vx + ck * vy)
+            ex, ey = vx * q[k], vy * q[k]
+            px[k] += ck * ex - sk * ey
+            py[k] += sk * ex + ck * ey
+        return
     for k in range(c.shape[0]):
         ck, sk = c[k], s[k]
         col1[k] += ck * vx - sk * vy
@@ -389,7 +411,7 @@ def slide_column(product, col1, col2, q, vx, vy):
         py[k] += sk * ex + ck * ey
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always", error_model="numpy")
 def loop_log(c, s, px, py, angle, share):
     """The twist ``log(g)`` of the loop product at every point (as ``kernels.log_rigid``): the angle ``t``, then
     ``v = p - (w x p)/2 + D w x (w x p)`` with ``D`` by its Taylor series (a closed loop turns by round-off);
@@ -438,13 +460,45 @@ def planar_closure(flat, rel, q, jac, res, scratch):
     revolute joint's ``exp`` uses the cosine and sine of its relative rotation as the bodies' poses give them,
     which equal those of its reported value to an ulp (the value is read back from them by an ``atan2``): no
     sine or cosine is evaluated here. Each step is one loop over the points on 1-d arrays (straight-line code
-    that vectorises).
+    that vectorises). The entries that do not depend on the point (row ``omega_z`` and the zeros) are written by
+    :func:`closure_constants`, the others by :func:`closure_columns`.
     """
+    fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
+    closure_constants(flat, jac, fresh)
+    closure_columns(flat, rel, q, jac, res, scratch, fresh)
+
+
+@kernel(error_model="numpy")
+def closure_constants(flat, jac, fresh):
+    """The entries of the planar closure Jacobian ``jac (E, m, K)`` that are the same at every point: each loop's
+    ``omega_z`` row (``s w`` summed over the loop's joints of each unknown) and zero everywhere else, for
+    :func:`closure_columns` to fill in the rest (its rows ``v_x, v_y`` of each loop's columns) at every block of
+    points; ``fresh[idx]`` whether loop entry ``idx`` is the first of its loop with its unknown (its column is
+    written, the others' added)."""
+    twists, loop_joint, loop_sign, loop_ptr, groups = flat
+    E = jac.shape[0]
+    jac[:] = 0.0
+    for loop in range(E // 3):
+        for idx in range(loop_ptr[loop], loop_ptr[loop + 1]):
+            j = loop_joint[idx]
+            g = groups[j]
+            seen = False
+            for before in range(loop_ptr[loop], idx):
+                seen = seen or groups[loop_joint[before]] == g
+            fresh[idx] = g >= 0 and not seen
+            if g >= 0:
+                jac[3 * loop, g, :] += float(loop_sign[idx]) * twists[j, 2]
+
+
+@kernel(inline="always", error_model="numpy")
+def closure_columns(flat, rel, q, jac, res, scratch, fresh):
+    """:func:`planar_closure` at a block of points into a ``jac`` whose constant entries
+    :func:`closure_constants` wrote (once, for every block): each loop's rows ``v_x, v_y`` (the loop's columns
+    only) and the residual ``res``."""
     twists, loop_joint, loop_sign, loop_ptr, groups = flat
     E, K = jac.shape[0], jac.shape[2]
     # the loop product's partial (cos, sin, p_x, p_y); its log's angle and norm
     product, angle, share = scratch
-    jac[:] = 0.0
     res[:] = 0.0
     for loop in range(E // 3):
         c, s, px, py = product[0], product[1], product[2], product[3]
@@ -460,12 +514,10 @@ def planar_closure(flat, rel, q, jac, res, scratch):
             # every joint is its own unknown in a dyad plan; a fixed one would add to a scratch column
             g = groups[j]
             col1, col2 = (jac[3 * loop + 1, g], jac[3 * loop + 2, g]) if g >= 0 else (angle, share)
-            if g >= 0:
-                jac[3 * loop, g, :] += w
             if w != 0.0:
-                turn_column(product, col1, col2, rel[j], sign, w, vx, vy)
+                turn_column(product, col1, col2, rel[j], sign, w, vx, vy, fresh[idx])
             else:
-                slide_column(product, col1, col2, q[j], vx, vy)
+                slide_column(product, col1, col2, q[j], vx, vy, fresh[idx])
         if loop_log(c, s, px, py, angle, share) > 0:  # a loop that does not close (never after a dyad solve)
             for k in range(K):
                 t = angle[k]
@@ -749,123 +801,47 @@ def closed_form_path(flat, plan, run):
     carry = (np.zeros(n), np.zeros(n), np.zeros(C))  # each joint's value at column 0, its whole turns there
     scratch = (np.empty((4, C)), np.empty(C), np.empty(C))
     jac = np.empty((E, m, C))
+    fresh = np.empty(flat[1].shape[0], dtype=np.bool_)
+    closure_constants(flat, jac, fresh)  # the entries the same at every point, once for every block
     res = np.empty(C)
     sigma = np.empty((E, C))
     tangent = np.empty((m, C))
     raw_tau = np.empty(C)
-    measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))
-    align, dist, wrapped, outside = measures
+    measures = (np.empty(C), np.empty(C), np.empty(C), np.empty(C))  # align, dist, wrapped, outside
     flips, taus = np.empty(C), np.empty(C)  # each point's tangent orientation and test function
     svd_state = multi_loop_state(E)  # the Jacobi warm start, from block to block (more loops)
     far = 0.0
     flipped = 0  # the tangent's orientation is -1 (the one before the block's first point)
     turn_bits = np.empty(C, dtype=np.int64)
     near_start = 1.5 * abs(h)  # a path closes where it comes back this near its start
+    limits = (min_ratio, min_drive, near_start, hmax, det_basis)
     for first in range(1, steps + 1, BLOCK):
         # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
-        value = drive_q[0]  # carried in a register, not reloaded from the store before
-        for i in range(1, C):
-            value = target if first - 1 + i == steps else value + h
-            drive_q[i] = value
+        drive_values(drive_q, first, steps, h, target)
         status[:] = CLEAN
         jump[:] = 0.0
         place_driver(joint_int, joint_geo, head, drive_q, poses)
         place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
         joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry)
-        size, ended = min(BLOCK, steps + 1 - first), CLEAN  # points of the block placed; why the next was not
-        for i in range(1, size + 1):
-            code = JUMP if status[i] == CLEAN and jump[i] > 0.5 * np.pi else status[i]
-            if code != CLEAN:
-                size, ended = i - 1, code
-                break
+        size, ended = first_failure(status, jump, min(BLOCK, steps + 1 - first))
         for i in range(size + 1, C):  # past the block's last point: its copies (no NaN, no work for the rows)
             rel[:, :, i] = rel[:, :, size]
             q[:, i] = q[:, size]
         # The Jacobians and their rows (the tangent, det([J; t^T]), the singular values), column 0 included.
-        planar_closure(flat, rel, q, jac, res, scratch)
+        closure_columns(flat, rel, q, jac, res, scratch, fresh)
         if E == 3 and m == 4:  # one loop (a four-bar, a slider-crank): batched, vectorised across the points
             one_loop_rows(jac, sigma, tangent, raw_tau)
         else:
             multi_loop_rows(jac, sigma, tangent, raw_tau, 0 if first == 1 else 1, svd_state)
-        for x in measures:
-            x[:] = 0.0
         path_measures(q, groups, tangent, t0, (lo, hi, periodic), measures)
-        # The tangent's orientation (continuous from point to point, the start's at row 0), then the test function
-        # and every check at every point, then, point by point, the first point that fails (in the march's order:
-        # a rank or drive check, a sign change, a limit, then the closed path after the point is stored).
         begin = 0 if first == 1 else 1
-        # orient = -1 where align * (the orientation before) < 0, else 1 (at the start, the one before is 1): as
-        # bits, flipped = (align < 0) xor (flipped before) where align is neither 0 nor NaN, else 0. The bits in a
-        # vectorised loop, the recurrence (two integer operations a point) in a scalar one.
-        for i in range(begin, size + 1):
-            a = align[i]
-            turn_bits[i] = (1 if a < 0.0 else 0) | (2 if (a < 0.0) | (a > 0.0) else 0)
-        for i in range(begin, size + 1):
-            bits = turn_bits[i]
-            flipped = ((bits & 1) ^ flipped) & (bits >> 1)
-            turn_bits[i] = flipped
         taus[0] = out_tau[first - 1]
-        for i in range(begin, size + 1):
-            flips[i] = -1.0 if turn_bits[i] else 1.0
-            taus[i] = det_basis * raw_tau[i] * flips[i]
-        # Every check at every point (vectorised); a clean point that could close the path (near the start, not
-        # the start or the target) is marked NEAR_START for the scan below.
-        for i in range(begin, size + 1):
-            k = first - 1 + i
-            later = k > 0  # not the start
-            t_drive = tangent[g_drive, i]
-            singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
-            turned = later & ((flips[i] * t_drive) * h <= 0.0)
-            crossed = later & (taus[i] * taus[i - 1] < 0.0)
-            code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
-            code = LIMIT if code == CLEAN and outside[i] > 0.0 else code
-            near = later & (k < steps) & (wrapped[i] < near_start)
-            status[i] = NEAR_START if code == CLEAN and near else code
-        stop, code = size + 1, ended
-        arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
-        i = begin
-        while i <= size:  # the marked points one by one, the runs of clean points between them in loops
-            j = i
-            while j <= size and status[j] == CLEAN:
-                j += 1
-            for p in range(i, j):  # a running sum, in the march's order
-                arc = arc + dist[p] if first - 1 + p > 0 else 0.0
-                out_s[first - 1 + p] = arc
-            # The march's closed-path test keeps the largest distance from the start, and only compares it with
-            # 4 hmax: once above, it stays above (unless a NaN comes, which the march's select keeps too).
-            odd = 0
-            if far > 4.0 * hmax:
-                for p in range(i, j):
-                    odd += 0 if wrapped[p] == wrapped[p] else 1
-            if odd > 0 or not far > 4.0 * hmax:
-                for p in range(i, j):
-                    d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
-                    far = far if far >= d else d
-            if j > size:
-                break
-            if status[j] != NEAR_START:
-                stop, code = j, status[j]
-                break
-            # Near the start: the march's closed-path test (the target's step ends the march before it).
-            k = first - 1 + j
-            arc = arc + dist[j]
-            out_s[k] = arc
-            d = wrapped[j]
-            far = far if far >= d else d
-            if far > 4.0 * hmax:
-                stop, code = j, CLOSED  # row k is stored, but the path ends before it
-                break
-            i = j + 1
-        for j in range(n):
-            g = groups[j]
-            for i in range(begin, stop + 1 if code == CLOSED else stop):
-                out_u[first - 1 + i, g] = q[j, i]
-        for e in range(E):
-            for i in range(begin, stop + 1 if code == CLOSED else stop):
-                out_sigma[first - 1 + i, e] = sigma[e, i]
-        for i in range(begin, stop + 1 if code == CLOSED else stop):
-            out_res[first - 1 + i] = res[i]
-            out_tau[first - 1 + i] = taus[i]
+        flipped = check_points(
+            (sigma, tangent, raw_tau, measures), (flips, taus, turn_bits), status, (first, begin, size, steps),
+            g_drive, h, limits, flipped,
+        )  # fmt: skip
+        stop, code, far = scan_points(status, measures, out_s, (first, begin, size, steps), far, hmax, ended)
+        store_rows((q, sigma, res, taus), groups, outs, first, begin, stop + 1 if code == CLOSED else stop)
         if stop <= size:
             return zero_tail(first - 1 + stop, code, outs)
         if ended != CLEAN:
@@ -881,28 +857,203 @@ def closed_form_path(flat, plan, run):
     return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
 
 
-@kernel(error_model="numpy")
+@kernel(inline="always")
+def drive_values(drive_q, first, steps, h, target):
+    """The drive's values at the block of points from ``first``: ``drive_q[i]`` at point ``first - 1 + i``, a
+    running sum of the step ``h`` from ``drive_q[0]`` (as the march steps), ``target`` at point ``steps``."""
+    value = drive_q[0]  # carried in a register, not reloaded from the store before
+    for i in range(1, drive_q.shape[0]):
+        value = target if first - 1 + i == steps else value + h
+        drive_q[i] = value
+
+
+@kernel(inline="always")
+def first_failure(status, jump, size):
+    """``(placed, code)``: how many of the block's first ``size`` points were placed cleanly (a dyad solved, no
+    joint stepping by more than a quarter turn), and why the next one was not (:data:`CLEAN` if all were)."""
+    for i in range(1, size + 1):
+        code = JUMP if status[i] == CLEAN and jump[i] > 0.5 * np.pi else status[i]
+        if code != CLEAN:
+            return i - 1, code
+    return size, CLEAN
+
+
+@kernel(inline="always")
+def check_points(rows, orient, status, span, g_drive, h, limits, flipped):
+    """Every check at every point of the block, in ``status`` (vectorised); returns the orientation of the
+    tangent at the block's last point (1 for -1).
+
+    ``rows = (sigma, tangent, raw_tau, measures)``, ``orient = (flips, taus, turn_bits)`` (written: each point's
+    tangent orientation and test function; ``taus[0]`` the point before's), ``span = (first, begin, size,
+    steps)``, ``limits = (min_ratio, min_drive, near_start, hmax, det_basis)``.
+
+    The tangent's orientation (continuous from point to point, the start's at row 0), then the test function
+    and every check (in the march's order: a rank or drive check, a sign change, a limit); a clean point that
+    could close the path (near the start, not the start or the target) is marked :data:`NEAR_START`.
+    """
+    sigma, tangent, raw_tau, measures = rows
+    flips, taus, turn_bits = orient
+    first, begin, size, steps = span
+    min_ratio, min_drive, near_start, _hmax, det_basis = limits
+    align, _dist, wrapped, outside = measures
+    E = sigma.shape[0]
+    # orient = -1 where align * (the orientation before) < 0, else 1 (at the start, the one before is 1): as
+    # bits, flipped = (align < 0) xor (flipped before) where align is neither 0 nor NaN, else 0. The bits in a
+    # vectorised loop, the recurrence (two integer operations a point) in a scalar one.
+    for i in range(begin, size + 1):
+        a = align[i]
+        turn_bits[i] = (1 if a < 0.0 else 0) | (2 if (a < 0.0) | (a > 0.0) else 0)
+    for i in range(begin, size + 1):
+        bits = turn_bits[i]
+        flipped = ((bits & 1) ^ flipped) & (bits >> 1)
+        turn_bits[i] = flipped
+    for i in range(begin, size + 1):
+        flips[i] = -1.0 if turn_bits[i] else 1.0
+        taus[i] = det_basis * raw_tau[i] * flips[i]
+    for i in range(begin, size + 1):
+        k = first - 1 + i
+        later = k > 0  # not the start
+        t_drive = tangent[g_drive, i]
+        singular = (sigma[E - 1, i] < min_ratio * sigma[0, i]) | (abs(t_drive) < min_drive)
+        turned = later & ((flips[i] * t_drive) * h <= 0.0)
+        crossed = later & (taus[i] * taus[i - 1] < 0.0)
+        code = NEAR_SINGULAR if singular | turned else (SIGN_CHANGE if crossed else CLEAN)
+        code = LIMIT if code == CLEAN and outside[i] > 0.0 else code
+        near = later & (k < steps) & (wrapped[i] < near_start)
+        status[i] = NEAR_START if code == CLEAN and near else code
+    return flipped
+
+
+@kernel(inline="always")
+def scan_points(status, measures, out_s, span, far, hmax, ended):
+    """``(stop, code, far)``: the block's first point that ends the path (``size + 1`` and ``ended`` if none) and
+    why, point by point in the march's order, running the arclength's sum into ``out_s`` and the largest distance
+    from the start ``far`` (carried from block to block). ``span = (first, begin, size, steps)``.
+
+    The marked points one by one, the runs of clean points between them in loops. A point near the start
+    (:data:`NEAR_START`) closes the path once ``far`` exceeds ``4 hmax`` (the march's test: its row is stored, but
+    the path ends before it)."""
+    _align, dist, wrapped, _outside = measures
+    first, begin, size, steps = span
+    stop, code = size + 1, ended
+    arc = out_s[first - 1]  # the arclength so far, carried in a register (0 at the start)
+    i = begin
+    while i <= size:
+        j = i
+        while j <= size and status[j] == CLEAN:
+            j += 1
+        for p in range(i, j):  # a running sum, in the march's order
+            arc = arc + dist[p] if first - 1 + p > 0 else 0.0
+            out_s[first - 1 + p] = arc
+        # The march's closed-path test keeps the largest distance from the start, and only compares it with
+        # 4 hmax: once above, it stays above (unless a NaN comes, which the march's select keeps too).
+        odd = 0
+        if far > 4.0 * hmax:
+            for p in range(i, j):
+                odd += 0 if wrapped[p] == wrapped[p] else 1
+        if odd > 0 or not far > 4.0 * hmax:
+            for p in range(i, j):
+                d = wrapped[p] if 0 < first - 1 + p < steps else 0.0
+                far = far if far >= d else d
+        if j > size:
+            break
+        if status[j] != NEAR_START:
+            stop, code = j, status[j]
+            break
+        # Near the start: the march's closed-path test (the target's step ends the march before it).
+        k = first - 1 + j
+        arc = arc + dist[j]
+        out_s[k] = arc
+        d = wrapped[j]
+        far = far if far >= d else d
+        if far > 4.0 * hmax:
+            stop, code = j, CLOSED  # row k is stored, but the path ends before it
+            break
+        i = j + 1
+    return stop, code, far
+
+
+@kernel(inline="always")
+def store_rows(block, groups, outs, first, begin, end):
+    """The block's rows ``begin .. end - 1`` into the outputs at rows ``first - 1 + i``: ``block = (q, sigma, res,
+    taus)``, ``outs = (out_u, out_sigma, out_res, out_tau, out_s)`` (the arclength is written by the scan). Row by
+    row (each output row's entries side by side in memory), the block's arrays read along their columns; for the
+    usual sizes (one loop of four joints, two of seven) with the sizes as literal constants, so that the loops
+    over a row unroll."""
+    n, E = block[0].shape[0], block[1].shape[0]
+    if n == 4 and E == 3:
+        store_sized(block, groups, outs, first, begin, end, 4, 3)
+    elif n == 7 and E == 6:
+        store_sized(block, groups, outs, first, begin, end, 7, 6)
+    else:
+        store_sized(block, groups, outs, first, begin, end, n, E)
+
+
+@kernel(inline="always")
+def store_sized(block, groups, outs, first, begin, end, n, E):
+    """:func:`store_rows` with ``n`` joints and ``E`` singular values (literal constants where it is called)."""
+    q, sigma, res, taus = block
+    out_u, out_sigma, out_res, out_tau, _out_s = outs
+    for i in range(begin, end):
+        row = first - 1 + i
+        for j in range(n):
+            out_u[row, groups[j]] = q[j, i]
+        for e in range(E):
+            out_sigma[row, e] = sigma[e, i]
+    for i in range(begin, end):
+        out_res[first - 1 + i] = res[i]
+        out_tau[first - 1 + i] = taus[i]
+
+
+@kernel(inline="always", error_model="numpy")
 def path_measures(q, groups, tangent, t0, bounds, measures):
     """At every point ``k`` of a path of joint values ``q (n, K)`` with unit tangents ``tangent (m, K)``:
-    ``measures = (align, dist, wrapped, outside)``: ``align[k]`` the tangent's inner product with the one before
-    (``t0`` at ``k = 0``; orientations aside), ``dist[k]`` the step's length from ``k - 1``, ``wrapped[k]`` the
-    distance from the start with periodic unknowns wrapped onto ``[-pi, pi)``, ``outside[k]`` how many unknowns
-    are outside ``bounds = (lo, hi, periodic)``. Loops over the points, one unknown at a time (vectorised)."""
+    ``measures = (align, dist, wrapped, outside)`` (written): ``align[k]`` the tangent's inner product with the one
+    before (``t0`` at ``k = 0``; orientations aside), ``dist[k]`` the step's length from ``k - 1`` (0 at ``k =
+    0``), ``wrapped[k]`` the distance from the start with periodic unknowns wrapped onto ``[-pi, pi)``,
+    ``outside[k]`` how many unknowns are outside ``bounds = (lo, hi, periodic)``.
+
+    The inner products and step lengths point by point, the sums over the unknowns in registers (for the usual
+    sizes, four and seven unknowns, with the sizes as literal constants: the sums unroll and the loop over the
+    points vectorises); the distances from the start and the bounds one unknown at a time (vectorised)."""
+    n, m = q.shape[0], tangent.shape[0]
+    if n == 4 and m == 4:
+        measures_sized(q, groups, tangent, t0, bounds, measures, 4, 4)
+    elif n == 7 and m == 7:
+        measures_sized(q, groups, tangent, t0, bounds, measures, 7, 7)
+    else:
+        measures_sized(q, groups, tangent, t0, bounds, measures, n, m)
+
+
+@kernel(inline="always")
+def measures_sized(q, groups, tangent, t0, bounds, measures, n, m):
+    """:func:`path_measures` with ``n`` joints and ``m`` unknowns (literal constants where it is called); every
+    sum in the order of the unknowns from 0.0, as one sum into zeroed arrays gives it."""
     lo, hi, periodic = bounds
     align, dist, wrapped, outside = measures
-    m, K = tangent.shape[0], tangent.shape[1]
+    K = tangent.shape[1]
+    acc = 0.0
     for a in range(m):
-        align[0] += tangent[a, 0] * t0[a]
-        ta = tangent[a]
-        for k in range(1, K):
-            align[k] += ta[k] * ta[k - 1]
-    for j in range(q.shape[0]):
+        acc += tangent[a, 0] * t0[a]
+    align[0] = acc
+    for k in range(1, K):
+        acc = 0.0
+        for a in range(m):
+            acc += tangent[a, k] * tangent[a, k - 1]
+        align[k] = acc
+    dist[0] = 0.0
+    for k in range(1, K):
+        acc = 0.0
+        for j in range(n):
+            du = q[j, k] - q[j, k - 1]
+            acc += du * du
+        dist[k] = np.sqrt(acc)
+    wrapped[:] = 0.0
+    outside[:] = 0.0
+    for j in range(n):
         g = groups[j]
         qj = q[j]
         low, high, turn = lo[g], hi[g], TWO_PI if periodic[g] else 0.0
-        for k in range(1, K):
-            du = qj[k] - qj[k - 1]
-            dist[k] += du * du
         for k in range(K):
             x = qj[k]
             outside[k] += 1.0 if (x < low) | (x > high) else 0.0
@@ -911,5 +1062,4 @@ def path_measures(q, groups, tangent, t0, bounds, measures):
             )  # periodic: onto [-pi, pi) (geometry.angles.wrap)
             wrapped[k] += x * x
     for k in range(K):
-        dist[k] = np.sqrt(dist[k])
         wrapped[k] = np.sqrt(wrapped[k])

@@ -193,6 +193,16 @@ def _start_mode(kinds: IntArray, geo: Array, dyad: tuple[int, ...]) -> float | N
     return 1.0 if value > 0.0 else -1.0
 
 
+def _basis_sign(mech: Mechanism, basis: Array) -> float:
+    """The sign of ``det(basis)`` (which orients the test function), once per mechanism and basis: the tracer
+    passes the start's basis, the same array on every trace of the mechanism (LAPACK's determinant of a 6 x 6
+    matrix is a few microseconds, a tenth of the Python of a trace)."""
+    return mech.derived(
+        ("closed-form basis sign", basis.shape, basis.tobytes()),
+        lambda: 1.0 if np.linalg.det(basis) >= 0.0 else -1.0,
+    )
+
+
 def closed_form_rows(
     mech: Mechanism,
     kernels: object,
@@ -223,7 +233,7 @@ def closed_form_rows(
     values[S_TARGET] = settings.target
     values[S_STEPS] = steps
     values[S_HMAX] = settings.max_step
-    values[S_DET_BASIS] = 1.0 if np.linalg.det(basis) >= 0.0 else -1.0
+    values[S_DET_BASIS] = _basis_sign(mech, basis)
     values[S_MIN_RATIO] = settings.tol.local_min
     values[S_MIN_DRIVE] = MIN_DRIVE
     values[S_MIN_MARGIN] = MIN_MARGIN
