@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from linkwork.interrupts import in_compiler
 from linkwork.outputs.staging import MANIFEST, staged_output
 
 INTERRUPTED_WRITER = textwrap.dedent(
@@ -68,3 +69,67 @@ def test_an_interrupted_demo_leaves_no_partial_output(tmp_path: Path) -> None:
     assert not out.exists()
     assert not list(tmp_path.glob(".linkwork-*"))
     assert b"Traceback" not in stderr
+
+
+HELD_SIGNAL = textwrap.dedent(
+    """
+    import sys, time
+    from pathlib import Path
+    from linkwork.interrupts import install_safe_interrupt
+    from linkwork.outputs.staging import staged_output
+
+    # A stand-in for numba loading a kernel: code of a module in the numba package that receives the signal
+    # part way and must run to its end.
+    LOADER = (
+        "def load(signum):\\n"
+        "    import os, time\\n"
+        "    os.kill(os.getpid(), signum)\\n"
+        "    t = time.monotonic()\\n"
+        "    while time.monotonic() - t < 0.2:\\n"
+        "        pass\\n"
+    )
+    space = {"__name__": "numba.core.loader_stand_in"}
+    exec(LOADER, space)
+    install_safe_interrupt()
+    name, out = sys.argv[1], Path(sys.argv[2])
+    stage = "loading"
+    try:
+        with staged_output(out) as folder:
+            (folder / "path.csv").write_text("half", encoding="utf-8")
+            space["load"](2 if name == "SIGINT" else 15)
+            stage = "loaded"
+            time.sleep(10)
+            stage = "never interrupted"
+    except (KeyboardInterrupt, SystemExit) as exc:
+        print(stage, type(exc).__name__, flush=True)
+    """
+)
+
+
+@pytest.mark.parametrize(("name", "raised"), [("SIGINT", "KeyboardInterrupt"), ("SIGTERM", "SystemExit")])
+def test_a_signal_inside_the_compiler_is_held_until_it_returns(
+    tmp_path: Path, name: str, raised: str
+) -> None:
+    """A signal that lands in numba's or llvmlite's code (a kernel loading from the cache: interrupted there,
+    their C state is left half-built and the process crashed, one Ctrl-C of the demo in about thirty, leaving its
+    staging folder) is delivered once that code has returned, and the staging folder is removed."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    done = subprocess.run(
+        [sys.executable, "-c", HELD_SIGNAL, name, str(tmp_path / "out")],
+        env=env,
+        capture_output=True,
+        timeout=60,
+    )
+    assert done.stdout.decode().split() == ["loaded", raised], done
+    assert not (tmp_path / "out").exists()
+    assert not list(tmp_path.glob(".linkwork-*"))
+
+
+def test_in_compiler_looks_at_every_calling_frame() -> None:
+    space: dict[str, object] = {"__name__": "llvmlite.binding.stand_in", "sys": sys}
+    exec("def inner(call):\n    return call()\n", space)
+    inner = space["inner"]
+    assert callable(inner)
+    assert in_compiler(inner(lambda: sys._getframe()))  # the lambda's caller is llvmlite's
+    assert not in_compiler(sys._getframe())
+    assert not in_compiler(None)

@@ -27,6 +27,7 @@ from linkwork.cli import (
     trace,
 )
 from linkwork.cli.common import check_flags, fail
+from linkwork.interrupts import install_safe_interrupt
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
     from typer._click import exceptions as click_exceptions
@@ -136,5 +137,6 @@ def main() -> None:
     group called from Python, compile in the foreground)."""
     from linkwork.kinematics import jit
 
+    install_safe_interrupt()
     jit.enable_background_compile([sys.executable, "-c", kernels.BACKGROUND_COMMAND])
     app()

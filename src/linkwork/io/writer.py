@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.interrupts import when_safe
 from linkwork.io.toml_reader import escape_line, show
 
 __all__ = [
@@ -182,7 +183,7 @@ def _cleanup_on_signals() -> Iterator[None]:
         yield
         return
     wanted = [signal.SIGTERM] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])
-    previous = {sig: signal.signal(sig, stop) for sig in wanted}
+    previous = {sig: signal.signal(sig, when_safe(stop)) for sig in wanted}
     try:
         yield
     finally:

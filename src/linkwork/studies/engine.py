@@ -31,6 +31,7 @@ from types import FrameType
 from typing import Any, TypeVar
 
 from linkwork.errors import LinkworkError, RequestNotMetError, SpecError
+from linkwork.interrupts import when_safe
 from linkwork.progress import Progress
 
 T = TypeVar("T")
@@ -188,7 +189,7 @@ def caught_signals(state: RunStatus) -> Iterator[None]:
             raise Interrupted(signum)
         state.signal = signum
 
-    before = {sig: signal.signal(sig, record) for sig in (signal.SIGINT, signal.SIGTERM)}
+    before = {sig: signal.signal(sig, when_safe(record)) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:
