@@ -167,6 +167,15 @@ def reduction_bound(m, E):
 
 
 @kernel(inline="always")
+def certifiable(m, E):
+    """Whether the bidiagonal route can certify ``m x E`` (``J^T``) Jacobians: the reduction's share of the budget
+    at its worst (``|J|_F = sqrt(E) sigma_1``), ``c u sqrt(E)``, is at most three quarters of :data:`SIGMA_TOL`,
+    leaving the roots at least a quarter. True for two loops (``6 x 7``: ``c = 213``, 0.58) and fewer; false
+    for three (``9 x 10``: ``c = 427``, 1.42, wider than the whole budget: every lane would fall back) and more."""
+    return reduction_bound(m, E) * U * math.sqrt(E) <= 0.75 * SIGMA_TOL
+
+
+@kernel(inline="always")
 def lanes_bidiagonal(S, L, m, E):
     """Householder bidiagonalisation of the ``LANES`` matrices ``M`` (``m x E``) of ``S`` in place, side by side
     (Golub & Van Loan Alg. 5.4.2): for each column ``k`` a reflection from the left zeroes ``M[k+1:, k]``, then one
