@@ -44,8 +44,13 @@ one still not certified goes to the exact fall-back, a one-sided Jacobi SVD of `
 and ``raw_tau`` are those of the reduction (Householder reflections are backward stable: ``|J t| <= c u |J|_F``,
 ``c`` as above, a few ``u sigma_1`` in practice).
 
-Every loop has the lane innermost, or is the whole per-lane computation with no branches (conditional expressions
-only), so that LLVM vectorises it across lanes; every kernel also runs as plain Python (the twins of
+The reduction and the tangent run :data:`CHUNK` points at a time (:func:`chunk_bidiagonal`), each loop over the
+chunk's points innermost on separate rows of its array: long loops, which LLVM vectorises with a run-time check
+that the rows do not overlap (the lanes' loops, 16 long at offsets known only at run time, stayed scalar). Each
+point's arithmetic is the lane loops' before, in the same order (the results are bit for bit the same, so the
+reduction's bound is unchanged). The roots then go :data:`LANES` points at a time; there every loop has the lane
+innermost, or is the whole per-lane computation with no branches (conditional expressions only), so that LLVM
+vectorises it across lanes; every kernel also runs as plain Python (the twins of
 :mod:`linkwork.kinematics.jit`): divisors and square roots are guarded, so a degenerate lane gives a value that
 fails its certification, never an exception or a warning.
 
@@ -74,7 +79,10 @@ from linkwork.kinematics.small_svd import jacobi_svd
 U = 2.0**-53
 """The unit round-off of float64."""
 LANES = 16
-"""Points solved side by side (each a lane of the packed operations)."""
+"""Points whose roots are found side by side (each a lane of the packed operations)."""
+CHUNK = 256
+"""Points reduced together (:func:`chunk_bidiagonal`): a multiple of :data:`LANES`, long loops for the packed
+operations, the chunk's array (about 150 kB for ``6 x 7``) in the L2 cache."""
 SIGMA_TOL = 1e-13
 """A lane is certified when every singular value's error bound is below this times ``sigma_1``."""
 WARM_EVALUATIONS = 3
@@ -167,111 +175,167 @@ def reduction_bound(m, E):
 
 
 @kernel(inline="always")
-def lanes_bidiagonal(S, L, m, E):
-    """Householder bidiagonalisation of the ``LANES`` matrices ``M`` (``m x E``) of ``S`` in place, side by side
-    (Golub & Van Loan Alg. 5.4.2): for each column ``k`` a reflection from the left zeroes ``M[k+1:, k]``, then one
-    from the right zeroes ``M[k, k+2:]``. ``DET`` collects ``-1`` for each reflection made (a zero vector's is the
-    identity)."""
-    M, VH, BETA, VR, BR, DET, _, _, _, _, _, _, _, _, _, _, _, _, TMP, _, _, _ = work_rows(m, E)
-    for l in range(L):
-        S[DET * L + l] = 1.0
-    for k in range(E):
-        # From the left: column k, rows k .. m - 1.
-        for l in range(L):
-            S[TMP * L + l] = 0.0
-        for a in range(k, m):
-            for l in range(L):
-                x = S[(M + a * E + k) * L + l]
-                S[TMP * L + l] += x * x
-        for l in range(L):
-            norm = math.sqrt(S[TMP * L + l])
-            x = S[(M + k * E + k) * L + l]
-            alpha = -norm if x >= 0.0 else norm
-            vv = norm * (norm + abs(x))  # |x - alpha e_k|^2 / 2
-            b = 1.0 / vv if vv > FLOOR else 0.0
-            S[(VH + k) * L + l] = x - alpha
-            S[(BETA + k) * L + l] = b
-            S[(M + k * E + k) * L + l] = alpha
-            S[DET * L + l] = -S[DET * L + l] if b > 0.0 else S[DET * L + l]
-        for c in range(k + 1, E):
-            for l in range(L):
-                S[(TMP + 1) * L + l] = S[(VH + k) * L + l] * S[(M + k * E + c) * L + l]
-            for a in range(k + 1, m):
-                for l in range(L):
-                    S[(TMP + 1) * L + l] += S[(M + a * E + k) * L + l] * S[(M + a * E + c) * L + l]
-            for l in range(L):
-                d = S[(TMP + 1) * L + l] * S[(BETA + k) * L + l]
-                S[(TMP + 1) * L + l] = d
-                S[(M + k * E + c) * L + l] -= d * S[(VH + k) * L + l]
-            for a in range(k + 1, m):
-                for l in range(L):
-                    S[(M + a * E + c) * L + l] -= S[(TMP + 1) * L + l] * S[(M + a * E + k) * L + l]
-        if k >= E - 2:
-            continue
-        # From the right: row k, columns k + 1 .. E - 1 (its reflector in that row, right of k + 1).
-        for l in range(L):
-            S[TMP * L + l] = 0.0
-        for c in range(k + 1, E):
-            for l in range(L):
-                x = S[(M + k * E + c) * L + l]
-                S[TMP * L + l] += x * x
-        for l in range(L):
-            norm = math.sqrt(S[TMP * L + l])
-            x = S[(M + k * E + k + 1) * L + l]
-            alpha = -norm if x >= 0.0 else norm
-            vv = norm * (norm + abs(x))
-            b = 1.0 / vv if vv > FLOOR else 0.0
-            S[(VR + k) * L + l] = x - alpha
-            S[(BR + k) * L + l] = b
-            S[(M + k * E + k + 1) * L + l] = alpha
-            S[DET * L + l] = -S[DET * L + l] if b > 0.0 else S[DET * L + l]
-        for a in range(k + 1, m):
-            for l in range(L):
-                S[(TMP + 1) * L + l] = S[(VR + k) * L + l] * S[(M + a * E + k + 1) * L + l]
-            for c in range(k + 2, E):
-                for l in range(L):
-                    S[(TMP + 1) * L + l] += S[(M + k * E + c) * L + l] * S[(M + a * E + c) * L + l]
-            for l in range(L):
-                d = S[(TMP + 1) * L + l] * S[(BR + k) * L + l]
-                S[(TMP + 1) * L + l] = d
-                S[(M + a * E + k + 1) * L + l] -= d * S[(VR + k) * L + l]
-            for c in range(k + 2, E):
-                for l in range(L):
-                    S[(M + a * E + c) * L + l] -= S[(TMP + 1) * L + l] * S[(M + k * E + c) * L + l]
+def certifiable(m, E):
+    """Whether the bidiagonal route can certify ``m x E`` (``J^T``) Jacobians: the reduction's share of the budget
+    at its worst (``|J|_F = sqrt(E) sigma_1``), ``c u sqrt(E)``, is at most three quarters of :data:`SIGMA_TOL`,
+    leaving the roots at least a quarter. True for two loops (``6 x 7``: ``c = 213``, 0.58) and fewer; false
+    for three (``9 x 10``: ``c = 427``, 1.42, wider than the whole budget: every lane would fall back) and more."""
+    return reduction_bound(m, E) * U * math.sqrt(E) <= 0.75 * SIGMA_TOL
 
 
 @kernel(inline="always")
-def lanes_tangent(S, L, m, E):
+def chunk_rows(m, E):
+    """The rows of the chunk's array (each :data:`CHUNK` doubles, one a point): ``M`` (``J^T``, ``m x E``,
+    reduced in place as in :func:`work_rows`), the reflectors' first entries and factors (left and right, ``E``
+    each), ``det(U) det(V)``, the tangent (``m``), two temporaries. Returns their offsets and the total."""
+    M = 0
+    VH = M + m * E
+    BETA = VH + E
+    VR = BETA + E
+    BR = VR + E
+    DET = BR + E
+    T = DET + 1
+    TMP = T + m
+    return M, VH, BETA, VR, BR, DET, T, TMP, TMP + 2
+
+
+@kernel(inline="always")
+def chunk_reflect(B, n, pivot, head, factor, rows, start, stop, stride, det):
+    """One Householder reflection at each of the ``n`` points of ``B``: its vector is row ``pivot`` and rows
+    ``start, start + stride, ... < stop`` (zeroed below or right of the pivot); its first entry goes into row
+    ``head``, its factor into row ``factor``, the pivot becomes ``alpha = -sign(x) |v|``, and ``det`` changes
+    sign (a zero vector's reflection is the identity). ``rows`` the temporary."""
+    acc = B[rows]
+    x0 = B[pivot]
+    for p in range(n):
+        acc[p] = x0[p] * x0[p]
+    for a in range(start, stop, stride):
+        col = B[a]
+        for p in range(n):
+            x = col[p]
+            acc[p] += x * x
+    vh = B[head]
+    beta = B[factor]
+    sign = B[det]
+    for p in range(n):
+        norm = math.sqrt(acc[p])
+        x = x0[p]
+        alpha = -norm if x >= 0.0 else norm
+        vv = norm * (norm + abs(x))  # |x - alpha e_k|^2 / 2
+        b = 1.0 / vv if vv > FLOOR else 0.0
+        vh[p] = x - alpha
+        beta[p] = b
+        x0[p] = alpha
+        sign[p] = -sign[p] if b > 0.0 else sign[p]
+
+
+@kernel(inline="always")
+def chunk_apply(B, n, head, factor, vector, target, count, vstep, tstep, top, rows):
+    """Applies a reflection (first entry row ``head``, factor row ``factor``, the rest rows ``vector + i vstep``,
+    ``i = 0 .. count - 1``) to the vector whose first entry is row ``top`` and the rest rows ``target + i tstep``,
+    at each of the ``n`` points: ``y -= beta (v . y) v``. ``rows`` the temporary (``beta (v . y)``)."""
+    dot = B[rows]
+    vh = B[head]
+    y0 = B[top]
+    for p in range(n):
+        dot[p] = vh[p] * y0[p]
+    for i in range(0, count - 1, 2):  # two terms a pass (half the loads and stores of ``dot``), in order
+        u = B[vector + i * vstep]
+        v = B[target + i * tstep]
+        u2 = B[vector + (i + 1) * vstep]
+        v2 = B[target + (i + 1) * tstep]
+        for p in range(n):
+            dot[p] = (dot[p] + u[p] * v[p]) + u2[p] * v2[p]
+    if count % 2 == 1:
+        u = B[vector + (count - 1) * vstep]
+        v = B[target + (count - 1) * tstep]
+        for p in range(n):
+            dot[p] += u[p] * v[p]
+    beta = B[factor]
+    for p in range(n):
+        d = dot[p] * beta[p]
+        dot[p] = d
+        y0[p] -= d * vh[p]
+    for i in range(count):
+        u = B[vector + i * vstep]
+        v = B[target + i * tstep]
+        for p in range(n):
+            v[p] -= dot[p] * u[p]
+
+
+@kernel(inline="always")
+def chunk_bidiagonal(B, n, m, E):
+    """Householder bidiagonalisation of the ``n`` matrices ``M`` (``m x E``) of ``B`` in place (Golub & Van Loan
+    Alg. 5.4.2): for each column ``k`` a reflection from the left zeroes ``M[k+1:, k]``, then one from the right
+    zeroes ``M[k, k+2:]``. ``DET`` collects ``-1`` for each reflection made. Every loop has the point innermost,
+    over the chunk (separate rows, a long trip count: LLVM checks at run time that the rows do not overlap and
+    runs the packed loop); each point's arithmetic is that of the lane loops before, in the same order."""
+    M, VH, BETA, VR, BR, DET, _, TMP, _ = chunk_rows(m, E)
+    sign = B[DET]
+    for p in range(n):
+        sign[p] = 1.0
+    for k in range(E):
+        # From the left: column k, rows k .. m - 1.
+        chunk_reflect(B, n, M + k * E + k, VH + k, BETA + k, TMP, M + (k + 1) * E + k, M + m * E, E, DET)
+        for c in range(k + 1, E):
+            chunk_apply(
+                B,
+                n,
+                VH + k,
+                BETA + k,
+                M + (k + 1) * E + k,
+                M + (k + 1) * E + c,
+                m - k - 1,
+                E,
+                E,
+                M + k * E + c,
+                TMP + 1,
+            )
+        if k >= E - 2:
+            continue
+        # From the right: row k, columns k + 1 .. E - 1 (its reflector in that row, right of k + 1).
+        chunk_reflect(B, n, M + k * E + k + 1, VR + k, BR + k, TMP, M + k * E + k + 2, M + k * E + E, 1, DET)
+        for a in range(k + 1, m):
+            chunk_apply(
+                B,
+                n,
+                VR + k,
+                BR + k,
+                M + k * E + k + 2,
+                M + a * E + k + 2,
+                E - k - 2,
+                1,
+                1,
+                M + a * E + k + 1,
+                TMP + 1,
+            )
+
+
+@kernel(inline="always")
+def chunk_tangent(B, n, m, E):
     """``t = U e_m`` (normalised: a unit null vector of ``J`` where it has full row rank) from the left
-    reflectors, applied last to first."""
-    M, VH, BETA, _, _, _, T, _, _, _, _, _, _, _, _, _, _, _, TMP, _, _, _ = work_rows(m, E)
+    reflectors, applied last to first, at each of the ``n`` points."""
+    M, VH, BETA, _, _, _, T, TMP, _ = chunk_rows(m, E)
     for a in range(m):
-        for l in range(L):
-            S[(T + a) * L + l] = 1.0 if a == m - 1 else 0.0
+        row = B[T + a]
+        for p in range(n):
+            row[p] = 1.0 if a == m - 1 else 0.0
     for k in range(E - 1, -1, -1):
-        for l in range(L):
-            S[(TMP + 1) * L + l] = S[(VH + k) * L + l] * S[(T + k) * L + l]
-        for a in range(k + 1, m):
-            for l in range(L):
-                S[(TMP + 1) * L + l] += S[(M + a * E + k) * L + l] * S[(T + a) * L + l]
-        for l in range(L):
-            d = S[(TMP + 1) * L + l] * S[(BETA + k) * L + l]
-            S[(TMP + 1) * L + l] = d
-            S[(T + k) * L + l] -= d * S[(VH + k) * L + l]
-        for a in range(k + 1, m):
-            for l in range(L):
-                S[(T + a) * L + l] -= S[(TMP + 1) * L + l] * S[(M + a * E + k) * L + l]
-    for l in range(L):
-        S[TMP * L + l] = 0.0
+        chunk_apply(B, n, VH + k, BETA + k, M + (k + 1) * E + k, T + k + 1, m - k - 1, E, 1, T + k, TMP + 1)
+    acc = B[TMP]
+    for p in range(n):
+        acc[p] = 0.0
     for a in range(m):
-        for l in range(L):
-            x = S[(T + a) * L + l]
-            S[TMP * L + l] += x * x
-    for l in range(L):
-        S[TMP * L + l] = 1.0 / math.sqrt(S[TMP * L + l])  # 1 to a few rounding errors
+        row = B[T + a]
+        for p in range(n):
+            x = row[p]
+            acc[p] += x * x
+    for p in range(n):
+        acc[p] = 1.0 / math.sqrt(acc[p])  # 1 to a few rounding errors
     for a in range(m):
-        for l in range(L):
-            S[(T + a) * L + l] *= S[TMP * L + l]
+        row = B[T + a]
+        for p in range(n):
+            row[p] *= acc[p]
 
 
 @kernel(inline="always")
@@ -507,25 +571,27 @@ def lanes_roots(S, L, m, E):
 
 
 @kernel(inline="always")
-def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
-    """The rows at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side by side; returns how many lanes fell
-    back to the exact routine. ``m, E``: the sizes (literal at a call site, so that the loops over them unroll and
-    the lanes' loops vectorise)."""
-    M, _, _, _, _, DET, T, _, _, _, P1, _, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
+def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
+    """The singular values and the raw test function at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side
+    by side, from their reduction (columns ``base .. base + LANES - 1`` of the chunk's array ``B``); returns how
+    many lanes fell back to the exact routine. ``m, E``: the sizes (literal at a call site, so that the loops over
+    them unroll and the lanes' loops vectorise)."""
+    M, _, _, _, _, DET, _, _, _, _, P1, _, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
+    DET_B = chunk_rows(m, E)[5]
     L = LANES  # a constant: LLVM proves the rows' ranges disjoint and vectorises without run-time checks
-    for a in range(m):
-        for e in range(E):
+    for k in range(E):
+        for l in range(L):
+            S[(M + k * E + k) * L + l] = B[M + k * E + k, base + l]
+        if k < E - 1:
             for l in range(L):
-                S[(M + a * E + e) * L + l] = jac[e, a, points[l]]
-    lanes_bidiagonal(S, L, m, E)
-    lanes_tangent(S, L, m, E)
+                S[(M + k * E + k + 1) * L + l] = B[M + k * E + k + 1, base + l]
+    for l in range(L):
+        S[DET * L + l] = B[DET_B, base + l]
     lanes_tridiagonal(S, L, m, E)
     bad = lanes_roots(S, L, m, E)
     count = 0
     for l in range(L):
         k = points[l]
-        for a in range(m):
-            tangent[a, k] = S[(T + a) * L + l]
         raw_tau[k] = S[DET * L + l]
         if bad > 0 and S[OK * L + l] == 0.0:  # not certified: the exact routine, cold
             A, Vx, Wx, norms, order = fallback
@@ -553,13 +619,17 @@ def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
 
 @kernel(inline="always")
 def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
-    """:func:`bidiagonal_rows` with the sizes ``m, E`` given (literal at a call site)."""
+    """:func:`bidiagonal_rows` with the sizes ``m, E`` given (literal at a call site): :data:`CHUNK` points at a
+    time reduced together (:func:`chunk_bidiagonal`, :func:`chunk_tangent`), then their roots :data:`LANES` at a
+    time (:func:`lanes_at`)."""
     K = jac.shape[2]
     _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, PREV, _, total = work_rows(m, E)
+    M, _, _, _, _, _, T, _, rows = chunk_rows(m, E)
     L = LANES
     S = np.zeros(total * L)
     for i in range(state.shape[0]):
         S[PREV * L + i] = state[i]
+    B = np.empty((rows, CHUNK))
     fallback = (
         np.empty((E, m)),
         np.empty((m, m)),
@@ -567,15 +637,28 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
         np.empty(m),
         np.empty(m, dtype=np.int64),
     )
-    points = np.empty(L, dtype=np.int64)
+    points = np.empty(CHUNK, dtype=np.int64)
     groups = (K - begin + L - 1) // L
     first = K - groups * L
     count = 0
-    for g in range(groups):
-        for l in range(L):
-            k = first + g * L + l
-            points[l] = k if k >= begin else begin
-        count += lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E)
+    for g0 in range(0, groups, CHUNK // L):
+        n = min(CHUNK, (groups - g0) * L)
+        for p in range(n):
+            k = first + g0 * L + p
+            points[p] = k if k >= begin else begin
+        for a in range(m):
+            for e in range(E):
+                row = B[M + a * E + e]
+                for p in range(n):
+                    row[p] = jac[e, a, points[p]]
+        chunk_bidiagonal(B, n, m, E)
+        chunk_tangent(B, n, m, E)
+        for a in range(m):
+            row = B[T + a]
+            for p in range(n):
+                tangent[a, points[p]] = row[p]
+        for g in range(n // L):
+            count += lanes_at(jac, sigma, raw_tau, points[g * L : (g + 1) * L], S, B, g * L, fallback, m, E)
     for i in range(state.shape[0]):
         state[i] = S[PREV * L + i]
     return count

@@ -60,7 +60,7 @@ import math
 import numpy as np
 
 from linkwork.kernel_cache import kernel
-from linkwork.kinematics.bidiagonal_rows import bidiagonal_rows, bidiagonal_state
+from linkwork.kinematics.bidiagonal_rows import bidiagonal_rows, bidiagonal_state, certifiable
 from linkwork.kinematics.small_svd import jacobi_svd
 
 U = 2.0**-53
@@ -662,9 +662,9 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
 
 @kernel(error_model="numpy", fastmath={"contract"})
 def jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
-    """The route :func:`multi_loop_rows` took before its certified bidiagonal one (kept as the benchmark's
-    baseline, ``benchmarks/bench_planar_rows.py``; its singular values are not certified lane by lane, only their
-    sweeps' convergence). Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
+    """The route :func:`multi_loop_rows` took before its certified bidiagonal one, and still takes for three loops
+    and more (the benchmark's baseline for two, ``benchmarks/bench_planar_rows.py``; its singular values are not
+    certified lane by lane, only their sweeps' convergence). Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
     (``m = E + 1``, one degree of freedom) at points ``begin .. K - 1``, :data:`LANES` points side by side.
 
     Writes ``sigma (E, K)`` (descending), ``tangent (m, K)`` (a unit null vector; either sign) and ``raw_tau
@@ -691,8 +691,11 @@ def jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
 def multi_loop_state(E):
     """The warm start of :func:`multi_loop_rows`, carried from one call to the next along a path
     (:func:`linkwork.kinematics.bidiagonal_rows.bidiagonal_state`: each lane's squared singular values at its last
-    point)."""
-    return bidiagonal_state(E)
+    point) where that route is taken (:func:`linkwork.kinematics.bidiagonal_rows.certifiable`: two loops and
+    fewer), else :func:`jacobi_loop_state` (the Jacobi lanes' right singular vectors)."""
+    if certifiable(E + 1, E):
+        return bidiagonal_state(E)
+    return jacobi_loop_state(E)
 
 
 @kernel(error_model="numpy", fastmath={"contract"})
@@ -711,5 +714,12 @@ def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     the bounds), the smallest ``|det B|`` over the others' product; every lane carries a first-order error bound
     and is certified to ``1e-13 sigma_1`` for every singular value, or falls back. ``|J t| <= 1e-14 sigma_1``
     (Householder reflections are backward stable), ``|t| = 1`` to ``1e-15``.
+
+    Three loops and more (``9 x 10``, ...): the reduction's own error bound there is wider than the budget
+    (:func:`linkwork.kinematics.bidiagonal_rows.certifiable`), so every lane would fall back; those sizes take the
+    Jacobi lanes (:func:`jacobi_loop_rows`, its state from :func:`multi_loop_state`) instead.
     """
-    return bidiagonal_rows(jac, sigma, tangent, raw_tau, begin, state)
+    E, m = jac.shape[0], jac.shape[1]
+    if certifiable(m, E):
+        return bidiagonal_rows(jac, sigma, tangent, raw_tau, begin, state)
+    return jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state)
