@@ -682,8 +682,8 @@ def jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     sigma_1``, ``|J t| <= 1e-14 sigma_1`` (Householder QR is backward stable), ``|t| = 1`` to ``1e-15``.
     """
     E, m = jac.shape[0], jac.shape[1]
-    if E == 6 and m == 7:  # two loops (a Watt or a Stephenson six-bar): sizes known, the loops unroll
-        return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, 7, 6)
+    # Sizes as data (no literal 6 x 7 copy: two loops take the bidiagonal route, and a second, unrolled copy of
+    # these lanes took minutes of every cold compile).
     return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E)
 
 
