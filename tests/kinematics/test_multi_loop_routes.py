@@ -6,11 +6,17 @@ three-loop eight-bar's turn."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from bookkeeping_reference import planar_four_bar
 from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
-from linkwork.kinematics.bidiagonal_rows import certifiable
+from linkwork.kinematics.bidiagonal_rows import (
+    bidiagonal_rows,
+    bidiagonal_state,
+    certifiable,
+    takes_bidiagonal,
+)
 from linkwork.kinematics.closure import jacobian
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.planar_rows import jacobi_loop_state, multi_loop_rows, multi_loop_state
@@ -60,9 +66,14 @@ def eight_bar(theta: float) -> Mechanism:
 
 
 def test_routes_by_size() -> None:
-    """The bidiagonal route for one and two loops, the Jacobi lanes (and their state) for three and four."""
+    """The bidiagonal route for two loops (the one multi-loop size it can certify), the Jacobi lanes (and their
+    state) for three and four; the bidiagonal kernel refuses any other size instead of running it."""
     assert certifiable(4, 3) and certifiable(7, 6)
     assert not certifiable(10, 9) and not certifiable(13, 12)
+    assert takes_bidiagonal(7, 6) and not takes_bidiagonal(4, 3) and not takes_bidiagonal(10, 9)
+    jac = np.zeros((9, 10, 20))
+    with pytest.raises(ValueError, match="6 x 7"):
+        bidiagonal_rows(jac, np.zeros((9, 20)), np.zeros((10, 20)), np.zeros(20), 0, bidiagonal_state(9))
     assert multi_loop_state(6).shape == (6 * 16,)
     for E in (9, 12):
         np.testing.assert_array_equal(multi_loop_state(E), jacobi_loop_state(E))

@@ -664,15 +664,23 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     return count
 
 
+@kernel(inline="always")
+def takes_bidiagonal(m, E):
+    """Whether :func:`bidiagonal_rows` serves ``m x E`` (``J^T``) Jacobians: two loops (``7 x 6``), the one
+    multi-loop size that is :func:`certifiable` (one loop, ``4 x 3``, is
+    :func:`linkwork.kinematics.planar_rows.one_loop_rows`' job; three loops and more are not certifiable). One
+    size only, compiled with its sizes literal: a second, generic copy of these lanes doubled their compile."""
+    return m == 7 and E == 6
+
+
 @kernel(error_model="numpy", fastmath={"contract"})
 def bidiagonal_rows(jac, sigma, tangent, raw_tau, begin, state):
-    """Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
-    (``m = E + 1``) at points ``begin .. K - 1``, :data:`LANES` points side by side, certified (see the module's
-    docstring); returns the number of points recomputed by the exact fall-back. ``state``
-    (:func:`bidiagonal_state`) is each lane's warm start, carried from call to call along a path: lane ``l`` takes
-    points ``k0 + l``, aligned on the last point, so that from one call to the next every lane continues its own
-    stretch."""
-    E, m = jac.shape[0], jac.shape[1]
-    if E == 6 and m == 7:  # two loops (a Watt or a Stephenson six-bar): sizes known, the loops unroll
-        return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, 7, 6)
-    return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E)
+    """Singular values, unit tangent and raw test function of the two-loop planar Jacobians ``jac (6, 7, K)`` at
+    points ``begin .. K - 1``, :data:`LANES` points side by side, certified (see the module's docstring); returns
+    the number of points recomputed by the exact fall-back. ``state`` (:func:`bidiagonal_state`) is each lane's
+    warm start, carried from call to call along a path: lane ``l`` takes points ``k0 + l``, aligned on the last
+    point, so that from one call to the next every lane continues its own stretch. Other sizes
+    (:func:`takes_bidiagonal`) raise ``ValueError``."""
+    if not takes_bidiagonal(jac.shape[1], jac.shape[0]):
+        raise ValueError("bidiagonal_rows takes two-loop (6 x 7) Jacobians only")
+    return lanes_pass(jac, sigma, tangent, raw_tau, begin, state, 7, 6)

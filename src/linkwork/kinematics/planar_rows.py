@@ -60,7 +60,7 @@ import math
 import numpy as np
 
 from linkwork.kernel_cache import kernel
-from linkwork.kinematics.bidiagonal_rows import bidiagonal_rows, bidiagonal_state, certifiable
+from linkwork.kinematics.bidiagonal_rows import bidiagonal_rows, bidiagonal_state, takes_bidiagonal
 from linkwork.kinematics.small_svd import jacobi_svd
 
 U = 2.0**-53
@@ -691,9 +691,9 @@ def jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
 def multi_loop_state(E):
     """The warm start of :func:`multi_loop_rows`, carried from one call to the next along a path
     (:func:`linkwork.kinematics.bidiagonal_rows.bidiagonal_state`: each lane's squared singular values at its last
-    point) where that route is taken (:func:`linkwork.kinematics.bidiagonal_rows.certifiable`: two loops and
-    fewer), else :func:`jacobi_loop_state` (the Jacobi lanes' right singular vectors)."""
-    if certifiable(E + 1, E):
+    point) where that route is taken (:func:`linkwork.kinematics.bidiagonal_rows.takes_bidiagonal`: two
+    loops), else :func:`jacobi_loop_state` (the Jacobi lanes' right singular vectors)."""
+    if takes_bidiagonal(E + 1, E):
         return bidiagonal_state(E)
     return jacobi_loop_state(E)
 
@@ -708,7 +708,7 @@ def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     route could not certify (recomputed by :func:`linkwork.kinematics.small_svd.jacobi_svd`, cold). ``state``
     (:func:`multi_loop_state`) is carried from call to call along a path.
 
-    The route (:mod:`linkwork.kinematics.bidiagonal_rows`): a Householder bidiagonalisation of ``J^T``, 16 points
+    Two loops (``6 x 7``, :mod:`linkwork.kinematics.bidiagonal_rows`): a Householder bidiagonalisation of ``J^T``, 16 points
     side by side, gives the tangent, ``det([J; t^T])`` and a bidiagonal ``B``; the squared singular values are the
     roots of ``B^T B``'s characteristic polynomial (Laguerre's method from the lane's previous point's, else from
     the bounds), the smallest ``|det B|`` over the others' product; every lane carries a first-order error bound
@@ -720,6 +720,6 @@ def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     Jacobi lanes (:func:`jacobi_loop_rows`, its state from :func:`multi_loop_state`) instead.
     """
     E, m = jac.shape[0], jac.shape[1]
-    if certifiable(m, E):
+    if takes_bidiagonal(m, E):
         return bidiagonal_rows(jac, sigma, tangent, raw_tau, begin, state)
     return jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state)
