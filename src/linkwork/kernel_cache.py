@@ -208,4 +208,13 @@ CACHE = KernelCache(Path(__file__).resolve().parent, KERNEL_MODULES, __version__
 """linkwork's kernel cache."""
 
 kernel = CACHE.kernel
+
+ROWS_OPTIONS = {"error_model": "numpy", "fastmath": {"contract"}}
+"""The options of the planar rows' kernels (``kinematics.planar_rows``, ``kinematics.bidiagonal_rows``) and of every
+pass they call as a compiled function of its own: no division check (their divisors are guarded), fused
+multiply-adds. A pass called with these options computes what it did inlined into its caller. Passes that a large
+kernel calls are compiled once each (specialised on the literal sizes they are called with, inlined or called by
+LLVM as it sees fit) rather than inlined by numba (``inline="always"``): numba copies an inlined function's whole
+intermediate code, its own inlined callees included, at every call site, which made those kernels' cold compile
+minutes long."""
 """Declare a linkwork kernel: ``@kernel()``, ``@kernel(inline="always")`` (see :meth:`KernelCache.kernel`)."""

@@ -73,7 +73,7 @@ import math
 
 import numpy as np
 
-from linkwork.kernel_cache import kernel
+from linkwork.kernel_cache import ROWS_OPTIONS, kernel
 from linkwork.kinematics.small_svd import jacobi_svd
 
 U = 2.0**-53
@@ -98,12 +98,6 @@ BELOW = 1e-3
 """From the bounds, root ``i + 1``'s first iterate is root ``i`` times ``1 - BELOW`` (below it, off its pole)."""
 FLOOR = 1e-300
 """Divisors are at least this (a degenerate lane gives finite nonsense, which fails its certification)."""
-PASS = {"error_model": "numpy", "fastmath": {"contract"}}
-"""The options of every pass (each its own compiled function, specialised on the literal sizes it is called with,
-and inlined or called by LLVM as it sees fit): those of :func:`bidiagonal_rows`, so that a pass computes the same
-as it did inlined. Only the small helpers (offsets, the polynomial's recurrence, one reflection) are inlined by
-numba itself: numba copies a function's whole intermediate code at every call site it inlines, its callees'
-included, and these lanes inlined that way took minutes of every cold compile."""
 
 
 @kernel(inline="always")
@@ -482,7 +476,7 @@ def lanes_check(S, L, m, E, strict):
     return bad
 
 
-@kernel(**PASS)
+@kernel(**ROWS_OPTIONS)
 def lanes_cold(S, L, m, E):
     """Roots into ``XC`` from the bounds: the largest from Samuelson's bound of ``T``'s eigenvalues (``1/E + sqrt(E
     - 1) std``, ``std`` from ``trace(T) = 1`` and ``|T|_F^2``), each next from just below the one before
@@ -524,7 +518,7 @@ def lanes_cold(S, L, m, E):
             S[(XC + r) * L + l] = x
 
 
-@kernel(**PASS)
+@kernel(**ROWS_OPTIONS)
 def lanes_refine(S, L, m, E):
     """Laguerre's steps from the roots ``X``: :data:`BLIND_STEPS` on every lane (:func:`lanes_step`), then
     :data:`WARM_EVALUATIONS` evaluations with their bounds, a step after each but the last on the lanes not yet
@@ -549,7 +543,7 @@ def lanes_refine(S, L, m, E):
     return bad
 
 
-@kernel(**PASS)
+@kernel(**ROWS_OPTIONS)
 def lanes_roots(S, L, m, E):
     """The roots of every lane, certified where possible (``OK``): refined from the state's previous roots; if any
     lane is fresh or not certified, the roots from the bounds for those lanes, refined again."""
@@ -576,7 +570,7 @@ def lanes_roots(S, L, m, E):
     return bad
 
 
-@kernel(**PASS)
+@kernel(**ROWS_OPTIONS)
 def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     """The singular values and the raw test function at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side
     by side, from their reduction (columns ``base .. base + LANES - 1`` of the chunk's array ``B``); returns how
@@ -623,7 +617,7 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     return count
 
 
-@kernel(**PASS)
+@kernel(**ROWS_OPTIONS)
 def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     """:func:`bidiagonal_rows` with the sizes ``m, E`` given (literal at a call site): :data:`CHUNK` points at a
     time reduced together (:func:`chunk_bidiagonal`, :func:`chunk_tangent`), then their roots :data:`LANES` at a
@@ -679,7 +673,7 @@ def takes_bidiagonal(m, E):
     return m == 7 and E == 6
 
 
-@kernel(**PASS)
+@kernel(**ROWS_OPTIONS)
 def bidiagonal_rows(jac, sigma, tangent, raw_tau, begin, state):
     """Singular values, unit tangent and raw test function of the two-loop planar Jacobians ``jac (6, 7, K)`` at
     points ``begin .. K - 1``, :data:`LANES` points side by side, certified (see the module's docstring); returns

@@ -59,7 +59,7 @@ import math
 
 import numpy as np
 
-from linkwork.kernel_cache import kernel
+from linkwork.kernel_cache import ROWS_OPTIONS, kernel
 from linkwork.kinematics.bidiagonal_rows import bidiagonal_rows, bidiagonal_state, takes_bidiagonal
 from linkwork.kinematics.small_svd import jacobi_svd
 
@@ -284,7 +284,7 @@ def exact_lane(jac, k, sigma, tangent, raw_tau, work, warm):
     raw_tau[k] = det if null % 2 == 1 else -det
 
 
-@kernel(error_model="numpy", fastmath={"contract"})
+@kernel(**ROWS_OPTIONS)
 def one_loop_rows(jac, sigma, tangent, raw_tau):
     """Singular values, unit tangent and raw test function of ``K`` one-loop planar Jacobians.
 
@@ -371,7 +371,7 @@ def jacobi_loop_state(E):
     return state
 
 
-@kernel(inline="always")
+@kernel(**ROWS_OPTIONS)
 def lanes_qr(S, L, m, E):
     """Householder QR of the ``LANES`` matrices ``M`` (``J^T``, ``m x E``) of the work array ``S`` in place, side
     by side: ``R`` on and above the diagonal, the reflectors below it with their first entries in ``VH`` and
@@ -446,7 +446,7 @@ def lanes_tangent(S, L, m, E):
             S[(T + a) * L + l] *= S[TMP * L + l]
 
 
-@kernel(inline="always")
+@kernel(**ROWS_OPTIONS)
 def lanes_warm_start(S, L, m, E):
     """Each lane's start ``V``: its right singular vectors extrapolated from its last three points (``3 V - 3
     V_1 + V_2``, off by their third difference) once it has three and the extrapolation moves no entry by more
@@ -505,7 +505,7 @@ def lanes_warm_start(S, L, m, E):
                 S[(W + a * E + c) * L + l] = S[TMP * L + l]
 
 
-@kernel(inline="always")
+@kernel(**ROWS_OPTIONS)
 def lanes_sweep(S, L, m, E):
     """One cyclic sweep of one-sided Jacobi rotations (Hestenes) on the columns of every lane's ``W (E, E)``
     (and ``V``), side by side: the rotation of :func:`linkwork.kinematics.dyad_solver.jacobi_sweeps`, made as
@@ -562,7 +562,7 @@ def lanes_sweep(S, L, m, E):
                     S[(V + a * E + r) * L + l] = sin * vp + cos * vr
 
 
-@kernel(inline="always")
+@kernel(**ROWS_OPTIONS)
 def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
     """The rows at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side by side (see
     :func:`jacobi_loop_rows`; ``S`` the work array, :func:`lane_rows`); returns how many lanes fell back to the
@@ -630,7 +630,7 @@ def lanes_at(jac, sigma, tangent, raw_tau, points, S, fallback, m, E):
     return count
 
 
-@kernel(inline="always")
+@kernel(**ROWS_OPTIONS)
 def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     """:func:`jacobi_loop_rows` with the sizes ``m, E`` given (literal at a call site)."""
     K = jac.shape[2]
@@ -660,7 +660,7 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     return count
 
 
-@kernel(error_model="numpy", fastmath={"contract"})
+@kernel(**ROWS_OPTIONS)
 def jacobi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     """The route :func:`multi_loop_rows` took before its certified bidiagonal one, and still takes for three loops
     and more (the benchmark's baseline for two, ``benchmarks/bench_planar_rows.py``; its singular values are not
@@ -698,7 +698,7 @@ def multi_loop_state(E):
     return jacobi_loop_state(E)
 
 
-@kernel(error_model="numpy", fastmath={"contract"})
+@kernel(**ROWS_OPTIONS)
 def multi_loop_rows(jac, sigma, tangent, raw_tau, begin, state):
     """Singular values, unit tangent and raw test function of the multi-loop planar Jacobians ``jac (E, m, K)``
     (``m = E + 1``, one degree of freedom) at points ``begin .. K - 1``.
