@@ -13,9 +13,11 @@ superdiagonal ``e``. Then
   characteristic polynomial ``p`` and its first two derivatives come from the three-term recurrence of the leading
   minors (Golub & Van Loan Sec. 8.4.1), without division; the ``E - 1`` largest roots by Laguerre's method
   (cubically convergent, and for a polynomial with real roots convergent from any start to a root next to it:
-  Stoer & Bulirsch Sec. 5.5, Wilkinson Sec. 7.48), started from the lane's previous point's (``state``); where a
-  lane has none, or those steps do not certify it, from Samuelson's bound of the largest root, each next root from
-  just below the one before with Maehly's implicit deflation ``p(x) / prod (x - x_j)`` (Stoer & Bulirsch Sec.
+  Stoer & Bulirsch Sec. 5.5, Wilkinson Sec. 7.48), started from the cubic through the lane's roots at its last
+  four points (``state``; the points are equally spaced along a path, so the start errs by ``O(h^4)``: one
+  Laguerre step then leaves it at rounding level, where two were needed from the last point's roots alone); where
+  a lane has none, or those steps do not certify it, from Samuelson's bound of the largest root, each next root
+  from just below the one before with Maehly's implicit deflation ``p(x) / prod (x - x_j)`` (Stoer & Bulirsch Sec.
   5.5);
 * the smallest singular value is ``sigma_E = |prod d_i| / (sigma_1 ... sigma_(E-1))`` (``|det B|`` is the product
   of ``B``'s singular values): accurate relative to itself however small, so a near rank drop is measured, not
@@ -90,9 +92,14 @@ WARM_EVALUATIONS = 3
 """Evaluations of the characteristic polynomial and its error bound at each root after :data:`BLIND_STEPS` (a
 Laguerre step after each but the last, on the lanes not yet certified); the lanes stop together when every lane is
 certified."""
-BLIND_STEPS = 2
-"""Laguerre steps from a warm start before the first evaluation of the bounds (without them: on the Watt six-bar's
-turn in 3600 steps, lanes 16 points apart, two leave every root within a few rounding errors)."""
+BLIND_STEPS = 1
+"""Laguerre steps from a warm start before the first evaluation of the bounds (Laguerre's method converges
+cubically: on the Watt six-bar's turn in 3600 steps, lanes 16 points apart, one step from the cubic extrapolation of
+:data:`HISTORY` points leaves every root within about ``1e-15`` of ``T``'s largest eigenvalue, and two from the
+last point's roots alone did)."""
+HISTORY = 4
+"""The points of its own a lane's warm start is extrapolated from: the roots at its last four points, a cubic
+through them (fewer where fewer are set: the last point's roots alone when one is)."""
 COLD_STEPS = 6
 """Laguerre steps for each root from the bounds (Maehly's deflation): enough for Gaussian Jacobians."""
 BELOW = 1e-3
@@ -107,8 +114,9 @@ def work_rows(m, E):
     the left reflectors below the diagonal, the right ones right of the superdiagonal), the reflectors' first
     entries and factors (left and right, ``E`` each), ``det(U) det(V)``, the tangent (``m``), ``T``'s diagonal and
     squared off-diagonal (``E`` each), ``prod d_i``, ``|B|_F^2``, the roots, their bounds, their Laguerre steps,
-    whether each is converged, the cold roots (``E`` each), the singular values (``E``), the certified flag, four temporaries, then the state:
-    the previous roots (``E - 1``) and whether they are set. Returns their offsets and the total."""
+    whether each is converged, the cold roots (``E`` each), the singular values (``E``), the certified flag, four
+    temporaries, then the state: the roots at the lane's last :data:`HISTORY` points (``E - 1`` rows each, the
+    last point's first) and how many of them are set. Returns their offsets and the total."""
     M = 0
     VH = M + m * E
     BETA = VH + E
@@ -129,7 +137,7 @@ def work_rows(m, E):
     OK = SIG + E
     TMP = OK + 1
     PREV = TMP + 4
-    SET = PREV + E - 1
+    SET = PREV + HISTORY * (E - 1)
     return (
         M,
         VH,
@@ -158,9 +166,9 @@ def work_rows(m, E):
 
 @kernel()
 def bidiagonal_state(E):
-    """The warm start carried along a path: each lane's roots at its last point (``E - 1`` rows of ``LANES``) and
-    whether they are set (one row; fresh: not)."""
-    return np.zeros(E * LANES)
+    """The warm start carried along a path: each lane's roots at its last :data:`HISTORY` points (``E - 1`` rows
+    of ``LANES`` each, the last point's first) and how many of them are set (one row; fresh: none)."""
+    return np.zeros((HISTORY * (E - 1) + 1) * LANES)
 
 
 @kernel(inline="always")
@@ -391,17 +399,28 @@ def lanes_refine(S, L, m, E):
 
 @kernel(inline="always")
 def lanes_roots(S, L, m, E):
-    """The roots of every lane, certified where possible (``OK``): refined from the state's previous roots; if any
-    lane is fresh or not certified, the roots from the bounds for those lanes, refined again."""
+    """The roots of every lane, certified where possible (``OK``): refined from the state's previous roots
+    extrapolated one point on (:data:`HISTORY`); if any lane is fresh or not certified, the roots from the bounds
+    for those lanes, refined again."""
     _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, XC, _, OK, _, PREV, SET, _ = work_rows(m, E)
     fresh = 0
     for l in range(L):
         fresh += 1 if S[SET * L + l] == 0.0 else 0
     bad = L
     if fresh < L:
+        H = E - 1
         for r in range(E - 1):
-            for l in range(L):
-                S[(X + r) * L + l] = S[(PREV + r) * L + l]
+            for l in range(L):  # the polynomial through the last points (equally spaced), one point on
+                c = S[SET * L + l]
+                x0 = S[(PREV + r) * L + l]
+                x1 = S[(PREV + H + r) * L + l]
+                x2 = S[(PREV + 2 * H + r) * L + l]
+                x3 = S[(PREV + 3 * H + r) * L + l]
+                cubic = 4.0 * x0 - 6.0 * x1 + 4.0 * x2 - x3
+                quadratic = 3.0 * x0 - 3.0 * x1 + x2
+                S[(X + r) * L + l] = (
+                    cubic if c > 3.0 else (quadratic if c > 2.0 else (2.0 * x0 - x1 if c > 1.0 else x0))
+                )
         bad = lanes_refine(S, L, m, E)
     else:
         for l in range(L):
@@ -453,13 +472,21 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
             count += 1 if l == 0 or k != points[l - 1] else 0  # a repeated point (before ``begin``) once
         for e in range(E):
             sigma[e, k] = S[(SIG + e) * L + l]
+    H = E - 1
+    for r in range(HISTORY * H - 1, H - 1, -1):  # the history one point older
+        for l in range(L):
+            S[(PREV + r) * L + l] = S[(PREV + r - H) * L + l]
     for r in range(E - 1):
         for l in range(L):
             s = S[(SIG + r) * L + l]
             p1 = S[P1 * L + l]
             S[(PREV + r) * L + l] = s * s / p1 if p1 > FLOOR else 0.0
     for l in range(L):
-        S[SET * L + l] = 1.0 if S[P1 * L + l] > FLOOR else 0.0
+        # A repeated point (before ``begin``, the next lane's too) is not one point on: its roots alone are set.
+        c = S[SET * L + l] + 1.0
+        c = c if c < HISTORY else float(HISTORY)
+        c = 1.0 if l < L - 1 and points[l] == points[l + 1] else c
+        S[SET * L + l] = c if S[P1 * L + l] > FLOOR else 0.0
     return count
 
 
