@@ -322,8 +322,10 @@ def lanes_check(S, L, m, E, strict):
         for r in range(E - 1):
             s = S[(SIG + r) * L + l]
             ok = ok & (S[(DX + r) * L + l] * p1 * (spread + s) <= beta * s * s)
-        x_low = low * low / (p1 if p1 > FLOOR else FLOOR)
-        ok = ok & (low <= S[(SIG + E - 2) * L + l])
+        below = low <= S[(SIG + E - 2) * L + l]
+        ok = ok & below
+        kept = low if below else 0.0  # a lane that fails here may have ``low`` near the overflow: not squared
+        x_low = kept * kept / (p1 if p1 > FLOOR else FLOOR)
         ok = ok & (abs(found + x_low - trace) <= 2.0 * width + 4.0 * E * U + 2.0 * x_low * SIGMA_TOL)
         S[OK * L + l] = 1.0 if ok else 0.0
         bad += 0 if ok else 1
