@@ -413,7 +413,7 @@ def lanes_roots(S, L, m, E):
         H = E - 1
         for r in range(E - 1):
             for l in range(L):  # the polynomial through the last points (equally spaced), one point on
-                c = S[SET * L + l]
+                seen = S[SET * L + l]
                 x0 = S[(PREV + r) * L + l]
                 x1 = S[(PREV + H + r) * L + l]
                 x2 = S[(PREV + 2 * H + r) * L + l]
@@ -421,7 +421,9 @@ def lanes_roots(S, L, m, E):
                 cubic = 4.0 * x0 - 6.0 * x1 + 4.0 * x2 - x3
                 quadratic = 3.0 * x0 - 3.0 * x1 + x2
                 S[(X + r) * L + l] = (
-                    cubic if c > 3.0 else (quadratic if c > 2.0 else (2.0 * x0 - x1 if c > 1.0 else x0))
+                    cubic
+                    if seen > 3.0
+                    else (quadratic if seen > 2.0 else (2.0 * x0 - x1 if seen > 1.0 else x0))
                 )
         bad = lanes_refine(S, L, m, E)
     else:
@@ -485,10 +487,10 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
             S[(PREV + r) * L + l] = s * s / p1 if p1 > FLOOR else 0.0
     for l in range(L):
         # A repeated point (before ``begin``, the next lane's too) is not one point on: its roots alone are set.
-        c = S[SET * L + l] + 1.0
-        c = c if c < HISTORY else float(HISTORY)
-        c = 1.0 if l < L - 1 and points[l] == points[l + 1] else c
-        S[SET * L + l] = c if S[P1 * L + l] > FLOOR else 0.0
+        seen = S[SET * L + l] + 1.0
+        seen = seen if seen < HISTORY else float(HISTORY)
+        seen = 1.0 if l < L - 1 and points[l] == points[l + 1] else seen
+        S[SET * L + l] = seen if S[P1 * L + l] > FLOOR else 0.0
     return count
 
 
