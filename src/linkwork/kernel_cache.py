@@ -39,6 +39,7 @@ from numba.core import config as numba_config
 from linkwork.version import __version__
 
 KERNEL_MODULES = (
+    "kinematics/bidiagonal_7x6.py",
     "kinematics/bidiagonal_rows.py",
     "kinematics/dyad_solver.py",
     "kinematics/kernels.py",

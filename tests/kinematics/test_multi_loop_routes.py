@@ -12,6 +12,7 @@ from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
 from linkwork.kinematics.bidiagonal_rows import (
+    HISTORY,
     bidiagonal_rows,
     bidiagonal_state,
     certifiable,
@@ -74,7 +75,7 @@ def test_routes_by_size() -> None:
     jac = np.zeros((9, 10, 20))
     with pytest.raises(ValueError, match="6 x 7"):
         bidiagonal_rows(jac, np.zeros((9, 20)), np.zeros((10, 20)), np.zeros(20), 0, bidiagonal_state(9))
-    assert multi_loop_state(6).shape == (6 * 16,)
+    assert multi_loop_state(6).shape == ((HISTORY * 5 + 1) * 16,)  # the roots at four points, how many set
     for E in (9, 12):
         np.testing.assert_array_equal(multi_loop_state(E), jacobi_loop_state(E))
 

@@ -13,6 +13,7 @@ from bookkeeping_reference import stephenson_six_bar
 from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
+from linkwork.kinematics.bidiagonal_rows import HISTORY
 from linkwork.kinematics.closure import jacobian
 from linkwork.kinematics.jit import python_twin
 from linkwork.kinematics.mechanism import Mechanism
@@ -168,14 +169,16 @@ def test_certified_lanes_are_most_and_right() -> None:
 
 def test_a_wrong_warm_start_is_caught() -> None:
     """A state whose previous roots are nonsense (random, or every lane's the same value: Laguerre's steps then
-    converge to the wrong roots or to one root twice) is caught by the certification and redone from the bounds:
-    no fall-back, the contract kept."""
+    converge to the wrong roots or to one root twice; the last point's alone, or extrapolated from four) is caught
+    by the certification and redone from the bounds: no fall-back, the contract kept."""
     J = turn_jacobians(lw.load(str(WATT)))
     jac = np.ascontiguousarray(J.transpose(1, 2, 0))
-    for previous in (RNG.uniform(size=(5, 16)), np.full((5, 16), 0.3)):
+    cases = [(RNG.uniform(size=(HISTORY * 5, 16)), 1), (np.full((HISTORY * 5, 16), 0.3), 1)]
+    cases += [(RNG.uniform(size=(HISTORY * 5, 16)), HISTORY)]
+    for previous, points_set in cases:
         state = multi_loop_state(6)
-        state[: 5 * 16] = previous.ravel()
-        state[5 * 16 :] = 1.0  # set
+        state[: HISTORY * 5 * 16] = previous.ravel()
+        state[HISTORY * 5 * 16 :] = points_set
         K = len(J)
         sigma, tangent, tau = np.empty((6, K)), np.empty((7, K)), np.empty(K)
         assert multi_loop_rows(jac, sigma, tangent, tau, 0, state) == 0
