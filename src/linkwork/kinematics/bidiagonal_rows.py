@@ -439,7 +439,7 @@ def lanes_roots(S, L, m, E):
     return bad
 
 
-@kernel(**ROWS_OPTIONS)
+@kernel(inline="always")
 def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     """The singular values and the raw test function at the ``LANES`` points ``points`` of ``jac (E, m, K)``, side
     by side, from their reduction (points ``base .. base + LANES - 1`` of the chunk's array ``B``,
@@ -494,7 +494,7 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     return count
 
 
-@kernel(**ROWS_OPTIONS)
+@kernel(inline="always")
 def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     """:func:`bidiagonal_rows` with the sizes ``m, E`` given (literal at a call site; the reduction,
     :func:`linkwork.kinematics.bidiagonal_7x6.reduce_points`, is that of ``7 x 6``): :data:`CHUNK` points at a
