@@ -5,6 +5,7 @@ here for the output modules."""
 from __future__ import annotations
 
 import os
+from typing import Any
 
 from rich.align import AlignMethod
 from rich.console import Console, ConsoleDimensions
@@ -35,6 +36,15 @@ class _SummaryConsole(Console):
     """A console as wide as a terminal on a terminal, and :data:`FILE_WIDTH` wide on a file or a pipe (unless
     ``COLUMNS`` says otherwise), so a table saved to a file keeps its full headers and rows ("transmission", not
     "transmiss...") instead of being squeezed into 80 columns."""
+
+    def __init__(self, **options: Any) -> None:
+        super().__init__(**options)
+        # rich fixes the width from ``COLUMNS`` once, when the console is made (at import); the summaries read it
+        # when they print, so a caller (a test runner, a notebook) that sets or clears it later is obeyed.
+        if "width" not in options:
+            self._width = None
+        if "height" not in options:
+            self._height = None
 
     @property
     def size(self) -> ConsoleDimensions:
