@@ -113,7 +113,7 @@ def work_rows(m, E):
     """The rows of the work array (each ``LANES`` doubles, one a lane): ``M`` (``J^T``, ``m x E``, reduced in place:
     the left reflectors below the diagonal, the right ones right of the superdiagonal), the reflectors' first
     entries and factors (left and right, ``E`` each), ``det(U) det(V)``, the tangent (``m``), ``T``'s diagonal and
-    squared off-diagonal (``E`` each), ``prod d_i``, ``|B|_F^2``, the roots, their bounds, their Laguerre steps,
+    squared off-diagonal (``E`` each), ``prod d_i``, ``|B|_F^2``, the roots, their bounds,
     whether each is converged, the cold roots (``E`` each), the singular values (``E``), the certified flag, four
     temporaries, then the state: the roots at the lane's last :data:`HISTORY` points (``E - 1`` rows each, the
     last point's first) and how many of them are set. Returns their offsets and the total."""
@@ -130,8 +130,7 @@ def work_rows(m, E):
     P1 = PROD + 1
     X = P1 + 1
     DX = X + E
-    STEP = DX + E
-    CONV = STEP + E
+    CONV = DX + E
     XC = CONV + E
     SIG = XC + E
     OK = SIG + E
@@ -152,7 +151,6 @@ def work_rows(m, E):
         P1,
         X,
         DX,
-        STEP,
         CONV,
         XC,
         SIG,
@@ -196,7 +194,7 @@ def certifiable(m, E):
 def lanes_tridiagonal(S, L, m, E):
     """``T = B^T B / |B|_F^2`` (diagonal into ``A``, squared off-diagonal into ``W``), ``|B|_F^2`` into ``P1`` and
     ``prod d_i`` into ``PROD``; ``DET`` becomes ``det(U) det(V) prod d_i``."""
-    M, _, _, _, _, DET, _, A, W, PROD, P1, _, _, _, _, _, _, _, _, _, _, _ = work_rows(m, E)
+    M, _, _, _, _, DET, _, A, W, PROD, P1, _, _, _, _, _, _, _, _, _, _ = work_rows(m, E)
     for l in range(L):
         total, prod = 0.0, 1.0
         for k in range(E):
@@ -226,7 +224,7 @@ def characteristic(S, L, E, l, x):
     """``p(x) = det(T - x I)``, ``p'(x)``, ``p''(x)`` at lane ``l`` by the three-term recurrence of the leading
     minors, and ``mu``, a first-order bound of ``|fl(p) - p|`` for the exact ``T`` of ``B`` (running error
     analysis: ``a_i`` errs by ``4 u a_i``, ``w_i`` by ``5 u w_i``, each product and difference by ``u``)."""
-    _, _, _, _, _, _, _, A, W, _, _, _, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
+    _, _, _, _, _, _, _, A, W, _, _, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
     a = S[A * L + l]
     c = a - x
     pm, p = 1.0, c
@@ -247,30 +245,27 @@ def characteristic(S, L, E, l, x):
 
 @kernel(inline="always")
 def lanes_bounds(S, L, E):
-    """At each lane's roots ``X``: their error bounds ``(|p| + mu) / |p'|`` into ``DX`` and Laguerre's steps
-    ``n p / (p' +- sqrt((n - 1)^2 p'^2 - n (n - 1) p p''))`` (``n = E``, the sign of ``p'``) into ``STEP``, and
-    into ``CONV`` whether the root is converged to round-off (``|p| <= mu``: the residual is within the
-    evaluation's own error bound)."""
-    _, _, _, _, _, _, _, _, _, _, _, X, DX, STEP, CONV, _, _, _, _, _, _, _ = work_rows(E + 1, E)
-    n = float(E)
+    """At each lane's roots ``X``: their error bounds ``(|p| + mu) / |p'|`` into ``DX`` and into ``CONV`` whether
+    the root is converged to round-off (``|p| <= mu``: the residual is within the evaluation's own error bound).
+    No ``p''``: most lanes certify here, and the step of those that do not is taken from the same ``x``
+    (:func:`lanes_step`, masked)."""
+    _, _, _, _, _, _, _, _, _, _, _, X, DX, CONV, _, _, _, _, _, _, _ = work_rows(E + 1, E)
     for r in range(E - 1):
         for l in range(L):
             x = S[(X + r) * L + l]
-            p, dp, hp, mu = characteristic(S, L, E, l, x)
+            p, dp, _, mu = characteristic(S, L, E, l, x)
             slope = abs(dp)
             S[(DX + r) * L + l] = (abs(p) + mu) / (slope if slope > FLOOR else FLOOR)
-            disc = (n - 1.0) * ((n - 1.0) * dp * dp - n * p * hp)
-            root = math.sqrt(disc if disc > 0.0 else 0.0)
-            den = dp + root if dp >= 0.0 else dp - root
-            S[(STEP + r) * L + l] = n * p / (den if abs(den) > FLOOR else FLOOR)
             S[(CONV + r) * L + l] = 1.0 if abs(p) <= mu else 0.0
 
 
 @kernel(inline="always")
-def lanes_step(S, L, E):
-    """One Laguerre step (see :func:`lanes_bounds`) at every lane's roots ``X``, without their bounds (from a warm
-    start, a lane's last point ``LANES`` points back, the first evaluations would not certify)."""
-    _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, _, _, _, _, _, _, _ = work_rows(E + 1, E)
+def lanes_step(S, L, E, masked):
+    """One Laguerre step ``x -= n p / (p' +- sqrt((n - 1)^2 p'^2 - n (n - 1) p p''))`` (``n = E``, the sign of
+    ``p'``) at every lane's roots ``X`` (with ``masked``, only on the lanes not certified, ``OK`` 0), without
+    their bounds (from a warm start, a lane's last point ``LANES`` points back, the first evaluations would not
+    certify)."""
+    _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, _, OK, _, _, _, _ = work_rows(E + 1, E)
     n = float(E)
     for r in range(E - 1):
         for l in range(L):
@@ -279,7 +274,8 @@ def lanes_step(S, L, E):
             disc = (n - 1.0) * ((n - 1.0) * dp * dp - n * p * hp)
             root = math.sqrt(disc if disc > 0.0 else 0.0)
             den = dp + root if dp >= 0.0 else dp - root
-            S[(X + r) * L + l] = x - n * p / (den if abs(den) > FLOOR else FLOOR)
+            stepped = x - n * p / (den if abs(den) > FLOOR else FLOOR)
+            S[(X + r) * L + l] = x if masked and S[OK * L + l] > 0.0 else stepped
 
 
 @kernel(inline="always")
@@ -293,7 +289,7 @@ def lanes_check(S, L, m, E, strict):
     ``sigma_i`` (``i < E``) errs by at most ``dsigma_i = dlambda_i / sigma_i <= beta sigma_i / ((E - 1) sigma_E +
     sigma_i)``, so that ``dsigma_i <= beta`` and ``sigma_E``'s error, ``sigma_E sum_i dsigma_i / sigma_i`` (its
     relative error is the sum of theirs), is at most ``beta`` too; no division."""
-    _, _, _, _, _, _, _, A, _, PROD, P1, X, DX, _, CONV, _, SIG, OK, _, _, _, _ = work_rows(m, E)
+    _, _, _, _, _, _, _, A, _, PROD, P1, X, DX, CONV, _, SIG, OK, _, _, _, _ = work_rows(m, E)
     c = reduction_bound(m, E)
     bad = 0
     for l in range(L):
@@ -340,7 +336,7 @@ def lanes_cold(S, L, m, E):
     roots found (Maehly's deflation), in the homogeneous form ``f = p Q^2``, ``f' = (p' Q - p Q') Q``, ``f'' = p''
     Q^2 - 2 p' Q' Q - p Q'' Q + 2 p Q'^2`` (Laguerre's step is unchanged when ``f, f', f''`` are scaled
     together): no division but the step's."""
-    _, _, _, _, _, _, _, A, W, _, _, _, _, _, _, XC, _, _, _, _, _, _ = work_rows(m, E)
+    _, _, _, _, _, _, _, A, W, _, _, _, _, _, XC, _, _, _, _, _, _ = work_rows(m, E)
     for l in range(L):
         sq = 0.0
         for k in range(E):
@@ -380,10 +376,9 @@ def lanes_refine(S, L, m, E):
     :data:`WARM_EVALUATIONS` evaluations with their bounds, a step after each but the last on the lanes not yet
     certified and converged, all lanes stopping together when every lane is; returns the lanes not certified
     (converged or not) at the end."""
-    _, _, _, _, _, _, _, _, _, _, _, X, _, STEP, _, _, _, OK, _, _, _, _ = work_rows(m, E)
     bad = L
     for _ in range(BLIND_STEPS):
-        lanes_step(S, L, E)
+        lanes_step(S, L, E, False)
     for it in range(WARM_EVALUATIONS):
         lanes_bounds(S, L, E)
         bad = lanes_check(S, L, m, E, True)
@@ -392,10 +387,7 @@ def lanes_refine(S, L, m, E):
         if it == WARM_EVALUATIONS - 1:
             bad = lanes_check(S, L, m, E, False)  # certified, if not to round-off
             break
-        for r in range(E - 1):
-            for l in range(L):
-                x = S[(X + r) * L + l]
-                S[(X + r) * L + l] = x if S[OK * L + l] > 0.0 else x - S[(STEP + r) * L + l]
+        lanes_step(S, L, E, True)
     return bad
 
 
@@ -404,7 +396,7 @@ def lanes_roots(S, L, m, E):
     """The roots of every lane, certified where possible (``OK``): refined from the state's previous roots
     extrapolated one point on (:data:`HISTORY`); if any lane is fresh or not certified, the roots from the bounds
     for those lanes, refined again."""
-    _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, XC, _, OK, _, PREV, SET, _ = work_rows(m, E)
+    _, _, _, _, _, _, _, _, _, _, _, X, _, _, XC, _, OK, _, PREV, SET, _ = work_rows(m, E)
     fresh = 0
     for l in range(L):
         fresh += 1 if S[SET * L + l] == 0.0 else 0
@@ -446,7 +438,7 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     :func:`linkwork.kinematics.bidiagonal_7x6.reduce_points`); returns how
     many lanes fell back to the exact routine. ``m, E``: the sizes (literal at a call site, so that the loops over
     them unroll and the lanes' loops vectorise)."""
-    M, _, _, _, _, DET, _, _, _, _, P1, _, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
+    M, _, _, _, _, DET, _, _, _, _, P1, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
     L = LANES  # a constant: LLVM proves the rows' ranges disjoint and vectorises without run-time checks
     for k in range(E):
         for l in range(L):
@@ -500,7 +492,7 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     :func:`linkwork.kinematics.bidiagonal_7x6.reduce_points`, is that of ``7 x 6``): :data:`CHUNK` points at a
     time reduced together, then their roots :data:`LANES` at a time (:func:`lanes_at`)."""
     K = jac.shape[2]
-    _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, PREV, _, total = work_rows(m, E)
+    _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, PREV, _, total = work_rows(m, E)
     L = LANES
     S = np.zeros(total * L)
     for i in range(state.shape[0]):
