@@ -451,10 +451,9 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     lanes_tridiagonal(S, L, m, E)
     bad = lanes_roots(S, L, m, E)
     count = 0
-    for l in range(L):
+    for l in range(L if bad > 0 else 0):
         k = points[l]
-        raw_tau[k] = S[DET * L + l]
-        if bad > 0 and S[OK * L + l] == 0.0:  # not certified: the exact routine, cold
+        if S[OK * L + l] == 0.0:  # not certified: the exact routine, cold
             A, Vx, Wx, norms, order = fallback
             for e in range(E):
                 for c in range(m):
@@ -466,8 +465,12 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
             for e in range(E):
                 S[(SIG + e) * L + l] = norms[e]
             count += 1 if l == 0 or k != points[l - 1] else 0  # a repeated point (before ``begin``) once
-        for e in range(E):
-            sigma[e, k] = S[(SIG + e) * L + l]
+    # A repeated point's lanes (before ``begin``) hold the same values: any order of the stores will do.
+    for l in range(L):
+        raw_tau[points[l]] = S[DET * L + l]
+    for e in range(E):
+        for l in range(L):
+            sigma[e, points[l]] = S[(SIG + e) * L + l]
     H = E - 1
     for r in range(HISTORY * H - 1, H - 1, -1):  # the history one point older
         for l in range(L):
