@@ -438,7 +438,7 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     :func:`linkwork.kinematics.bidiagonal_7x6.reduce_points`); returns how
     many lanes fell back to the exact routine. ``m, E``: the sizes (literal at a call site, so that the loops over
     them unroll and the lanes' loops vectorise)."""
-    M, _, _, _, _, DET, _, _, _, _, P1, _, _, _, _, SIG, OK, _, PREV, SET, _ = work_rows(m, E)
+    M, _, _, _, _, DET, _, _, _, _, P1, _, _, _, _, SIG, OK, TMP, PREV, SET, _ = work_rows(m, E)
     L = LANES  # a constant: LLVM proves the rows' ranges disjoint and vectorises without run-time checks
     for k in range(E):
         for l in range(L):
@@ -475,11 +475,13 @@ def lanes_at(jac, sigma, raw_tau, points, S, B, base, fallback, m, E):
     for r in range(HISTORY * H - 1, H - 1, -1):  # the history one point older
         for l in range(L):
             S[(PREV + r) * L + l] = S[(PREV + r - H) * L + l]
+    for l in range(L):
+        p1 = S[P1 * L + l]
+        S[TMP * L + l] = 1.0 / p1 if p1 > FLOOR else 0.0  # one division a lane, not one a root
     for r in range(E - 1):
         for l in range(L):
             s = S[(SIG + r) * L + l]
-            p1 = S[P1 * L + l]
-            S[(PREV + r) * L + l] = s * s / p1 if p1 > FLOOR else 0.0
+            S[(PREV + r) * L + l] = s * s * S[TMP * L + l]
     for l in range(L):
         # A repeated point (before ``begin``, the next lane's too) is not one point on: its roots alone are set.
         seen = S[SET * L + l] + 1.0
