@@ -14,8 +14,10 @@ superdiagonal ``e``. Then
   minors (Golub & Van Loan Sec. 8.4.1), without division; the ``E - 1`` largest roots by Laguerre's method
   (cubically convergent, and for a polynomial with real roots convergent from any start to a root next to it:
   Stoer & Bulirsch Sec. 5.5, Wilkinson Sec. 7.48), started from the cubic through the lane's roots at its last
-  four points (``state``; the points are equally spaced along a path, so the start errs by ``O(h^4)``: one
-  Laguerre step then leaves it at rounding level, where two were needed from the last point's roots alone); where
+  four points (``state``; the points are equally spaced along a path, so the start errs by ``O(h^4)``: one blind
+  step of Halley's method, ``x -= 2 p p' / (2 p'^2 - p p'')``, cubically convergent near a simple root as
+  Laguerre's is but without its square root, then leaves it at rounding level, where two Laguerre steps were
+  needed from the last point's roots alone; a lane not certified after it takes Laguerre's steps); where
   a lane has none, or those steps do not certify it, from Samuelson's bound of the largest root, each next root
   from just below the one before with Maehly's implicit deflation ``p(x) / prod (x - x_j)`` (Stoer & Bulirsch Sec.
   5.5);
@@ -68,6 +70,7 @@ error bounds), Lemma 19.2 (applying a computed Householder reflection).
 J. Stoer, R. Bulirsch, *Introduction to Numerical Analysis*, 3rd ed., Springer (2002), Sec. 5.5 (roots of
 polynomials with real roots: Newton's and Laguerre's methods, Maehly's deflation).
 J. H. Wilkinson, *The Algebraic Eigenvalue Problem*, Oxford (1965), Sec. 7.48 (Laguerre's method).
+J. F. Traub, *Iterative Methods for the Solution of Equations*, Prentice-Hall (1964) (Halley's third-order method).
 P. A. Samuelson, J. Am. Stat. Assoc. 63 (1968) 1522-1525 (the upper bound ``mean + sqrt(n - 1) std`` of the roots).
 """
 
@@ -93,10 +96,10 @@ WARM_EVALUATIONS = 3
 Laguerre step after each but the last, on the lanes not yet certified); the lanes stop together when every lane is
 certified."""
 BLIND_STEPS = 1
-"""Laguerre steps from a warm start before the first evaluation of the bounds (Laguerre's method converges
-cubically: on the Watt six-bar's turn in 3600 steps, lanes 16 points apart, one step from the cubic extrapolation of
-:data:`HISTORY` points leaves every root within about ``1e-15`` of ``T``'s largest eigenvalue, and two from the
-last point's roots alone did)."""
+"""Halley steps from a warm start before the first evaluation of the bounds (Halley's method converges cubically
+near a simple root: on the Watt six-bar's turn in 3600 steps, lanes 16 points apart, one step from the cubic
+extrapolation of :data:`HISTORY` points leaves every root within about ``1e-15`` of ``T``'s largest eigenvalue;
+the steps after an evaluation are Laguerre's, convergent from any start)."""
 HISTORY = 4
 """The points of its own a lane's warm start is extrapolated from: the roots at its last four points, a cubic
 through them (fewer where fewer are set: the last point's roots alone when one is)."""
@@ -261,21 +264,25 @@ def lanes_bounds(S, L, E):
 
 @kernel(inline="always")
 def lanes_step(S, L, E, masked):
-    """One Laguerre step ``x -= n p / (p' +- sqrt((n - 1)^2 p'^2 - n (n - 1) p p''))`` (``n = E``, the sign of
-    ``p'``) at every lane's roots ``X`` (with ``masked``, only on the lanes not certified, ``OK`` 0), without
-    their bounds (from a warm start, a lane's last point ``LANES`` points back, the first evaluations would not
-    certify)."""
+    """One step at every lane's roots ``X``, without their bounds: with ``masked``, a Laguerre step ``x -= n p /
+    (p' +- sqrt((n - 1)^2 p'^2 - n (n - 1) p p''))`` (``n = E``, the sign of ``p'``) on the lanes not certified
+    (``OK`` 0); without, the blind step from a warm start (a lane's last point ``LANES`` points back: the first
+    evaluations would not certify) on every lane, Halley's ``x -= 2 p p' / (2 p'^2 - p p'')`` (no square root)."""
     _, _, _, _, _, _, _, _, _, _, _, X, _, _, _, _, OK, _, _, _, _ = work_rows(E + 1, E)
     n = float(E)
     for r in range(E - 1):
         for l in range(L):
             x = S[(X + r) * L + l]
             p, dp, hp, _ = characteristic(S, L, E, l, x)
-            disc = (n - 1.0) * ((n - 1.0) * dp * dp - n * p * hp)
-            root = math.sqrt(disc if disc > 0.0 else 0.0)
-            den = dp + root if dp >= 0.0 else dp - root
-            stepped = x - n * p / (den if abs(den) > FLOOR else FLOOR)
-            S[(X + r) * L + l] = x if masked and S[OK * L + l] > 0.0 else stepped
+            if masked:
+                disc = (n - 1.0) * ((n - 1.0) * dp * dp - n * p * hp)
+                root = math.sqrt(disc if disc > 0.0 else 0.0)
+                den = dp + root if dp >= 0.0 else dp - root
+                stepped = x - n * p / (den if abs(den) > FLOOR else FLOOR)
+                S[(X + r) * L + l] = x if S[OK * L + l] > 0.0 else stepped
+            else:
+                den = 2.0 * dp * dp - p * hp
+                S[(X + r) * L + l] = x - 2.0 * p * dp / (den if abs(den) > FLOOR else FLOOR)
 
 
 @kernel(inline="always")
@@ -372,7 +379,7 @@ def lanes_cold(S, L, m, E):
 
 @kernel(**ROWS_OPTIONS)
 def lanes_refine(S, L, m, E):
-    """Laguerre's steps from the roots ``X``: :data:`BLIND_STEPS` on every lane (:func:`lanes_step`), then
+    """Steps from the roots ``X``: :data:`BLIND_STEPS` Halley steps on every lane (:func:`lanes_step`), then
     :data:`WARM_EVALUATIONS` evaluations with their bounds, a step after each but the last on the lanes not yet
     certified and converged, all lanes stopping together when every lane is; returns the lanes not certified
     (converged or not) at the end."""
