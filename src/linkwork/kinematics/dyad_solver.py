@@ -988,10 +988,10 @@ def store_rows(block, offsets, outs, first, begin, end, loose):
     each joint's value ``q + offsets`` (what the trace reports); returns whether each of these rows passes the
     full-rank test of :func:`~linkwork.kinematics.kernels.every_row_full_rank` with ``loose``.
 
-    Column by column: each block array's row read along the points, written down one column of the output (a
-    stride of a row: the block's rows stay in the first-level cache), the offset in a register; for the usual
-    sizes (one loop of four joints, two of seven) with the sizes as literal constants, so that the loops over
-    the joints unroll."""
+    Row by row (each output row's entries side by side in memory; the block's arrays, read along their columns,
+    stay in the first-level cache), on slices of the block and of the outputs that start at 0; for the usual
+    sizes (one loop of four joints, two of seven) with the sizes as literal constants, so that the loops over a
+    row unroll. (Column by column, one output column at a time, costs three times as much.)"""
     n, E = block[0].shape[0], block[1].shape[0]
     if n == 4 and E == 3:
         return store_sized(block, offsets, outs, first, begin, end, loose, 4, 3)
@@ -1005,30 +1005,28 @@ def store_sized(block, offsets, outs, first, begin, end, loose, n, E):
     """:func:`store_rows` with ``n`` joints and ``E`` singular values (literal constants where it is called)."""
     q, sigma, res, taus = block
     out_angles, out_sigma, out_res, out_tau, _out_s = outs
-    shift = first - 1
-    for j in range(n):
-        qj, offset = q[j], offsets[j]
-        for i in range(begin, end):
-            out_angles[shift + i, j] = qj[i] + offset
-    for e in range(E):
-        se = sigma[e]
-        for i in range(begin, end):
-            out_sigma[shift + i, e] = se[i]
-    for i in range(begin, end):
-        out_res[shift + i] = res[i]
-        out_tau[shift + i] = taus[i]
-    # every_row_full_rank's test on these rows, the same comparisons (a count of failing rows: it vectorises)
-    failing = 0
-    for i in range(begin, end):
-        top = sigma[0, i]
+    lo, hi = first - 1 + begin, first - 1 + end
+    angles, values = out_angles[lo:hi], out_sigma[lo:hi]
+    q_rows, sigma_rows = q[:, begin:end], sigma[:, begin:end]
+    for i in range(end - begin):
+        for j in range(n):
+            angles[i, j] = q_rows[j, i] + offsets[j]
+        for e in range(E):
+            values[i, e] = sigma_rows[e, i]
+    out_res[lo:hi] = res[begin:end]
+    out_tau[lo:hi] = taus[begin:end]
+    # every_row_full_rank's test on these rows, the same comparisons (vectorised: no early exit)
+    failing = False
+    for i in range(end - begin):
+        top = sigma_rows[0, i]
         low = top
-        odd = 0
+        odd = False
         for e in range(1, E):
-            x = sigma[e, i]
-            odd += 0 if x == x else 1
+            x = sigma_rows[e, i]
+            odd |= x != x
             low = x if x < low else low
-        failing += 0 if (odd == 0) & (top > 0.0) & (low / top > loose) else 1
-    return failing == 0
+        failing |= not ((not odd) & (top > 0.0) & (low / top > loose))
+    return not failing
 
 
 @kernel(inline="always", error_model="numpy")
