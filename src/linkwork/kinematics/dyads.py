@@ -16,6 +16,7 @@ import math
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -207,10 +208,10 @@ def _basis_sign(mech: Mechanism, basis: Array) -> float:
     )
 
 
-@dataclass(frozen=True, slots=True)
-class ClosedFormRows:
+class ClosedFormRows(NamedTuple):
     """The rows of a paper-mode path that :func:`closed_form_rows` solved, one per point (row 0 the start): the
-    compiled solver's own arrays, each C-contiguous and writeable, handed to the ``Trace`` without copies.
+    compiled solver's own arrays, each C-contiguous and writeable, handed to the ``Trace`` without copies (a named
+    tuple: built once a trace, in a third of a frozen dataclass's time).
 
     ``angles (N, n)`` the joint values (joint order, reference offsets included), ``sigma (N, k)`` the singular
     values (descending), ``residual``, ``test`` (the signed test function), ``arclength`` ``(N,)``;

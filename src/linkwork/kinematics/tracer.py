@@ -321,7 +321,8 @@ def _closed_form_trace(
     m = mech.n_unknowns
     count = len(sigma)
     if rows.full_rank:  # usual: the closed form keeps off singular points
-        ranks = np.full(count, sigma.shape[1], dtype=np.int64)
+        ranks = np.empty(count, dtype=np.int64)
+        ranks.fill(sigma.shape[1])  # (np.full's Python wrapper costs half as much again)
         mobility = m - sigma.shape[1]  # _branch_mobility of a constant
     else:
         ranks = numerical_ranks(sigma, tol, backend.compiled)
