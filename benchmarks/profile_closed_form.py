@@ -39,7 +39,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from ab_closed_form import kernel_arguments
+from ab_closed_form import call_for, kernel_arguments, same_rows
 from threads import single_threaded
 
 from linkwork.kinematics import dyad_solver
@@ -100,7 +100,7 @@ class Block:
 
     def __init__(self, call: tuple[Any, ...]) -> None:
         self.flat, self.plan, self.run = call
-        joint_int, _, _, _, head = self.plan
+        joint_int, head = self.plan[0], self.plan[4]
         settings, t0 = self.run[0], self.run[1]
         n, m, E = joint_int.shape[0], t0.shape[0], 3 * (self.flat[3].shape[0] - 1)
         C = dyad_solver.BLOCK + 1
@@ -127,7 +127,7 @@ class Block:
         for i in range(1, self.C):
             value = target if first - 1 + i == self.steps else value + h
             self.drive_q[i] = value
-        joint_int, joint_geo, dyads, modes, head = self.plan
+        joint_int, joint_geo, dyads, modes, head = self.plan[:5]
         self.status[:] = 0
         self.jump[:] = 0.0
         dyad_solver.place_driver(joint_int, joint_geo, head, self.drive_q, self.poses)
@@ -256,9 +256,9 @@ def _repeat_scan(R, status, measures, out_s, span, far, hmax):  # type: ignore[n
 
 
 @numba.njit(error_model="numpy")
-def _repeat_store(R, block, groups, outs, first, begin, end):  # type: ignore[no-untyped-def]
+def _repeat_store(R, block, offsets, outs, first, begin, end, loose):  # type: ignore[no-untyped-def]
     for _ in range(R):
-        dyad_solver.store_rows(block, groups, outs, first, begin, end)
+        dyad_solver.store_rows(block, offsets, outs, first, begin, end, loose)
 
 
 @numba.njit(error_model="numpy")
@@ -276,7 +276,7 @@ def _repeat_one_rows(R, jac, sigma, tangent, raw_tau):  # type: ignore[no-untype
 def pass_timers(block: Block) -> dict[str, Callable[[int], None]]:
     """Each pass of the block, as ``run(R)``: the pass ``R`` times over the same block data."""
     b = block
-    joint_int, joint_geo, dyads, modes, head = b.plan
+    joint_int, joint_geo, dyads, modes, head, offsets = b.plan
     settings, t0, lo, hi, periodic = b.run
     margin = settings[dyad_solver.S_MIN_MARGIN]
     status = b.status.copy()
@@ -310,7 +310,7 @@ def pass_timers(block: Block) -> dict[str, Callable[[int], None]]:
     rows = (b.sigma, b.tangent, b.raw_tau, b.measures)
     checked = np.zeros(C, dtype=np.int64)
     dyad_solver.check_points(rows, orient, checked, span, b.flat[4][head[0]], h, limits, 0)
-    outs = (np.empty((steps + 1, b.m)), np.empty((steps + 1, b.E)), *(np.empty(steps + 1) for _ in range(3)))
+    outs = (np.empty((steps + 1, b.n)), np.empty((steps + 1, b.E)), *(np.empty(steps + 1) for _ in range(3)))
     timers["drive values"] = lambda R: _repeat_drive_values(
         R, b.drive_q.copy(), first, steps, h, settings[dyad_solver.S_TARGET]
     )
@@ -320,7 +320,7 @@ def pass_timers(block: Block) -> dict[str, Callable[[int], None]]:
     )
     timers["scan"] = lambda R: _repeat_scan(R, checked, b.measures, outs[4], span, 1e9, 1e-3)
     timers["store rows"] = lambda R: _repeat_store(
-        R, (b.q, b.sigma, b.res, orient[1]), b.flat[4], outs, first, 1, B + 1
+        R, (b.q, b.sigma, b.res, orient[1]), offsets, outs, first, 1, B + 1, settings[dyad_solver.S_LOOSE]
     )
     if b.E == 3 and b.m == 4:
         timers["(rows)"] = lambda R: _repeat_one_rows(
@@ -340,11 +340,6 @@ def source_at(rev: str) -> str:
     return subprocess.run(
         ["git", "show", f"{rev}:{SOURCE}"], cwd=ROOT, check=True, capture_output=True, text=True
     ).stdout
-
-
-def same_rows(a: tuple[Any, ...], b: tuple[Any, ...]) -> bool:
-    """Whether two ``closed_form_path`` results are bit-identical."""
-    return bool(a[:2] == b[:2] and all(np.array_equal(x, y) for x, y in zip(a[2:], b[2:], strict=True)))
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -368,11 +363,14 @@ def main(argv: list[str] | None = None) -> None:
             "this tree, rows replayed": lambda: ours.closed_form_path(*call),
         }
         expected = dyad_solver.closed_form_path(*call)
-        checks = {"this tree, rows replayed": same_rows(expected, ours.closed_form_path(*call))}
+        checks = {"this tree, rows replayed": same_rows(expected, ours.closed_form_path(*call), call)}
         if args.against:
             theirs = replayed_copy(source_at(args.against), Path(folder), "theirs", rows)
-            variants[f"{args.against}, rows replayed"] = lambda: theirs.closed_form_path(*call)
-            checks[f"{args.against}, rows replayed"] = same_rows(expected, theirs.closed_form_path(*call))
+            their_call = call_for(theirs, call)
+            variants[f"{args.against}, rows replayed"] = lambda: theirs.closed_form_path(*their_call)
+            checks[f"{args.against}, rows replayed"] = same_rows(
+                expected, theirs.closed_form_path(*their_call), call
+            )
         sig, tan, tau = (x.copy() for x in (block.sigma, block.tangent, block.raw_tau))
         variants["(the replay's copying alone)"] = lambda: ours.replay_all(
             sig, tan, tau, points, dyad_solver.BLOCK

@@ -33,7 +33,7 @@ def kernel_call(mech: Mechanism, turn: float, steps: int) -> tuple[tuple[Any, ..
 def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The positions and closure passes of the kernel on its own arguments: ``(poses, q, jac, res)``."""
     flat, plan, run = args
-    joint_int, joint_geo, dyads, modes, head = plan
+    joint_int, joint_geo, dyads, modes, head, _offsets = plan
     settings = run[0]
     steps = int(settings[dyad_solver.S_STEPS])
     K = steps + 1
@@ -73,18 +73,48 @@ def test_jacobian_and_residual_from_poses_equal_the_closure_at_the_reported_valu
     two of the kernel's blocks: its rows equal these passes over the whole path exactly."""
     mech = CASES[name]()
     steps = 2 * dyad_solver.BLOCK + 7
-    args, (count, status, u, _sigma, out_res, *_rest) = kernel_call(mech, np.radians(350.0), steps)
+    args, (count, status, out_angles, _sigma, out_res, *_rest) = kernel_call(mech, np.radians(350.0), steps)
     assert status == dyad_solver.CLEAN and count == steps + 1
     _poses, q, jac, res = passes(args)
-    groups = args[0][4]
-    assert np.array_equal(q[:, :count].T, u[:count][:, groups])  # the rows are these joint values
+    # the rows are these joint values, plus the reference offsets (numpy's sum)
+    assert np.array_equal(q[:, :count].T + mech.offsets, out_angles[:count])
     assert np.array_equal(res, out_res)
     for k in range(0, count, 5):
-        angles = mech.q_from_u(u[k])
+        angles = q[:, k]
         reference = jacobian(mech, angles)
         assert np.max(np.abs(jac[:, :, k] - reference)) < 1e-13 * max(1.0, np.max(np.abs(reference))), k
         independent = float(np.linalg.norm(closure_residual(mech, angles)))
         assert independent < 1e-13 and abs(res[k] - independent) < 1e-13, k
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_the_full_rank_verdict_is_the_quick_rank_test_of_the_rows(name: str) -> None:
+    """The kernel's last output (every row of full rank) is numpy's quick test :func:`all_full_rank` of its own
+    singular values (every ratio above ``loose``, strictly): True with the default ``loose``, and either side of
+    the path's smallest ratio, where it turns False at that ratio itself (the comparison is strict); the rows
+    themselves do not depend on ``loose``."""
+    from linkwork.kinematics.rank import Tolerances, all_full_rank
+
+    mech = CASES[name]()
+    args, out = kernel_call(mech, np.radians(300.0), 300)
+    assert out[1] == dyad_solver.CLEAN and bool(out[-1])
+    sigma = out[3]
+    smallest = float(np.min(sigma.min(axis=1) / sigma[:, 0]))
+    flat, plan, (settings, *rest) = args
+    for loose, expected in (
+        (1e-5, True),
+        (np.nextafter(smallest, 0.0), True),
+        (smallest, False),
+        (0.5, False),
+    ):
+        tol = Tolerances(floor=min(1e-10, loose), loose=loose)
+        assert all_full_rank(sigma, tol) == expected, loose
+        changed = settings.copy()
+        changed[dyad_solver.S_LOOSE] = loose
+        again = dyad_solver.closed_form_path(flat, plan, (changed, *rest))
+        assert bool(again[-1]) == expected, loose
+        assert again[:2] == out[:2]
+        assert all(np.array_equal(a, b) for a, b in zip(again[2:-1], out[2:-1], strict=True))
 
 
 def test_joint_values_match_the_poses_and_continue_through_turns() -> None:
@@ -112,18 +142,23 @@ def test_a_joint_limit_ends_the_path_at_the_first_row_beyond_it() -> None:
     """With an upper limit on the rocker's joint D inside its range, the kernel stops with LIMIT at exactly the
     first row whose D exceeds it (read from the unlimited run's rows)."""
     mech = lw.load("four-bar")
-    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(300.0), 300)
+    args, (count, status, angles, *_rest) = kernel_call(mech, np.radians(300.0), 300)
     assert status == dyad_solver.CLEAN
-    g = args[0][4][mech.index("D")]
-    limit = 0.5 * (u[:count, g].max() + u[:count, g].min())
+    d = mech.index("D")
+    g = args[0][4][d]
+    u = passes(args)[1][
+        d
+    ]  # the joint's displacements as the kernel computes them (its rows: offsets + these)
+    assert np.array_equal(u + mech.offsets[d], angles[:count, d])
+    limit = 0.5 * (u.max() + u.min())
     settings, t0, lo, hi, periodic = args[2]
     hi = hi.copy()
     hi[g] = limit
     out = dyad_solver.closed_form_path(args[0], args[1], (settings, t0, lo, hi, periodic))
-    expected = int(np.argmax(u[:count, g] > limit))
+    expected = int(np.argmax(u > limit))
     assert expected > 0
     assert out[:2] == (expected, dyad_solver.LIMIT)
-    np.testing.assert_array_equal(out[2][:expected], u[:expected])
+    np.testing.assert_array_equal(out[2][:expected], angles[:expected])
 
 
 def test_a_dyad_without_a_solution_ends_the_path_at_the_first_such_row() -> None:
@@ -148,11 +183,13 @@ def test_a_path_back_at_its_start_ends_closed_where_the_march_would_see_it() -> 
     last) whose distance from the start (angles wrapped, numpy's reading here) is below 1.5 steps after the path
     went farther than 4 maximum steps; that row is stored, the ones before are the path."""
     mech = lw.load("four-bar")
-    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(720.0), 720)
+    args, (count, status, angles, *_rest) = kernel_call(mech, np.radians(720.0), 720)
     assert status == dyad_solver.CLOSED
     settings, periodic = args[2][0], args[2][4]
     h, hmax = settings[dyad_solver.S_STEP], settings[dyad_solver.S_HMAX]
-    rows = u[: count + 1].copy()
+    q = passes(args)[1][:, : count + 1]  # the kernel's displacements (its rows: offsets + these)
+    assert np.array_equal(q.T + mech.offsets, angles[: count + 1])
+    rows = mech.u_from_q(q.T)
     rows[:, periodic] = (rows[:, periodic] + np.pi) % (2.0 * np.pi) - np.pi
     distance = np.linalg.norm(rows, axis=1)
     far = np.maximum.accumulate(distance)
@@ -243,17 +280,18 @@ def test_a_drive_step_of_whole_turns_is_no_jump() -> None:
     """One step of two whole turns brings every body back where it was: the march reads the drive's step wrapped
     (0), so the kernel reaches the target (2 rows) with the crank's value 720 degrees and every other joint at 0."""
     mech = lw.load("four-bar")
-    args, (count, status, u, *_rest) = kernel_call(mech, np.radians(720.0), 1)
+    _args, (count, status, angles, *_rest) = kernel_call(mech, np.radians(720.0), 1)
     assert (count, status) == (2, dyad_solver.CLEAN)
-    g = args[0][4][mech.index("A")]
-    assert abs(u[1, g] - np.radians(720.0)) < 1e-12
-    assert np.max(np.abs(np.delete(u[1], g))) < 1e-12
+    q = angles[1] - mech.offsets
+    a = mech.index("A")
+    assert abs(q[a] - np.radians(720.0)) < 1e-12
+    assert np.max(np.abs(np.delete(q, a))) < 1e-12
 
 
 def block_inputs(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray]:
     """``(rel, q)`` of every point of the kernel's path (as :func:`passes` computes them)."""
     _flat, plan, run = args
-    joint_int, joint_geo, dyads, modes, head = plan
+    joint_int, joint_geo, dyads, modes, head, _offsets = plan
     settings = run[0]
     steps = int(settings[dyad_solver.S_STEPS])
     drive_q = np.append(np.arange(steps) * settings[dyad_solver.S_STEP], settings[dyad_solver.S_TARGET])

@@ -51,7 +51,7 @@ CLEAN, NO_SOLUTION, NEAR_SINGULAR, SIGN_CHANGE, CLOSED, LIMIT, JUMP, UNSUPPORTED
 #: Internal mark of :func:`closed_form_path`'s scan: a clean point near the start, where the path may close.
 NEAR_START = -1
 #: Settings array layout of :func:`closed_form_path`.
-S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_MARGIN = (
+S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_MARGIN, S_LOOSE = (
     0,
     1,
     2,
@@ -60,8 +60,9 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
     5,
     6,
     7,
+    8,
 )
-N_SETTINGS = 8
+N_SETTINGS = 9
 TWO_PI = 2.0 * np.pi
 #: Points per block of :func:`closed_form_path` (a block's arrays stay in the second-level cache).
 BLOCK = 256
@@ -734,16 +735,17 @@ def rows_at_points(jac, sigma, tangent, raw_tau, begin, state):
 
 @kernel(inline="always")
 def zero_tail(count, code, outs):
-    """``(count, code, *outs)`` with every output's rows not written set to zero: those after ``count`` (after
-    ``count + 1`` for :data:`CLOSED`, whose row ``count`` is stored though the path ends before it)."""
-    out_u, out_sigma, out_res, out_tau, out_s = outs
+    """``(count, code, *outs, False)`` with every output's rows not written set to zero: those after ``count``
+    (after ``count + 1`` for :data:`CLOSED`, whose row ``count`` is stored though the path ends before it); the
+    full-rank verdict is left False (a path handed over has no rank to report)."""
+    out_angles, out_sigma, out_res, out_tau, out_s = outs
     tail = count + 1 if code == CLOSED else count
-    out_u[tail:] = 0.0
+    out_angles[tail:] = 0.0
     out_sigma[tail:] = 0.0
     out_res[tail:] = 0.0
     out_tau[tail:] = 0.0
     out_s[tail:] = 0.0
-    return count, code, out_u, out_sigma, out_res, out_tau, out_s
+    return count, code, out_angles, out_sigma, out_res, out_tau, out_s, False
 
 
 @kernel(error_model="numpy")
@@ -753,10 +755,14 @@ def closed_form_path(flat, plan, run):
     ``flat = (twists, loop_joint, loop_sign, loop_ptr, groups)``: the closure arrays (every joint its own
     unknown). ``plan = (joint_int (n, 3): kind, before body, after body; joint_geo (n, 3): revolute point and
     omega_z, or prismatic direction; dyads (k, 7): j1, j2, j3, K1, B1, B2, K2; modes (k,); head: drive joint,
-    driven body, number of bodies)``. ``run = (settings (N_SETTINGS,), t0 (m,), lo (m,), hi (m,), periodic (m,))``.
+    driven body, number of bodies; offsets (n,): every joint's value at the reference)``. ``run = (settings
+    (N_SETTINGS,), t0 (m,), lo (m,), hi (m,), periodic (m,))``.
 
-    Returns ``(count, status, u, sigma, res, tau, s)``: rows ``0 .. count - 1`` (row 0 the start), status
-    :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
+    Returns ``(count, status, angles, sigma, res, tau, s, full_rank)``: rows ``0 .. count - 1`` (row 0 the start),
+    status :data:`CLEAN` when the target was reached, otherwise why the closed form gave up at row ``count``.
+    ``angles (N, n)`` are the joint values (``offsets + q``, joint order: the trace's angles, what numpy's ``u[:,
+    groups] + offsets`` gives); ``full_rank`` whether every row of ``sigma`` passes
+    :func:`~linkwork.kinematics.kernels.every_row_full_rank` with ``settings[S_LOOSE]`` (False unless CLEAN).
 
     Passes over all points, each array indexed by the point last (structure of arrays), each pass a loop over
     the points with straight-line bodies that vectorise: the drive's poses, each dyad's two bodies, every joint's
@@ -770,7 +776,7 @@ def closed_form_path(flat, plan, run):
     first); those after the count are zeroed on an early return.
     """
     groups = flat[4]
-    joint_int, joint_geo, dyads, modes, head = plan
+    joint_int, joint_geo, dyads, modes, head, offsets = plan
     settings, t0, lo, hi, periodic = run
     n = joint_int.shape[0]
     m = t0.shape[0]
@@ -778,16 +784,17 @@ def closed_form_path(flat, plan, run):
     steps = int(settings[S_STEPS])
     h, target, hmax = settings[S_STEP], settings[S_TARGET], settings[S_HMAX]
     min_ratio, min_drive, min_margin = settings[S_MIN_RATIO], settings[S_MIN_DRIVE], settings[S_MIN_MARGIN]
-    det_basis = settings[S_DET_BASIS]
+    det_basis, loose = settings[S_DET_BASIS], settings[S_LOOSE]
     drive = head[0]
     g_drive = groups[drive]
     # Not zero-filled: every row up to the count is written; the rows after it are zeroed on return.
-    out_u = np.empty((steps + 1, m))
+    out_angles = np.empty((steps + 1, n))
     out_sigma = np.empty((steps + 1, E))
     out_res = np.empty(steps + 1)
     out_tau = np.empty(steps + 1)
     out_s = np.empty(steps + 1)
-    outs = (out_u, out_sigma, out_res, out_tau, out_s)
+    outs = (out_angles, out_sigma, out_res, out_tau, out_s)
+    full_rank = E > 0  # every stored row's ratios above loose (kernels.every_row_full_rank), so far
     # A block's arrays: column i is point first - 1 + i; column 0 the block before's last point (the start for
     # the first block), columns 1 .. BLOCK this block's points (past the last point: harmless extrapolation).
     C = BLOCK + 1
@@ -841,7 +848,8 @@ def closed_form_path(flat, plan, run):
             g_drive, h, limits, flipped,
         )  # fmt: skip
         stop, code, far = scan_points(status, measures, out_s, (first, begin, size, steps), far, hmax, ended)
-        store_rows((q, sigma, res, taus), groups, outs, first, begin, stop + 1 if code == CLOSED else stop)
+        end = stop + 1 if code == CLOSED else stop
+        full_rank &= store_rows((q, sigma, res, taus), offsets, outs, first, begin, end, loose)
         if stop <= size:
             return zero_tail(first - 1 + stop, code, outs)
         if ended != CLEAN:
@@ -854,7 +862,7 @@ def closed_form_path(flat, plan, run):
         sigma[:, 0] = sigma[:, BLOCK]
         tangent[:, 0] = tangent[:, BLOCK]
         raw_tau[0] = raw_tau[BLOCK]
-    return steps + 1, CLEAN, out_u, out_sigma, out_res, out_tau, out_s
+    return steps + 1, CLEAN, out_angles, out_sigma, out_res, out_tau, out_s, full_rank
 
 
 @kernel(inline="always")
@@ -974,35 +982,51 @@ def scan_points(status, measures, out_s, span, far, hmax, ended):
 
 
 @kernel(inline="always")
-def store_rows(block, groups, outs, first, begin, end):
+def store_rows(block, offsets, outs, first, begin, end, loose):
     """The block's rows ``begin .. end - 1`` into the outputs at rows ``first - 1 + i``: ``block = (q, sigma, res,
-    taus)``, ``outs = (out_u, out_sigma, out_res, out_tau, out_s)`` (the arclength is written by the scan). Row by
-    row (each output row's entries side by side in memory), the block's arrays read along their columns; for the
-    usual sizes (one loop of four joints, two of seven) with the sizes as literal constants, so that the loops
-    over a row unroll."""
+    taus)``, ``outs = (out_angles, out_sigma, out_res, out_tau, out_s)`` (the arclength is written by the scan),
+    each joint's value ``q + offsets`` (what the trace reports); returns whether each of these rows passes the
+    full-rank test of :func:`~linkwork.kinematics.kernels.every_row_full_rank` with ``loose``.
+
+    Row by row (each output row's entries side by side in memory; the block's arrays, read along their columns,
+    stay in the first-level cache), on slices of the block and of the outputs that start at 0; for the usual
+    sizes (one loop of four joints, two of seven) with the sizes as literal constants, so that the loops over a
+    row unroll. (Column by column, one output column at a time, costs three times as much.)"""
     n, E = block[0].shape[0], block[1].shape[0]
     if n == 4 and E == 3:
-        store_sized(block, groups, outs, first, begin, end, 4, 3)
-    elif n == 7 and E == 6:
-        store_sized(block, groups, outs, first, begin, end, 7, 6)
-    else:
-        store_sized(block, groups, outs, first, begin, end, n, E)
+        return store_sized(block, offsets, outs, first, begin, end, loose, 4, 3)
+    if n == 7 and E == 6:
+        return store_sized(block, offsets, outs, first, begin, end, loose, 7, 6)
+    return store_sized(block, offsets, outs, first, begin, end, loose, n, E)
 
 
 @kernel(inline="always")
-def store_sized(block, groups, outs, first, begin, end, n, E):
+def store_sized(block, offsets, outs, first, begin, end, loose, n, E):
     """:func:`store_rows` with ``n`` joints and ``E`` singular values (literal constants where it is called)."""
     q, sigma, res, taus = block
-    out_u, out_sigma, out_res, out_tau, _out_s = outs
-    for i in range(begin, end):
-        row = first - 1 + i
+    out_angles, out_sigma, out_res, out_tau, _out_s = outs
+    lo, hi = first - 1 + begin, first - 1 + end
+    angles, values = out_angles[lo:hi], out_sigma[lo:hi]
+    q_rows, sigma_rows = q[:, begin:end], sigma[:, begin:end]
+    for i in range(end - begin):
         for j in range(n):
-            out_u[row, groups[j]] = q[j, i]
+            angles[i, j] = q_rows[j, i] + offsets[j]
         for e in range(E):
-            out_sigma[row, e] = sigma[e, i]
-    for i in range(begin, end):
-        out_res[first - 1 + i] = res[i]
-        out_tau[first - 1 + i] = taus[i]
+            values[i, e] = sigma_rows[e, i]
+    out_res[lo:hi] = res[begin:end]
+    out_tau[lo:hi] = taus[begin:end]
+    # every_row_full_rank's test on these rows, the same comparisons (vectorised: no early exit)
+    failing = False
+    for i in range(end - begin):
+        top = sigma_rows[0, i]
+        low = top
+        odd = False
+        for e in range(1, E):
+            x = sigma_rows[e, i]
+            odd |= x != x
+            low = x if x < low else low
+        failing |= not ((not odd) & (top > 0.0) & (low / top > loose))
+    return not failing
 
 
 @kernel(inline="always", error_model="numpy")

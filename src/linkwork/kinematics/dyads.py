@@ -16,6 +16,7 @@ import math
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,6 +29,7 @@ from linkwork.kinematics.dyad_solver import (
     REVOLUTE,
     S_DET_BASIS,
     S_HMAX,
+    S_LOOSE,
     S_MIN_DRIVE,
     S_MIN_MARGIN,
     S_MIN_RATIO,
@@ -35,7 +37,7 @@ from linkwork.kinematics.dyad_solver import (
     S_STEPS,
     S_TARGET,
 )
-from linkwork.kinematics.marcher import MarchSettings, Rows
+from linkwork.kinematics.marcher import MarchSettings
 from linkwork.kinematics.mechanism import PLANAR_ROWS, Mechanism
 
 Array = NDArray[np.float64]
@@ -61,7 +63,8 @@ class DyadPlan:
     unit direction and 0; ``dyads (k, 7)``: ``j1, j2, j3, K1, B1, B2, K2`` (joint ``j1`` from placed body ``K1``
     to ``B1``, ``j2`` between ``B1`` and ``B2``, ``j3`` from ``B2`` to placed ``K2``) in solving order; ``modes
     (k,)`` the sign picking each dyad's assembly mode of the start; ``head``: the drive joint, the body it moves
-    and the number of bodies.
+    and the number of bodies; ``offsets (n,)`` every joint's value at the reference (the solver reports
+    ``offsets + q``).
     """
 
     joint_int: IntArray
@@ -69,10 +72,11 @@ class DyadPlan:
     dyads: IntArray
     modes: Array
     head: IntArray
+    offsets: Array
 
-    def arrays(self) -> tuple[IntArray, Array, IntArray, Array, IntArray]:
+    def arrays(self) -> tuple[IntArray, Array, IntArray, Array, IntArray, Array]:
         """The plan tuple of :func:`~linkwork.kinematics.dyad_solver.closed_form_path`."""
-        return self.joint_int, self.joint_geo, self.dyads, self.modes, self.head
+        return self.joint_int, self.joint_geo, self.dyads, self.modes, self.head, self.offsets
 
 
 def joint_geometry(mech: Mechanism) -> tuple[IntArray, Array] | None:
@@ -140,6 +144,7 @@ def dyad_plan(mech: Mechanism, drive: int) -> DyadPlan | None:
         dyads=np.array(dyads, dtype=np.int64).reshape(len(dyads), 7),
         modes=np.array(modes, dtype=float),
         head=np.array([drive, driven, len(names)], dtype=np.int64),
+        offsets=np.array(mech.offsets, dtype=float),
     )
 
 
@@ -203,6 +208,25 @@ def _basis_sign(mech: Mechanism, basis: Array) -> float:
     )
 
 
+class ClosedFormRows(NamedTuple):
+    """The rows of a paper-mode path that :func:`closed_form_rows` solved, one per point (row 0 the start): the
+    compiled solver's own arrays, each C-contiguous and writeable, handed to the ``Trace`` without copies (a named
+    tuple: built once a trace, in a third of a frozen dataclass's time).
+
+    ``angles (N, n)`` the joint values (joint order, reference offsets included), ``sigma (N, k)`` the singular
+    values (descending), ``residual``, ``test`` (the signed test function), ``arclength`` ``(N,)``;
+    ``full_rank``: every row has its full rank ``k`` by the quick test of
+    :func:`linkwork.kinematics.rank.all_full_rank` (False: the caller counts the ranks row by row).
+    """
+
+    angles: Array
+    sigma: Array
+    residual: Array
+    test: Array
+    arclength: Array
+    full_rank: bool
+
+
 def closed_form_rows(
     mech: Mechanism,
     kernels: object,
@@ -211,7 +235,7 @@ def closed_form_rows(
     steps: int,
     t0: Array,
     basis: Array,
-) -> Rows | None:
+) -> ClosedFormRows | None:
     """The rows of a paper-mode trace (``steps`` equal steps of joint ``drive`` to ``settings.target``) in closed
     form, or ``None`` when the predictor-corrector must trace it (see the module's docstring).
 
@@ -228,32 +252,30 @@ def closed_form_rows(
     plan = mech.derived(("dyad plan", drive), lambda: _frozen_plan(mech, drive))
     if plan is None:
         return None
+    tol = settings.tol
     values = [0.0] * N_SETTINGS
     values[S_STEP] = settings.target / steps
     values[S_TARGET] = settings.target
     values[S_STEPS] = steps
     values[S_HMAX] = settings.max_step
     values[S_DET_BASIS] = _basis_sign(mech, basis)
-    values[S_MIN_RATIO] = settings.tol.local_min
+    values[S_MIN_RATIO] = tol.local_min
     values[S_MIN_DRIVE] = MIN_DRIVE
     values[S_MIN_MARGIN] = MIN_MARGIN
+    values[S_LOOSE] = tol.loose
     run = np.array(values, dtype=float)
     twists, lj, ls, lp, _, groups = mech.kernel_arrays
     flat = (twists, lj, ls, lp, groups)
     periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)
-    count, status, u, sigma, res, tau, s = dyad_solver.closed_form_path(
+    _count, status, angles, sigma, res, tau, s, full_rank = dyad_solver.closed_form_path(
         flat,
         plan.arrays(),
         (run, np.ascontiguousarray(t0, dtype=float), settings.lo, settings.hi, periodic),
     )
     if status != CLEAN:
         return None
-    return Rows(
-        u=[u],
-        sigma=[sigma[:, : settings.n_sigma]],
-        res=[res],
-        tau=[tau],
-        s=[s],
-        branch=[np.zeros(count, dtype=np.int64)],
-        step=[np.arange(count, dtype=np.int64)],
-    )
+    k = settings.n_sigma
+    if k != sigma.shape[1]:  # (the path's rank is the number of equations: never taken)
+        sigma, full_rank = np.ascontiguousarray(sigma[:, :k]), False
+    # The kernel's test holds every row to rank k; numerical_rank agrees with a floor at or below loose.
+    return ClosedFormRows(angles, sigma, res, tau, s, bool(full_rank) and tol.floor <= tol.loose)

@@ -13,18 +13,17 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
 from linkwork.kinematics import kernels
-from linkwork.kinematics.dyads import closed_form_rows
+from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
-from linkwork.kinematics.marcher import BranchMarcher, MarchSettings, Rows
+from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
-from linkwork.kinematics.rank import DEFAULT, Tolerances, all_full_rank, numerical_rank, numerical_ranks
+from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_result import Branch, Trace
 from linkwork.kinematics.trace_stats import TraceStats
@@ -306,7 +305,7 @@ def _assemble(
 def _closed_form_trace(
     mech: Mechanism,
     d_joint: int,
-    rows: Rows,
+    rows: ClosedFormRows,
     steps: int,
     settings: MarchSettings,
     started: float,
@@ -315,27 +314,23 @@ def _closed_form_trace(
 ) -> Trace:
     """The :class:`Trace` of a paper-mode path the closed form gave: what :func:`_assemble` makes of one branch
     of ``steps`` steps ending on the target, with no point, fold or misfit besides its rows, built without a
-    marcher and without copying the rows (each is one block, the closed form's own arrays). With the compiled
-    ``backend``, the joint values and the rank check are one compiled pass each over the rows."""
-    compiled = backend.compiled
+    marcher and without copying the rows (the closed form's own arrays: its joint values and its verdict on the
+    ranks come from the compiled solver's pass that stores the rows)."""
     tol = settings.tol
-    U, sigma, residual = _joined(rows.u), _joined(rows.sigma), _joined(rows.res)
+    sigma, residual = rows.sigma, rows.residual
     m = mech.n_unknowns
-    if len(rows.rank) == len(rows.sigma):
-        ranks = _joined(rows.rank)
-        mobility = _branch_mobility(m - ranks)
-    elif _every_row_full_rank(sigma, tol, compiled):  # usual: the closed form keeps off singular points
-        ranks = np.full(len(sigma), sigma.shape[1], dtype=np.int64)
+    count = len(sigma)
+    if rows.full_rank:  # usual: the closed form keeps off singular points
+        ranks = np.empty(count, dtype=np.int64)
+        ranks.fill(sigma.shape[1])  # (np.full's Python wrapper costs half as much again)
         mobility = m - sigma.shape[1]  # _branch_mobility of a constant
     else:
-        ranks = numerical_ranks(sigma, tol, compiled)
+        ranks = numerical_ranks(sigma, tol, backend.compiled)
         mobility = _branch_mobility(m - ranks)
-    g = settings.drive
-    j = mech.first_joints[g]  # as BranchMarcher.end reports the drive at the last point
-    end_value = float(U[-1][g] + mech.offsets[j])
+    j = mech.first_joints[settings.drive]  # as BranchMarcher.end reports the drive at the last point
     branch = Branch(
         0, None, None, 1, steps, StopReason.TARGET.text, mobility=mobility,
-        end_kind=StopReason.TARGET, end_joint=mech.joint_names[j], end_value=end_value,
+        end_kind=StopReason.TARGET, end_joint=mech.joint_names[j], end_value=float(rows.angles[-1, j]),
     )  # fmt: skip
     stats = TraceStats(
         start_rank=settings.r_path,
@@ -344,37 +339,24 @@ def _closed_form_trace(
         closure_tol=tol.closure,
         max_misfit=float(max(0.0, float(residual.max()))),
         has_target=until is not None,
-        points=len(U),
+        points=count,
         seconds=time.perf_counter() - started,
     )
     return Trace(
         mechanism=mech,
         drive=mech.joint_names[d_joint],
-        angles=_angles(mech, U, compiled),
+        angles=rows.angles,
         sigma=sigma,
         residual=residual,
-        branch=_joined(rows.branch),
-        step=_joined(rows.step),
-        arclength=_joined(rows.s),
-        test=_joined(rows.tau),
+        branch=np.zeros(count, dtype=np.int64),
+        step=np.arange(count, dtype=np.int64),
+        arclength=rows.arclength,
+        test=rows.test,
         rank=ranks,
         bifurcations=(),
         branches=(branch,),
         stats=stats,
     )
-
-
-def _joined(blocks: list[Array] | list[NDArray[np.int64]]) -> Any:
-    """The rows of ``blocks`` as one array: the block itself when there is one."""
-    return blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
-
-
-def _every_row_full_rank(sigma: Array, tol: Tolerances, compiled: bool) -> bool:
-    """True when every row of ``sigma`` has its full rank by the quick test of :func:`all_full_rank` (``compiled``:
-    in one compiled pass); False leaves the ranks to :func:`numerical_ranks`."""
-    if compiled:
-        return tol.floor <= tol.loose and bool(kernels.every_row_full_rank(sigma, tol.loose))
-    return all_full_rank(sigma, tol)
 
 
 def _angles(mech: Mechanism, U: Array, compiled: bool = False) -> Array:
