@@ -1,6 +1,7 @@
 """Writes ``src/linkwork/kinematics/bidiagonal_7x6.py``: the Householder bidiagonalisation of ``7 x 6`` matrices
 (``J^T`` of a two-loop planar Jacobian) and the tangent ``U e_7``, unrolled into straight-line code over one loop of
-points, each point's 42 entries in local variables.
+points, each point's 42 entries in local variables, two points (``p`` and ``p + HALF``) per iteration with their
+statements interleaved.
 
 The statements are those of the lane loops they replace (``bidiagonal_rows.chunk_reflect`` / ``chunk_apply`` /
 ``chunk_bidiagonal`` / ``chunk_tangent`` before), written out with every index a literal: the same reflections, the
@@ -13,6 +14,7 @@ Run: ``python tools/generate_bidiagonal_7x6.py`` (``--check``: exit 1 if the mod
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
@@ -26,7 +28,11 @@ not edit by hand; a test checks that this file is its output).
 :func:`reduce_points` is one loop over the points whose body is the whole reduction written out, each point's 42
 entries in local variables: LLVM keeps them in registers (or the stack, never a streamed array) and vectorises the
 loop across points (the rows of ``B`` are :data:`CHUNK` apart, a constant, so that the stores provably do not meet
-the loads of later points). The arithmetic is that of Golub & Van Loan Alg. 5.4.2 as
+the loads of later points). One point's reduction is a chain of dependent operations (each reflection's sum of
+squares, square root and division waits for the one before), so its latency, not its arithmetic, bounds the time:
+each iteration reduces two points, ``p`` and ``p + HALF``, their statements interleaved, two independent chains
+that the processor overlaps (on the Watt six-bar's Jacobians, 83-90 ns a point with one chain, 63-68 with two;
+four chains spill too much and take 300). Each point's arithmetic is unchanged. The arithmetic is that of Golub & Van Loan Alg. 5.4.2 as
 :mod:`linkwork.kinematics.bidiagonal_rows` explains it: for each column ``k`` a reflection from the left zeroes
 ``M[k+1:, k]`` (``alpha = -sign(x) |v|``, ``v = x - alpha e_1``, ``beta = 1 / (|x| (|x| + |x_1|))``, the identity
 for a zero vector), applied to the columns right of ``k`` as ``y -= beta (v . y) v``; then one from the right
@@ -51,6 +57,8 @@ from linkwork.kernel_cache import kernel
 CHUNK = 256
 """Points reduced together, the length of each row of ``B`` (a multiple of the lanes of the roots, 16; about
 60 kB of rows for ``7 x 6``)."""
+HALF = CHUNK // 2
+"""Each iteration reduces points ``p`` and ``p + HALF``."""
 FLOOR = 1e-300
 """A reflection whose ``|v|^2 / 2`` is below this is the identity (its factor is 0)."""
 D = 42
@@ -71,8 +79,10 @@ def reduce_points(B, n):
     """Reduces the ``n`` (``<= CHUNK``) matrices ``J^T`` (``7 x 6``) of ``B`` (flat, ``ROWS x CHUNK``: row ``r``
     of point ``p`` at ``B[r * CHUNK + p]``) to upper bidiagonal form by Householder reflections from the left and
     the right (Golub & Van Loan Alg. 5.4.2), writing the diagonal, the superdiagonal, ``det(U) det(V)`` (``-1``
-    for each reflection made) and the unit tangent ``U e_7`` into rows ``D ..``; rows ``0 .. 41`` are read only."""
-    for p in range(n):
+    for each reflection made) and the unit tangent ``U e_7`` into rows ``D ..``; rows ``0 .. 41`` are read only.
+    Points ``n .. 2 HALF - 1`` (``n .. n + HALF - 1`` when ``n < HALF``) are reduced too, from whatever finite or
+    NaN values their rows hold, and their results ignored: no division or square root can raise."""
+    for p in range(min(n, HALF)):
 '''
 
 
@@ -160,9 +170,31 @@ def body() -> list[str]:
     return w.lines
 
 
+LOCALS = re.compile(r"\b(m\d\d|hl\d|bl\d|hr\d|br\d|t\d|acc|norm|alpha|vv|sign|dot)\b")
+"""The loop body's local variables (renamed for each of the two points of an iteration)."""
+
+
+def point(line: str, suffix: str, offset: str) -> str:
+    """``line`` of the body for one of an iteration's points: its locals suffixed, its index ``p`` moved by
+    ``offset`` (a trailing comment kept on the first point's line only)."""
+    code, mark, comment = line.partition("  # ")
+    code = LOCALS.sub(lambda found: found.group(1) + suffix, code).replace(" + p]", f" + p{offset}]")
+    return code + mark + comment if suffix == "_a" else code
+
+
+def interleaved(lines: list[str]) -> list[str]:
+    """The body for points ``p`` (suffix ``_a``) and ``p + HALF`` (``_b``), statement after statement."""
+    out = []
+    for line in lines:
+        out.append(point(line, "_a", ""))
+        if not line.strip().startswith("#"):
+            out.append(point(line, "_b", " + HALF"))
+    return out
+
+
 def source() -> str:
     """The module's text."""
-    return HEADER + "\n".join(body()) + "\n"
+    return HEADER + "\n".join(interleaved(body())) + "\n"
 
 
 def main() -> None:

@@ -44,11 +44,11 @@ def check_rows(J: np.ndarray, kernel=multi_loop_rows) -> int:  # type: ignore[no
     return count
 
 
-def with_singular_values(s: np.ndarray, K: int = 64) -> np.ndarray:
-    """``K`` Jacobians ``U diag(s) V^T`` with random orthogonal ``U (E, E)``, ``V (E + 1, E + 1)``."""
+def with_singular_values(s: np.ndarray, K: int = 64, rng: np.random.Generator = RNG) -> np.ndarray:
+    """``K`` Jacobians ``U diag(s) V^T`` with random orthogonal ``U (E, E)``, ``V (E + 1, E + 1)`` (from ``rng``)."""
     E = len(s)
-    U = np.linalg.qr(RNG.normal(size=(K, E, E)))[0]
-    V = np.linalg.qr(RNG.normal(size=(K, E + 1, E + 1)))[0]
+    U = np.linalg.qr(rng.normal(size=(K, E, E)))[0]
+    V = np.linalg.qr(rng.normal(size=(K, E + 1, E + 1)))[0]
     S = np.zeros((K, E, E + 1))
     S[:, range(E), range(E)] = s
     return U @ S @ V.transpose(0, 2, 1)
@@ -143,16 +143,22 @@ def test_plain_python_twin_keeps_the_contract() -> None:
 
 
 def test_lanes_not_certified_fall_back_and_are_right() -> None:
-    """Cases built to fail the certification: equal singular values (the roots' intervals overlap), one double pair
-    among distinct ones (the same), a fifth singular value 1e-7 sigma_1 (``d sigma = d lambda / sigma`` exceeds the
-    budget): every point falls back to the exact routine (counted once, also where a group is padded with
-    repeats of the first point), and the rows keep the contract."""
-    for values in [
-        (1.0, 1.0, 1.0, 1.0, 1.0, 1.0),
-        (1.0, 0.7, 0.5, 0.5, 0.3, 0.1),
-        (1.0, 0.8, 0.6, 0.4, 1e-7, 1e-8),
+    """Cases built to fail the certification: equal singular values (the roots' intervals overlap), a fifth
+    singular value 1e-7 sigma_1 (``d sigma = d lambda / sigma`` exceeds the budget): every point falls back to the
+    exact routine (counted once, also where a group is padded with repeats of the first point), and the rows keep
+    the contract. One double pair among distinct ones: nearly every point falls back; the reduction's rounding
+    splits the pair of the ``B`` it computes by a few ulps, and where the split is wider than the roots' bounds
+    the lane is certified, rightly (``B``'s roots are distinct; the contract holds), which happens at a point or
+    two in one draw of ten (hence no module-wide generator here: the draws would depend on the tests run
+    before)."""
+    rng = np.random.default_rng(20261127)
+    for values, at_least in [
+        ((1.0, 1.0, 1.0, 1.0, 1.0, 1.0), 20),
+        ((1.0, 0.8, 0.6, 0.4, 1e-7, 1e-8), 20),
+        ((1.0, 0.7, 0.5, 0.5, 0.3, 0.1), 17),
     ]:
-        assert check_rows(with_singular_values(np.array(values), 20)) == 20  # 2 groups, one padded
+        J = with_singular_values(np.array(values), 20, rng)  # 2 groups, one padded
+        assert at_least <= check_rows(J) <= 20
 
 
 def test_certified_lanes_are_most_and_right() -> None:
