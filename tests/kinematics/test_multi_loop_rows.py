@@ -13,7 +13,7 @@ from bookkeeping_reference import stephenson_six_bar
 from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
-from linkwork.kinematics.bidiagonal_rows import HISTORY
+from linkwork.kinematics.bidiagonal_rows import HISTORY, history_size
 from linkwork.kinematics.closure import jacobian
 from linkwork.kinematics.jit import python_twin
 from linkwork.kinematics.mechanism import Mechanism
@@ -184,7 +184,7 @@ def test_a_wrong_warm_start_is_caught() -> None:
     for previous, points_set in cases:
         state = multi_loop_state(6)
         state[: HISTORY * 5 * 16] = previous.ravel()
-        state[HISTORY * 5 * 16 :] = points_set
+        state[HISTORY * 5 * 16 : history_size(6)] = points_set
         K = len(J)
         sigma, tangent, tau = np.empty((6, K)), np.empty((7, K)), np.empty(K)
         assert multi_loop_rows(jac, sigma, tangent, tau, 0, state) == 0

@@ -165,11 +165,23 @@ def work_rows(m, E):
     )
 
 
+@kernel(inline="always")
+def history_size(E):
+    """The doubles of a lane's warm start in the state: :data:`HISTORY` points' roots (``E - 1`` rows of
+    :data:`LANES` each) and the row of how many are set."""
+    return (HISTORY * (E - 1) + 1) * LANES
+
+
 @kernel()
 def bidiagonal_state(E):
-    """The warm start carried along a path: each lane's roots at its last :data:`HISTORY` points (``E - 1`` rows
-    of ``LANES`` each, the last point's first) and how many of them are set (one row; fresh: none)."""
-    return np.zeros((HISTORY * (E - 1) + 1) * LANES)
+    """What :func:`bidiagonal_rows` carries along a path, zeros at the start: first the warm start, each lane's
+    roots at its last :data:`HISTORY` points (``E - 1`` rows of ``LANES`` each, the last point's first) and how
+    many of them are set (one row; fresh: none), :func:`history_size` doubles; then the lanes' work rows
+    (:func:`work_rows`) and the chunk's array of the reduction
+    (:data:`~linkwork.kinematics.bidiagonal_7x6.ROWS` ``x CHUNK``), kept from call to call so that they are
+    allocated and zeroed once a path rather than once a block of points (zeroing the chunk's 125 kB took about
+    5 ns a point)."""
+    return np.zeros(history_size(E) + work_rows(E + 1, E)[-1] * LANES + bidiagonal_7x6.ROWS * CHUNK)
 
 
 @kernel(inline="always")
@@ -506,10 +518,11 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
     K = jac.shape[2]
     _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _, PREV, _, total = work_rows(m, E)
     L = LANES
-    S = np.zeros(total * L)
-    for i in range(state.shape[0]):
+    kept = history_size(E)
+    S = state[kept : kept + total * L]  # the state's work rows and chunk (bidiagonal_state): no allocation
+    B = state[kept + total * L : kept + total * L + bidiagonal_7x6.ROWS * CHUNK]
+    for i in range(kept):
         S[PREV * L + i] = state[i]
-    B = np.zeros(bidiagonal_7x6.ROWS * CHUNK)
     fallback = (
         np.empty((E, m)),
         np.empty((m, m)),
@@ -538,7 +551,7 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
                 tangent[a, points[p]] = B[row + p]
         for g in range(n // L):
             count += lanes_at(jac, sigma, raw_tau, points[g * L : (g + 1) * L], S, B, g * L, fallback, m, E)
-    for i in range(state.shape[0]):
+    for i in range(kept):
         state[i] = S[PREV * L + i]
     return count
 
