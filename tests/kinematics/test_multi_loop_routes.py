@@ -11,12 +11,17 @@ from bookkeeping_reference import planar_four_bar
 from closed_form_probe import assert_rows_contract
 
 import linkwork as lw
+from linkwork.kinematics import bidiagonal_7x6
+from linkwork.kinematics.bidiagonal_7x6 import CHUNK
 from linkwork.kinematics.bidiagonal_rows import (
     HISTORY,
+    LANES,
     bidiagonal_rows,
     bidiagonal_state,
     certifiable,
+    history_size,
     takes_bidiagonal,
+    work_rows,
 )
 from linkwork.kinematics.closure import jacobian
 from linkwork.kinematics.mechanism import Mechanism
@@ -75,7 +80,11 @@ def test_routes_by_size() -> None:
     jac = np.zeros((9, 10, 20))
     with pytest.raises(ValueError, match="6 x 7"):
         bidiagonal_rows(jac, np.zeros((9, 20)), np.zeros((10, 20)), np.zeros(20), 0, bidiagonal_state(9))
-    assert multi_loop_state(6).shape == ((HISTORY * 5 + 1) * 16,)  # the roots at four points, how many set
+    # the roots at four points and how many are set, then the lanes' work rows and the chunk of the reduction
+    work = work_rows(7, 6)[-1] * LANES + bidiagonal_7x6.ROWS * CHUNK
+    assert history_size(6) == (HISTORY * 5 + 1) * 16
+    assert multi_loop_state(6).shape == (history_size(6) + work,)
+    assert not multi_loop_state(6).any()
     for E in (9, 12):
         np.testing.assert_array_equal(multi_loop_state(E), jacobi_loop_state(E))
 
