@@ -23,6 +23,8 @@ from types import FrameType
 
 import pytest
 from cli_cases import (
+    REFUSED_OUTS,
+    REFUSED_PATHS,
     SLOW,
     Case,
     cases,
@@ -134,6 +136,40 @@ def test_a_generated_hostile_case_keeps_every_promise(home: Path, case: Case) ->
     if run.code in (0, 3):
         for file in _outputs(out):
             assert_finite(file)
+
+
+def _refused_path_cases() -> list[Case]:
+    """Every path of every command (an input file or folder, ``--out``) with each path the file system refuses:
+    a name too long, a path through a file, a FIFO."""
+    out = []
+    for param in parameters():
+        if param.key == "--out":
+            kinds = REFUSED_OUTS
+        elif param.kind == "path" or (valid(param) or "").startswith("{") or param.key == "spec":
+            kinds = REFUSED_PATHS
+        else:
+            continue
+        out += [Case(param.command, param.key, kind, refused_before_work=True) for kind in kinds]
+    return out
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, id=c.id) for c in _refused_path_cases()])
+def test_a_path_the_file_system_refuses_is_bad_input_in_one_line(home: Path, case: Case) -> None:
+    """A path no file can be read from or written to (a name longer than 255 bytes, a path through a file, a
+    FIFO) is bad input: exit 2 before any work, one line naming the path (or its flag), never the ``OSError``
+    of the first function that touched it (which was exit 3, without saying what was expected) or a hang."""
+    args, out = command_line(case, home, FIXTURES)
+    previous = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(60)  # a FIFO opened for reading blocks until a writer comes: a hang is a failure
+    try:
+        run = run_cli(args, out=out, home=home)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert run.code == 2, (case.id, run.stderr)
+    assert ".linkwork-" not in run.stderr and "Errno" not in run.stderr, (
+        run.stderr
+    )  # the user's path, in words
 
 
 def _outputs(out: Path) -> list[Path]:

@@ -1,12 +1,14 @@
 """What every command shares: turning linkwork errors into one clear line and exit code 2 or 3, quietly.
 
 A command decorated with :func:`friendly_errors` runs with numpy's floating-point warnings and Python's
-``RuntimeWarning``\\ s silenced, so that the one ``error:`` line is the only line on stderr when it fails.
+``RuntimeWarning``\\ s silenced, and any other warning shown as one ``note:`` line, so that the one ``error:``
+line is the only error on stderr when it fails and no source line is ever printed.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import math
 import signal
 import warnings
@@ -53,6 +55,22 @@ def fail(message: str, code: int = 2) -> typer.Exit:
     return typer.Exit(code=code)
 
 
+def warning_note(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """Show a warning met while a command runs (one of matplotlib's, a deprecation) as one ``note:`` line on
+    stderr, like the kernel announcements: never Python's two lines with a source file and its code."""
+    text = escape_line(str(message))
+    if len(text) > MAX_MESSAGE_CHARS:
+        text = text[: MAX_MESSAGE_CHARS - 3] + "..."
+    err_console.print(Text(f"note: {text}"), highlight=False, soft_wrap=True)
+
+
 def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
     """Decorate a command so that a :class:`LinkworkError` becomes one line on stderr and exit code 2, or 3 for a
     :class:`RequestNotMetError`; numeric warnings are silenced while it runs."""
@@ -64,6 +82,7 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
         try:
             with warnings.catch_warnings(), np.errstate(all="ignore"):
                 warnings.simplefilter("ignore", RuntimeWarning)
+                warnings.showwarning = warning_note  # restored by catch_warnings
                 return func(*args, **kwargs)
         except RequestNotMetError as exc:
             raise fail(str(exc), code=3) from None
@@ -71,9 +90,9 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(str(exc)) from None
         except RecursionError:
             raise fail("the input is nested too deeply to be processed") from None
-        except OSError as exc:  # the file system refused (a read-only or full disk, a vanished folder)
-            where = f"{exc.filename}: " if exc.filename else ""
-            raise fail(f"{where}{exc.strerror or exc}", code=3) from None
+        except OSError as exc:  # the file system refused, outside the readers and the writer's own checks
+            message, code = os_error_line(exc)
+            raise fail(message, code=code) from None
         except MemoryError:
             raise fail("ran out of memory; the request is too large for this machine", code=3) from None
         except KeyboardInterrupt:  # Ctrl-C outside a study's run (which keeps its results itself)
@@ -87,6 +106,31 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(f"interrupted twice ({exc}); stopped at once", code=code) from None
 
     return wrapper
+
+
+_PATH_EXPECTED = {
+    errno.ENAMETOOLONG: "expected a shorter path (a name of at most 255 bytes)",
+    errno.ENOENT: "expected an existing file or folder",
+    errno.ENOTDIR: "expected a path through folders, not through a file",
+    errno.EISDIR: "expected a file, not a folder",
+    errno.ELOOP: "expected a path without a loop of symbolic links",
+    errno.EACCES: "expected a place linkwork may read and write",
+    errno.EPERM: "expected a place linkwork may read and write",
+    errno.EROFS: "expected a place on a writable file system",
+}
+"""What a path the user gave should have been, by the ``errno`` that refused it: bad input, exit 2."""
+
+
+def os_error_line(exc: OSError) -> tuple[str, int]:
+    """The one error line and exit code of an ``OSError`` that reached a command: a path the user gave that the
+    file system refuses (a name too long, not found, a file on the way) is bad input (exit 2, saying what was
+    expected); anything else (a full disk, an I/O error) is a request that could not be met (exit 3)."""
+    where = f"{show(str(exc.filename))}: " if exc.filename else ""
+    reason = exc.strerror or str(exc)
+    expected = _PATH_EXPECTED.get(exc.errno) if exc.errno is not None else None
+    if expected is not None:
+        return f"{where}{reason}; {expected}", 2
+    return f"{where}{reason}", 3
 
 
 def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
@@ -262,5 +306,7 @@ def parse_couple(items: list[str] | None) -> list[list[str]]:
         names = [x.strip() for x in item.split("=")]
         if len(names) < 2 or not all(names):
             raise fail(f"--couple {show(item)}: expected joints joined by '=', e.g. A=C=E")
+        if len(set(names)) < len(names):  # A=A couples nothing: a slip, not a request
+            raise fail(f"--couple {show(item)}: names a joint twice; expected distinct joints, e.g. A=C=E")
         groups.append(names)
     return groups
