@@ -172,3 +172,36 @@ def test_a_joint_coupled_to_itself_is_refused(tmp_path: Path) -> None:
         'error: --couple "A=B=A": names a joint twice; expected distinct joints, e.g. A=C=E'
     ]
     assert not (tmp_path / "t").exists()
+
+
+@pytest.mark.parametrize("kind", ["a file", "a name too long"])
+def test_a_cache_folder_that_cannot_be_written_stops_compile_at_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str
+) -> None:
+    """``LINKWORK_CACHE_DIR`` naming a file (or a name too long): ``linkwork compile`` compiled for minutes and
+    then failed, and every cold run started a background compile that could never be kept; now one line naming
+    the folder (exit 2), and the background process stops before compiling anything."""
+    from linkwork.cli import kernels
+    from linkwork.kernel_cache import CACHE
+    from linkwork.kinematics import jit
+
+    bad = tmp_path / "cache"
+    if kind == "a file":
+        bad.write_text("the user's file\n", encoding="utf-8")
+    else:
+        bad = tmp_path / ("c" * 300)
+    monkeypatch.setitem(CACHE.__dict__, "parent", bad)  # the cached property, as LINKWORK_CACHE_DIR sets it
+
+    def never() -> None:
+        raise AssertionError("compiled into a cache folder that cannot be written")
+
+    monkeypatch.setattr(kernels, "compile_all", never)
+    monkeypatch.setattr(jit, "hold_lock", never)
+    result = runner.invoke(app, ["compile"])
+    assert result.exit_code == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and "LINKWORK_CACHE_DIR" in lines[0]
+    assert str(bad)[:60] in lines[0]
+    kernels.compile_in_background()  # returns at once
+    if kind == "a file":
+        assert bad.read_text(encoding="utf-8") == "the user's file\n"

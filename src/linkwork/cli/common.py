@@ -23,6 +23,7 @@ from rich.text import Text
 from linkwork.errors import LinkworkError, RequestNotMetError
 from linkwork.io.toml_reader import escape_line, show
 from linkwork.limits import Limit
+from linkwork.messages import show_path
 from linkwork.progress import Progress
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -125,7 +126,7 @@ def os_error_line(exc: OSError) -> tuple[str, int]:
     """The one error line and exit code of an ``OSError`` that reached a command: a path the user gave that the
     file system refuses (a name too long, not found, a file on the way) is bad input (exit 2, saying what was
     expected); anything else (a full disk, an I/O error) is a request that could not be met (exit 3)."""
-    where = f"{show(str(exc.filename))}: " if exc.filename else ""
+    where = f"{show_path(exc.filename)}: " if exc.filename else ""
     reason = exc.strerror or str(exc)
     expected = _PATH_EXPECTED.get(exc.errno) if exc.errno is not None else None
     if expected is not None:

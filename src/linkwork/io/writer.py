@@ -43,7 +43,8 @@ from numpy.typing import ArrayLike
 
 from linkwork.errors import RequestNotMetError, SpecError
 from linkwork.interrupts import when_safe
-from linkwork.io.toml_reader import escape_line, show
+from linkwork.io.toml_reader import show
+from linkwork.messages import show_path
 
 __all__ = [
     "MANIFEST",
@@ -131,11 +132,7 @@ def _names(value: Any) -> set[str]:
     )
 
 
-def _shown(path: Path) -> str:
-    """A path for a message: whole (up to 500 characters), quoted, control characters escaped."""
-    text = str(path)
-    text = text if len(text) <= 500 else text[:497] + "..."
-    return '"' + escape_line(text).replace('"', '\\"') + '"'
+_shown = show_path
 
 
 def _exists(path: Path) -> bool:
