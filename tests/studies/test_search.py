@@ -312,3 +312,17 @@ def test_search_records_are_never_written_through_a_link(tmp_path: Path, kind: s
     assert len(lines) == 1 and lines[0].startswith("error: --out ") and ".linkwork-search" in lines[0]
     assert sorted(p.name for p in user.iterdir()) == ["notes.txt"]
     assert (user / "notes.txt").read_text() == "keep\n"
+
+
+def test_a_link_planted_beside_the_records_is_never_written_through(tmp_path: Path) -> None:
+    """The records' header was written to ``records.part`` and renamed: a link planted under that name had the
+    user's file it pointed to overwritten with the header, then every record appended to it."""
+    file = study(tmp_path, "mobility = 1", grid='width = [0.5]\ncuts = ["NS"]')
+    out, notes = tmp_path / "out", tmp_path / "notes.txt"
+    notes.write_text("keep\n", encoding="utf-8")
+    (out / RECORDS).parent.mkdir(parents=True)
+    (out / RECORDS).with_suffix(".part").symlink_to(notes)
+    code, output = search([str(file), "-o", str(out), "--workers", "0", "--gallery", "0"])
+    assert code in (0, 3), output
+    assert notes.read_text(encoding="utf-8") == "keep\n"
+    assert len((out / RECORDS).read_text().splitlines()) == 2  # the header and the one candidate

@@ -8,9 +8,11 @@ same ``OUT`` reads them and traces only the rest; a changed study starts afresh.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
+import tempfile
 from dataclasses import asdict
 from pathlib import Path
 from types import TracebackType
@@ -65,10 +67,16 @@ class SearchRecords:
             self._read()
         if not self.rows:
             self.file.parent.mkdir(parents=True, exist_ok=True)
-            part = self.file.with_suffix(".part")
             header = {"format": RECORD_FORMAT, "study": self.fingerprint}
-            part.write_text(json.dumps(header) + "\n", encoding="utf-8")
-            os.replace(part, self.file)
+            # a new file of its own, renamed into place: a link planted under any name is never written through
+            fd, part = tempfile.mkstemp(prefix=".records-", dir=self.file.parent)
+            try:
+                with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                    fh.write(json.dumps(header) + "\n")
+                os.replace(part, self.file)
+            finally:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(part)
         self._fh = self.file.open("a", encoding="utf-8")
         return self
 
