@@ -205,3 +205,31 @@ def test_a_cache_folder_that_cannot_be_written_stops_compile_at_once(
     kernels.compile_in_background()  # returns at once
     if kind == "a file":
         assert bad.read_text(encoding="utf-8") == "the user's file\n"
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full (Linux)")
+@pytest.mark.parametrize("command", [None, *COMMANDS])
+def test_help_into_a_full_standard_output_is_one_line(command: str | None) -> None:
+    """``linkwork --help > /dev/full`` was a 60-line traceback from rich's buffer: the help is printed outside
+    every command's ``friendly_errors``; now one line, exit 3 (the request could not be met)."""
+    import subprocess
+    import sys
+
+    with open("/dev/full", "w", encoding="utf-8") as full:
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "from linkwork.cli import app; app()",
+                *([command] if command else []),
+                "--help",
+            ],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    assert done.returncode == 3, done.stderr
+    assert done.stderr.strip().splitlines() == [
+        "error: cannot write to the standard output (No space left on device)"
+    ]

@@ -68,6 +68,12 @@ class OneLineErrors(help.Group):
         except typer.Abort:
             fail("aborted", code=1)
             sys.exit(1)
+        except (
+            OSError
+        ) as exc:  # printing the help or a usage line failed: the standard output is full or gone
+            where = f"{exc.filename}" if exc.filename else "the standard output"
+            fail(f"cannot write to {where} ({exc.strerror or exc})", code=3)
+            sys.exit(3)
         sys.exit(code if isinstance(code, int) else 0)
 
 
