@@ -20,6 +20,7 @@ import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
+from typing import Any
 
 import pytest
 from cli_cases import (
@@ -27,6 +28,7 @@ from cli_cases import (
     REFUSED_PATHS,
     SLOW,
     Case,
+    Param,
     cases,
     command_line,
     commands,
@@ -268,3 +270,41 @@ def test_a_hostile_study_key_is_refused_before_any_work(home: Path, key: str, va
             ["sweep", str(study), "--workers", "0", "--no-plots", "-o", str(out)], out=out, home=home
         )
         assert run.code == 2 and str(refused.value) in run.stderr, run
+
+
+@pytest.mark.parametrize(
+    "param",
+    [
+        pytest.param(p, id=f"{' '.join(p.command)}|{p.flag}")
+        for p in parameters()
+        if p.flag is not None and p.kind in ("int", "float", "str", "path")
+    ],
+)
+def test_an_option_of_one_value_given_twice_is_refused(home: Path, param: Param) -> None:
+    """Every option that takes one value, of every command, given twice (``--until A=80 --until A=90``): click
+    kept the last silently, so a slip ran with a value the user did not mean; now one line, exit 2, before any
+    work. The short form counts as the long one (``-o a --out b``)."""
+    assert param.flag is not None
+    short = [o for o in _option(param).opts if len(o) == 2]
+    run = run_cli([*param.command, param.flag, "1", *(short or [param.flag]), "1"], home=home)
+    assert run.code == 2
+    assert run.stderr.strip() == f"error: {param.flag} given twice; expected it once (it takes one value)"
+
+
+def _option(param: Param) -> Any:
+    """The click option of ``param`` in the built app."""
+    import typer.main
+
+    command: Any = typer.main.get_command(app)
+    for name in param.command:
+        command = command.commands[name]
+    return next(p for p in command.params if p.name == param.name)
+
+
+@pytest.mark.parametrize(
+    "repeatable", [["--set", "alpha1=40", "--set", "alpha2=130"], ["--no-plots", "--no-plots"]]
+)
+def test_repeatable_options_and_flags_may_be_repeated(home: Path, repeatable: list[str]) -> None:
+    out = home / "out"
+    run = run_cli(["trace", "bennett", "--max-steps", "10", "-o", str(out), *repeatable], out=out, home=home)
+    assert run.code == 0, run.stderr

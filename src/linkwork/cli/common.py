@@ -12,7 +12,7 @@ import errno
 import math
 import signal
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from functools import wraps
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
@@ -224,6 +224,41 @@ def _checked_callback(flag: str, limit: Limit | None, then: Callable[..., Any] |
         return then(ctx, param, value) if then is not None else value
 
     return check
+
+
+def repeated_option(group: Any, args: Sequence[str]) -> str | None:
+    """The first option of the command ``args`` call in ``group`` (the built app) that takes one value and is
+    given twice (``--until A=80 --until A=90``, ``-o a --out b``), or ``None``. Click keeps the last silently, so
+    a slip in a long command line would run with a value the user did not mean; repeatable options (``--set``)
+    and on/off flags are not counted."""
+    command, rest = group, list(args)
+    while getattr(command, "commands", None) is not None:
+        if not rest or rest[0].startswith("-") or rest[0] not in command.commands:
+            return None  # a root option, or a command click refuses itself
+        command, rest = command.commands[rest[0]], rest[1:]
+    takes_value: dict[str, Any] = {}
+    for param in getattr(command, "params", []):
+        if param.param_type_name == "option" and not param.is_flag and not param.count:
+            takes_value.update(dict.fromkeys(param.opts, param))
+    seen: set[str] = set()
+    i = 0
+    while i < len(rest):
+        token = rest[i]
+        if token == "--":
+            break
+        long_form = token.startswith("--")
+        name = token.partition("=")[0] if long_form else token[:2]
+        param = takes_value.get(name) if token.startswith("-") else None
+        if param is None:
+            i += 1
+            continue
+        if not param.multiple:
+            if param.name in seen:
+                return str(max(param.opts, key=len))
+            seen.add(param.name)
+        attached = "=" in token if long_form else len(token) > 2
+        i += 1 if attached else 2
+    return None
 
 
 def check_workers(workers: int | None) -> None:
