@@ -205,7 +205,8 @@ def _load_profiles(reader: TomlReader, folder: Path, files: list[str], kind: Pro
         key = key_path("profiles", index)
         problem = input_file_problem(file)
         if problem is not None:
-            raise reader.error(key, f'file "{escape_line(str(file))}": {problem}; expected a profile file')
+            what = "not found" if problem == "file not found" else problem
+            raise reader.error(key, f'file "{escape_line(str(file))}" {what}; expected a profile file')
         points = load_profile(file)
         if kind == "closed":
             gap = float(np.hypot(*(points[-1] - points[0])))
