@@ -11,7 +11,7 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
-__all__ = ["SHOW_CHARS", "closest", "escape_line", "show"]
+__all__ = ["SHOW_CHARS", "SHOW_PATH_CHARS", "closest", "escape_line", "show", "show_path"]
 
 SHOW_CHARS = 40
 """The longest string :func:`show` quotes whole; a longer one is cut, ending in ``...``."""
@@ -36,6 +36,17 @@ def show(value: Any) -> str:
     if isinstance(value, int) and abs(value) >= 10**30:
         return f"an integer of {len(str(abs(value)))} digits"
     return escape_line(str(value))
+
+
+SHOW_PATH_CHARS = 500
+"""The longest path :func:`show_path` quotes whole (a path is cut later than a value: the user needs to find it)."""
+
+
+def show_path(path: Any) -> str:
+    """A path for a message: quoted, whole up to 500 characters, control characters escaped, on one line."""
+    text = str(path)
+    text = text if len(text) <= SHOW_PATH_CHARS else text[: SHOW_PATH_CHARS - 3] + "..."
+    return '"' + escape_line(text).replace('"', '\\"') + '"'
 
 
 _CONTROL = re.compile(r"[\x00-\x1f\x7f\u0085\u2028\u2029]")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import re
 from contextlib import redirect_stdout
+from pathlib import Path
 
 import pytest
 from rich.table import Table
@@ -84,3 +85,40 @@ def test_a_section_rule_printed_to_a_pipe_stays_a_line_wide(monkeypatch: pytest.
             console.file = None  # type: ignore[assignment]
     lines = [ANSI.sub("", line) for line in buffer.getvalue().splitlines() if line.strip()]
     assert len(lines) == 1 and "1. Tracing" in lines[0] and 40 <= len(lines[0]) <= RULE_WIDTH
+
+
+HOSTILE_OUT = "a\x1b[31mred\rX"
+"""An output name with an escape sequence (red text) and a carriage return (the cursor back to the line's start)."""
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["trace", "bennett", "--no-plots", "--max-steps", "10", "-o", "{dir}"],
+        ["export", "stl", "{trace}", "-o", "{dir}.stl"],
+        ["export", "mjcf", "{trace}", "-o", "{dir}.xml"],
+        ["export", "dxf", "{trace}", "-o", "{dir}.dxf"],
+        ["sweep", "{study}", "--workers", "0", "--no-plots", "-o", "{dir}"],
+    ],
+    ids=lambda c: " ".join(c[:2]),
+)
+def test_a_users_path_in_a_summary_line_sends_no_control_characters(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, command: list[str]
+) -> None:
+    """``wrote ... to OUT/`` printed the --out a user gave as it was: ``-o $'a\\x1b[31m...'`` turned the terminal
+    red and ``\\r`` moved the cursor. Every summary goes through the one console, which escapes them."""
+    monkeypatch.chdir(tmp_path)
+    trace = tmp_path / "t"
+    assert (
+        runner.invoke(
+            app, ["trace", "four-bar", "--no-plots", "--max-steps", "10", "-o", str(trace)]
+        ).exit_code
+        == 0
+    )
+    study = tmp_path / "study.toml"
+    study.write_text('linkage = "bennett"\n[trace]\nuntil = "A=90"\nsteps = 5\n[grid]\nalpha1 = [30]\n')
+    args = [a.format(dir=HOSTILE_OUT, trace=trace, study=study) for a in command]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.stderr
+    assert "\x1b" not in result.stdout and "\r" not in result.stdout
+    assert "a\\x1b[31mred\\rX" in result.stdout

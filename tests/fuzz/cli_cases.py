@@ -158,6 +158,13 @@ OUT_KINDS = [
     *(["@out-readonly"] if READ_ONLY else []),
 ]
 DAMAGES = ["truncate", "empty", "binary", "short-rows", "symlink"]
+#: Paths the file system refuses to look up, or that are no file to read: a name longer than 255 bytes, a path
+#: through a user's file, a FIFO (reading it would block for ever). Every path of every command gets each and
+#: must refuse it before any work (exit 2, one line), never as an ``OSError`` (exit 3) or a hang.
+REFUSED_PATHS = ["@long-name", "@through-file", "@fifo"]
+REFUSED_OUTS = ["@out-long-name", "@out-through-file"]
+#: Longer than any file system's limit on one name (255 bytes).
+LONG_NAME = "n" * 300
 
 
 def valid(param: Param) -> str | None:
@@ -269,7 +276,7 @@ def command_line(case: Case, home: Path, fixtures: dict[str, Path]) -> tuple[lis
         if value is None:
             raise AssertionError(f"no valid value for {' '.join(param.command)} {param.key}: add it to VALID")
         if param.key == "--out" and value.startswith("@out"):
-            value = materialize_out(value, out)
+            value = materialize_out(value, out, (valid(param) or "").partition("{out}/")[2])
         else:
             value = materialize(value, home, fixtures, out)
         if param.flag is None:
@@ -314,6 +321,13 @@ def materialize(value: str, home: Path, fixtures: dict[str, Path], out: Path) ->
             target.mkdir()
             (target / "inside.toml").write_text("x = 1\n", encoding="utf-8")
             target.chmod(stat.S_IRUSR | stat.S_IXUSR)
+        case "@long-name":
+            return str(home / f"{LONG_NAME}.toml")
+        case "@through-file":
+            return str(user / "input.toml")
+        case "@fifo":
+            target = home / "input.toml"
+            os.mkfifo(target)
         case "@present" | "@plain":
             return value
         case "@damaged":
@@ -324,10 +338,17 @@ def materialize(value: str, home: Path, fixtures: dict[str, Path], out: Path) ->
     return str(target)
 
 
-def materialize_out(value: str, out: Path) -> str:
-    """A hostile --out: a user's file, a link to a user's folder, a read-only folder, a folder with a user file."""
+def materialize_out(value: str, out: Path, file_name: str = "") -> str:
+    """A hostile --out: a user's file, a link to a user's folder, a read-only folder, a folder with a user file,
+    a name too long, a path through a user's file. ``file_name`` is the file a single-file output writes
+    (``parts.stl``), whose suffix a refused path keeps so that it is refused for the path, not the suffix."""
     home = out.parent
     match value:
+        case "@out-long-name":
+            return str(home / (LONG_NAME + Path(file_name).suffix))
+        case "@out-through-file":
+            out.write_text("the user's own file\n", encoding="utf-8")
+            return str(out / (file_name or "inside"))
         case "@out-user-file":
             out.write_text("the user's own file\n", encoding="utf-8")
         case "@out-symlink":

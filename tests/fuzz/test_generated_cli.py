@@ -20,11 +20,15 @@ import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
+from typing import Any
 
 import pytest
 from cli_cases import (
+    REFUSED_OUTS,
+    REFUSED_PATHS,
     SLOW,
     Case,
+    Param,
     cases,
     command_line,
     commands,
@@ -136,6 +140,40 @@ def test_a_generated_hostile_case_keeps_every_promise(home: Path, case: Case) ->
             assert_finite(file)
 
 
+def _refused_path_cases() -> list[Case]:
+    """Every path of every command (an input file or folder, ``--out``) with each path the file system refuses:
+    a name too long, a path through a file, a FIFO."""
+    out = []
+    for param in parameters():
+        if param.key == "--out":
+            kinds = REFUSED_OUTS
+        elif param.kind == "path" or (valid(param) or "").startswith("{") or param.key == "spec":
+            kinds = REFUSED_PATHS
+        else:
+            continue
+        out += [Case(param.command, param.key, kind, refused_before_work=True) for kind in kinds]
+    return out
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, id=c.id) for c in _refused_path_cases()])
+def test_a_path_the_file_system_refuses_is_bad_input_in_one_line(home: Path, case: Case) -> None:
+    """A path no file can be read from or written to (a name longer than 255 bytes, a path through a file, a
+    FIFO) is bad input: exit 2 before any work, one line naming the path (or its flag), never the ``OSError``
+    of the first function that touched it (which was exit 3, without saying what was expected) or a hang."""
+    args, out = command_line(case, home, FIXTURES)
+    previous = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(60)  # a FIFO opened for reading blocks until a writer comes: a hang is a failure
+    try:
+        run = run_cli(args, out=out, home=home)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert run.code == 2, (case.id, run.stderr)
+    assert ".linkwork-" not in run.stderr and "Errno" not in run.stderr, (
+        run.stderr
+    )  # the user's path, in words
+
+
 def _outputs(out: Path) -> list[Path]:
     if out.is_symlink() or not out.exists():
         return []
@@ -232,3 +270,41 @@ def test_a_hostile_study_key_is_refused_before_any_work(home: Path, key: str, va
             ["sweep", str(study), "--workers", "0", "--no-plots", "-o", str(out)], out=out, home=home
         )
         assert run.code == 2 and str(refused.value) in run.stderr, run
+
+
+@pytest.mark.parametrize(
+    "param",
+    [
+        pytest.param(p, id=f"{' '.join(p.command)}|{p.flag}")
+        for p in parameters()
+        if p.flag is not None and p.kind in ("int", "float", "str", "path")
+    ],
+)
+def test_an_option_of_one_value_given_twice_is_refused(home: Path, param: Param) -> None:
+    """Every option that takes one value, of every command, given twice (``--until A=80 --until A=90``): click
+    kept the last silently, so a slip ran with a value the user did not mean; now one line, exit 2, before any
+    work. The short form counts as the long one (``-o a --out b``)."""
+    assert param.flag is not None
+    short = [o for o in _option(param).opts if len(o) == 2]
+    run = run_cli([*param.command, param.flag, "1", *(short or [param.flag]), "1"], home=home)
+    assert run.code == 2
+    assert run.stderr.strip() == f"error: {param.flag} given twice; expected it once (it takes one value)"
+
+
+def _option(param: Param) -> Any:
+    """The click option of ``param`` in the built app."""
+    import typer.main
+
+    command: Any = typer.main.get_command(app)
+    for name in param.command:
+        command = command.commands[name]
+    return next(p for p in command.params if p.name == param.name)
+
+
+@pytest.mark.parametrize(
+    "repeatable", [["--set", "alpha1=40", "--set", "alpha2=130"], ["--no-plots", "--no-plots"]]
+)
+def test_repeatable_options_and_flags_may_be_repeated(home: Path, repeatable: list[str]) -> None:
+    out = home / "out"
+    run = run_cli(["trace", "bennett", "--max-steps", "10", "-o", str(out), *repeatable], out=out, home=home)
+    assert run.code == 0, run.stderr

@@ -382,3 +382,17 @@ def test_an_out_folder_that_cannot_be_created_is_one_line(home: Path) -> None:
     )
     assert run.code == 2
     assert '--out "/proc/linkwork-out": cannot write there' in run.stderr
+
+
+@pytest.mark.parametrize("kind", ["mjcf", "dxf"])
+def test_export_of_a_synth_folder_without_its_mechanism_says_how_to_get_one(
+    home: Path, two_profile_chain: Path, kind: str
+) -> None:
+    """``export dxf`` takes a synth folder (its --help says so), but only once mechanized: the line said a
+    folder "written by linkwork trace, synth or mechanize" was expected, which the folder given was."""
+    run = run_cli(
+        ["export", kind, str(two_profile_chain), "-o", f"x.{'xml' if kind == 'mjcf' else kind}"], home=home
+    )
+    assert run.code == 2
+    assert "this synth folder has a chain but no mechanism yet" in run.stderr
+    assert "linkwork mechanize FOLDER" in run.stderr

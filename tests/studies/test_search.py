@@ -253,3 +253,76 @@ def test_stalled_members_are_mobile_to_first_order_only() -> None:
             moving += 1
             assert second < 1e-12, faces
     assert stalled > 0 and moving > 0 and stalled + moving == 36
+
+
+#: Ways a record line of a search can be damaged (by hand, by a disk) while staying a JSON object: each record so
+#: damaged must be traced again, never read as a candidate's row (they were a KeyError or an IndexError traceback,
+#: or, with a negative index, the last candidate's row taken for another).
+RECORD_DAMAGES = {
+    "only an index": lambda row: {"index": row["index"]},
+    "index past the grid": lambda row: {**row, "index": 99999},
+    "negative index": lambda row: {**row, "index": -1},
+    "index of another candidate": lambda row: {**row, "index": 1 - row["index"]},
+    "index a float": lambda row: {**row, "index": float(row["index"])},
+    "index a bool": lambda row: {**row, "index": False},
+    "a measure as text": lambda row: {**row, "membrane_stretch": "x"},
+    "a measure as a list": lambda row: {**row, "bundle_ratio": [1]},
+    "passes as text": lambda row: {**row, "passes": "yes"},
+    "a parameter changed": lambda row: {**row, "width": 123.0},
+}
+
+
+@pytest.mark.parametrize("damage", sorted(RECORD_DAMAGES))
+def test_a_damaged_record_is_traced_again(tmp_path: Path, damage: str) -> None:
+    file = study(tmp_path, "mobility = 1", grid='width = [0.5, 1.0]\ncuts = ["NS"]')
+    out = tmp_path / "out"
+    args = [str(file), "-o", str(out), "--workers", "0", "--gallery", "1"]
+    code, output = search(args)
+    assert code in (0, 3), output
+    whole = (out / "candidates.csv").read_text()
+    lines = (out / RECORDS).read_text().splitlines()
+    row = json.loads(lines[1])
+    (out / RECORDS).write_text("\n".join([lines[0], json.dumps(RECORD_DAMAGES[damage](row))]) + "\n")
+    again, output = search(args)
+    assert again == code, output
+    assert "resuming" not in output  # the only record kept was the damaged one: nothing is resumed
+    assert (out / "candidates.csv").read_text() == whole
+
+
+@pytest.mark.parametrize("kind", ["folder link", "records link", "a file for the folder"])
+def test_search_records_are_never_written_through_a_link(tmp_path: Path, kind: str) -> None:
+    """``OUT/.linkwork-search`` a link to a user's folder: the records were written into it; a user's file of that
+    name was a 'File exists' exit 3."""
+    file = study(tmp_path, "mobility = 1", grid='width = [0.5]\ncuts = ["NS"]')
+    out, user = tmp_path / "out", tmp_path / "user"
+    out.mkdir()
+    user.mkdir()
+    (user / "notes.txt").write_text("keep\n", encoding="utf-8")
+    records = out / RECORDS
+    if kind == "folder link":
+        records.parent.symlink_to(user)
+    elif kind == "records link":
+        records.parent.mkdir()
+        records.symlink_to(user / "notes.txt")
+    else:
+        records.parent.write_text("the user's file\n", encoding="utf-8")
+    result = CliRunner().invoke(app, ["search", str(file), "-o", str(out), "--workers", "0"])
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: --out ") and ".linkwork-search" in lines[0]
+    assert sorted(p.name for p in user.iterdir()) == ["notes.txt"]
+    assert (user / "notes.txt").read_text() == "keep\n"
+
+
+def test_a_link_planted_beside_the_records_is_never_written_through(tmp_path: Path) -> None:
+    """The records' header was written to ``records.part`` and renamed: a link planted under that name had the
+    user's file it pointed to overwritten with the header, then every record appended to it."""
+    file = study(tmp_path, "mobility = 1", grid='width = [0.5]\ncuts = ["NS"]')
+    out, notes = tmp_path / "out", tmp_path / "notes.txt"
+    notes.write_text("keep\n", encoding="utf-8")
+    (out / RECORDS).parent.mkdir(parents=True)
+    (out / RECORDS).with_suffix(".part").symlink_to(notes)
+    code, output = search([str(file), "-o", str(out), "--workers", "0", "--gallery", "0"])
+    assert code in (0, 3), output
+    assert notes.read_text(encoding="utf-8") == "keep\n"
+    assert len((out / RECORDS).read_text().splitlines()) == 2  # the header and the one candidate

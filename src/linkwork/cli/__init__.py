@@ -26,7 +26,7 @@ from linkwork.cli import (
     synth,
     trace,
 )
-from linkwork.cli.common import check_flags, fail
+from linkwork.cli.common import check_flags, fail, repeated_option
 from linkwork.interrupts import install_safe_interrupt
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -55,6 +55,15 @@ class OneLineErrors(help.Group):
         **extra: Any,
     ) -> Any:
         check_flags(self)  # every numeric flag's bounds (cli/options.py), checked before any work starts
+        given = list(sys.argv[1:] if args is None else args)
+        twice = repeated_option(self, given)
+        if twice is not None:
+            if not standalone_mode:
+                raise click_exceptions.UsageError(
+                    f"{twice} given twice; expected it once (it takes one value)"
+                )
+            fail(f"{twice} given twice; expected it once (it takes one value)", code=2)
+            sys.exit(2)
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, False, windows_expand_args, **extra)
         try:
@@ -68,6 +77,12 @@ class OneLineErrors(help.Group):
         except typer.Abort:
             fail("aborted", code=1)
             sys.exit(1)
+        except (
+            OSError
+        ) as exc:  # printing the help or a usage line failed: the standard output is full or gone
+            where = f"{exc.filename}" if exc.filename else "the standard output"
+            fail(f"cannot write to {where} ({exc.strerror or exc})", code=3)
+            sys.exit(3)
         sys.exit(code if isinstance(code, int) else 0)
 
 

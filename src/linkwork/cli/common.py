@@ -1,16 +1,18 @@
 """What every command shares: turning linkwork errors into one clear line and exit code 2 or 3, quietly.
 
 A command decorated with :func:`friendly_errors` runs with numpy's floating-point warnings and Python's
-``RuntimeWarning``\\ s silenced, so that the one ``error:`` line is the only line on stderr when it fails.
+``RuntimeWarning``\\ s silenced, and any other warning shown as one ``note:`` line, so that the one ``error:``
+line is the only error on stderr when it fails and no source line is ever printed.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import math
 import signal
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from functools import wraps
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
@@ -21,6 +23,7 @@ from rich.text import Text
 from linkwork.errors import LinkworkError, RequestNotMetError
 from linkwork.io.toml_reader import escape_line, show
 from linkwork.limits import Limit
+from linkwork.messages import show_path
 from linkwork.progress import Progress
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -53,6 +56,22 @@ def fail(message: str, code: int = 2) -> typer.Exit:
     return typer.Exit(code=code)
 
 
+def warning_note(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """Show a warning met while a command runs (one of matplotlib's, a deprecation) as one ``note:`` line on
+    stderr, like the kernel announcements: never Python's two lines with a source file and its code."""
+    text = escape_line(str(message))
+    if len(text) > MAX_MESSAGE_CHARS:
+        text = text[: MAX_MESSAGE_CHARS - 3] + "..."
+    err_console.print(Text(f"note: {text}"), highlight=False, soft_wrap=True)
+
+
 def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
     """Decorate a command so that a :class:`LinkworkError` becomes one line on stderr and exit code 2, or 3 for a
     :class:`RequestNotMetError`; numeric warnings are silenced while it runs."""
@@ -64,6 +83,7 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
         try:
             with warnings.catch_warnings(), np.errstate(all="ignore"):
                 warnings.simplefilter("ignore", RuntimeWarning)
+                warnings.showwarning = warning_note  # restored by catch_warnings
                 return func(*args, **kwargs)
         except RequestNotMetError as exc:
             raise fail(str(exc), code=3) from None
@@ -71,9 +91,9 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(str(exc)) from None
         except RecursionError:
             raise fail("the input is nested too deeply to be processed") from None
-        except OSError as exc:  # the file system refused (a read-only or full disk, a vanished folder)
-            where = f"{exc.filename}: " if exc.filename else ""
-            raise fail(f"{where}{exc.strerror or exc}", code=3) from None
+        except OSError as exc:  # the file system refused, outside the readers and the writer's own checks
+            message, code = os_error_line(exc)
+            raise fail(message, code=code) from None
         except MemoryError:
             raise fail("ran out of memory; the request is too large for this machine", code=3) from None
         except KeyboardInterrupt:  # Ctrl-C outside a study's run (which keeps its results itself)
@@ -87,6 +107,31 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(f"interrupted twice ({exc}); stopped at once", code=code) from None
 
     return wrapper
+
+
+_PATH_EXPECTED = {
+    errno.ENAMETOOLONG: "expected a shorter path (a name of at most 255 bytes)",
+    errno.ENOENT: "expected an existing file or folder",
+    errno.ENOTDIR: "expected a path through folders, not through a file",
+    errno.EISDIR: "expected a file, not a folder",
+    errno.ELOOP: "expected a path without a loop of symbolic links",
+    errno.EACCES: "expected a place linkwork may read and write",
+    errno.EPERM: "expected a place linkwork may read and write",
+    errno.EROFS: "expected a place on a writable file system",
+}
+"""What a path the user gave should have been, by the ``errno`` that refused it: bad input, exit 2."""
+
+
+def os_error_line(exc: OSError) -> tuple[str, int]:
+    """The one error line and exit code of an ``OSError`` that reached a command: a path the user gave that the
+    file system refuses (a name too long, not found, a file on the way) is bad input (exit 2, saying what was
+    expected); anything else (a full disk, an I/O error) is a request that could not be met (exit 3)."""
+    where = f"{show_path(exc.filename)}: " if exc.filename else ""
+    reason = exc.strerror or str(exc)
+    expected = _PATH_EXPECTED.get(exc.errno) if exc.errno is not None else None
+    if expected is not None:
+        return f"{where}{reason}; {expected}", 2
+    return f"{where}{reason}", 3
 
 
 def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
@@ -181,6 +226,41 @@ def _checked_callback(flag: str, limit: Limit | None, then: Callable[..., Any] |
     return check
 
 
+def repeated_option(group: Any, args: Sequence[str]) -> str | None:
+    """The first option of the command ``args`` call in ``group`` (the built app) that takes one value and is
+    given twice (``--until A=80 --until A=90``, ``-o a --out b``), or ``None``. Click keeps the last silently, so
+    a slip in a long command line would run with a value the user did not mean; repeatable options (``--set``)
+    and on/off flags are not counted."""
+    command, rest = group, list(args)
+    while getattr(command, "commands", None) is not None:
+        if not rest or rest[0].startswith("-") or rest[0] not in command.commands:
+            return None  # a root option, or a command click refuses itself
+        command, rest = command.commands[rest[0]], rest[1:]
+    takes_value: dict[str, Any] = {}
+    for param in getattr(command, "params", []):
+        if param.param_type_name == "option" and not param.is_flag and not param.count:
+            takes_value.update(dict.fromkeys(param.opts, param))
+    seen: set[str] = set()
+    i = 0
+    while i < len(rest):
+        token = rest[i]
+        if token == "--":
+            break
+        long_form = token.startswith("--")
+        name = token.partition("=")[0] if long_form else token[:2]
+        param = takes_value.get(name) if token.startswith("-") else None
+        if param is None:
+            i += 1
+            continue
+        if not param.multiple:
+            if param.name in seen:
+                return str(max(param.opts, key=len))
+            seen.add(param.name)
+        attached = "=" in token if long_form else len(token) > 2
+        i += 1 if attached else 2
+    return None
+
+
 def check_workers(workers: int | None) -> None:
     """Refuse a ``--workers`` outside ``0 ..`` the machine's cores (0 runs a study in this process); the flag
     is checked as it is parsed, this repeats it for a caller that passes the value itself."""
@@ -262,5 +342,7 @@ def parse_couple(items: list[str] | None) -> list[list[str]]:
         names = [x.strip() for x in item.split("=")]
         if len(names) < 2 or not all(names):
             raise fail(f"--couple {show(item)}: expected joints joined by '=', e.g. A=C=E")
+        if len(set(names)) < len(names):  # A=A couples nothing: a slip, not a request
+            raise fail(f"--couple {show(item)}: names a joint twice; expected distinct joints, e.g. A=C=E")
         groups.append(names)
     return groups

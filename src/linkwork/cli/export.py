@@ -117,6 +117,7 @@ def dxf(
     from linkwork.export.files import write_whole
     from linkwork.export.trace_folder import read_trace_folder
     from linkwork.io.profiles import LENGTH_UNITS
+    from linkwork.messages import show
 
     check_output_file(out)
     path = Path(spec)
@@ -125,7 +126,7 @@ def dxf(
 
         units = read_chain(path / "chain.json").get("units")
     if units is not None and units not in LENGTH_UNITS:
-        raise SpecError(f"--units: expected one of {', '.join(LENGTH_UNITS)}, got {units!r}")
+        raise SpecError(f"--units: expected one of {', '.join(LENGTH_UNITS)}, got {show(units)}")
     if (path / "path.csv").is_file():
         folder = read_trace_folder(path)
         mech, angles = folder.mechanism, folder.point(branch, point)
@@ -145,8 +146,11 @@ def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None
 
     path = Path(spec)
     if path.is_dir() and not (path / "mechanism.toml").is_file():
+        unmechanized = (path / "chain.json").is_file()  # a synth folder holds a mechanism once mechanized
         raise SpecError(
-            f"{path}: no mechanism.toml; expected a folder written by linkwork trace, synth or mechanize"
+            f"{path}: no mechanism.toml; expected a folder written by linkwork trace, or a synth folder after "
+            "its mechanization (linkwork mechanize FOLDER, or synth --mechanize)"
+            + ("; this synth folder has a chain but no mechanism yet" if unmechanized else "")
         )
     if path.is_dir():
         if set_:

@@ -12,6 +12,8 @@ import time
 from collections.abc import Callable
 
 from linkwork.cli.common import friendly_errors
+from linkwork.errors import SpecError
+from linkwork.messages import show_path
 from linkwork.outputs.staging import console
 
 BACKGROUND_COMMAND = "from linkwork.cli.kernels import compile_in_background; compile_in_background()"
@@ -84,10 +86,30 @@ def compile_all(report: Callable[[str, float], None] | None = None) -> float:
     return time.perf_counter() - begin
 
 
+def cache_folder_problem() -> str | None:
+    """Why the kernels' cache folder cannot hold the compiled kernels (``$LINKWORK_CACHE_DIR`` naming a file, a
+    name too long, a read-only place), or ``None`` when it can. Checked before compiling: numba only fails to
+    write its cache after minutes of compiling."""
+    import tempfile
+
+    from linkwork.kernel_cache import CACHE
+
+    try:
+        CACHE.directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=CACHE.directory):
+            pass
+    except OSError as exc:
+        return f"{show_path(CACHE.parent)}: cannot hold the compiled kernels ({exc.strerror or exc})"
+    return None
+
+
 def compile_in_background() -> None:
-    """The detached background process: every kernel into the cache, holding the lock file meanwhile."""
+    """The detached background process: every kernel into the cache, holding the lock file meanwhile (nothing,
+    at once, when the cache folder cannot be written: a compile there would be minutes of work lost)."""
     from linkwork.kinematics import jit
 
+    if cache_folder_problem() is not None:
+        return
     jit.hold_lock()
     try:
         compile_all()
@@ -100,6 +122,12 @@ def compile_kernels() -> None:
     """Compile every kernel into linkwork's cache now (for CI, container images and Dask workers), so that no
     later run traces with the slower plain-Python kernels or compiles on its first call."""
     from linkwork.kernel_cache import CACHE
+
+    problem = cache_folder_problem()
+    if problem is not None:
+        raise SpecError(
+            f"{problem}; expected a folder linkwork may create and write into (set LINKWORK_CACHE_DIR)"
+        )
 
     def report(group: str, seconds: float) -> None:
         console.print(f"{group}: ready ({seconds:.1f} s)")

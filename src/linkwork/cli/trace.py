@@ -23,6 +23,7 @@ from linkwork.cli.common import (
 )
 from linkwork.cli.out_folder import out_help, run_folder, spec_label
 from linkwork.errors import RequestNotMetError
+from linkwork.messages import show
 from linkwork.outputs.staging import check_output_folder, console
 
 MAX_STEP_DEG = 90.0
@@ -57,7 +58,11 @@ def _parse_limits(items: list[str] | None) -> dict[str, tuple[float, float]]:
             or lo >= hi
         ):
             raise fail(
-                f"--limit {item!r}: expected JOINT=LO:HI with LO < HI (degrees, or lengths), e.g. D=-140:-100"
+                f"--limit {show(item)}: expected JOINT=LO:HI with LO < HI (degrees, or lengths), e.g. D=-140:-100"
+            )
+        if name.strip() in out:  # two ranges for one joint: which one was meant?
+            raise fail(
+                f"--limit {show(item)}: {show(name.strip())} is limited twice; expected one range a joint"
             )
         out[name.strip()] = (lo, hi)
     return out

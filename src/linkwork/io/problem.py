@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
-from linkwork.io.toml_reader import TomlReader, escape_line, key_path, read_toml, show
+from linkwork.io.toml_reader import TomlReader, escape_line, input_file_problem, key_path, read_toml, show
 from linkwork.mechanization.options import OPTION_KEYS, options_from_values
 from linkwork.synthesis.problem import KINDS, Problem, ProfileKind
 
@@ -203,8 +203,10 @@ def _load_profiles(reader: TomlReader, folder: Path, files: list[str], kind: Pro
     for index, name in enumerate(files):
         file = folder / name
         key = key_path("profiles", index)
-        if not file.is_file():
-            raise reader.error(key, f'file "{escape_line(str(file))}" not found; expected a profile file')
+        problem = input_file_problem(file)
+        if problem is not None:
+            what = "not found" if problem == "file not found" else problem
+            raise reader.error(key, f'file "{escape_line(str(file))}" {what}; expected a profile file')
         points = load_profile(file)
         if kind == "closed":
             gap = float(np.hypot(*(points[-1] - points[0])))

@@ -44,7 +44,7 @@ from linkwork.io.curves import (
 from linkwork.io.drawing import LENGTH_UNITS, new_dxf, svg_d, svg_document, svg_path
 from linkwork.io.outlines import final_chain, write_outline_dxf, write_outline_svg
 from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
-from linkwork.io.toml_reader import escape_line
+from linkwork.io.toml_reader import check_input_file, escape_line
 
 __all__ = [
     "COINCIDENT",
@@ -410,10 +410,7 @@ def save_profile(path: str | Path, points: ArrayLike) -> None:
 
 
 def _check_readable(path: Path) -> None:
-    if not path.exists():
-        raise SpecError("file not found; expected a profile file", source=str(path))
-    if not path.is_file():
-        raise SpecError("is a folder; expected a profile file", source=str(path))
+    check_input_file(path, "a profile file")
     try:
         with path.open("rb"):
             pass

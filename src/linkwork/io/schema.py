@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from linkwork.errors import SpecError
-from linkwork.io.toml_reader import MAX_FILE_BYTES, escape_line, key_path, show
+from linkwork.io.toml_reader import MAX_FILE_BYTES, check_input_file, escape_line, key_path, show
 
 __all__ = [
     "BOOLEAN",
@@ -55,8 +55,7 @@ def read_text(path: Path, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:
     file is a :class:`SpecError` naming it and ``what`` was expected."""
     source = escape_line(str(path))
     expected = f"expected {what}"
-    if not path.is_file():
-        raise SpecError(f"{'is a folder' if path.is_dir() else 'file not found'}; {expected}", source=source)
+    check_input_file(path, what)
     try:
         size = path.stat().st_size
         if size > max_bytes:

@@ -29,7 +29,9 @@ __all__ = [
     "MAX_MAGNITUDE",
     "MAX_NAME_CHARS",
     "TomlReader",
+    "check_input_file",
     "closest",
+    "input_file_problem",
     "key_path",
     "read_toml",
     "show",
@@ -54,16 +56,37 @@ def key_path(path: str, key: str | int) -> str:
     return f"{path}.{key}" if path else key
 
 
+def input_file_problem(path: Path) -> str | None:
+    """What keeps ``path`` from being read as an input file (``"file not found"``, ``"is a folder"``, ``"is not a
+    regular file ..."``, ``"cannot be read (File name too long)"``), or ``None`` when it is a regular file."""
+    try:
+        if not path.exists():
+            return "file not found"
+        if path.is_dir():
+            return "is a folder"
+        if not path.is_file():  # reading a FIFO would block, a device might never end
+            return "is not a regular file (a FIFO, socket or device)"
+    except OSError as exc:  # ENAMETOOLONG, EACCES on a folder on the way: Path.exists lets these through
+        return f"cannot be read ({exc.strerror or exc})"
+    return None
+
+
+def check_input_file(path: Path, what: str) -> None:
+    """Refuse an input ``path`` that cannot be read as a file (see :func:`input_file_problem`) with one
+    :class:`SpecError` naming it and ``what`` was expected (``"a linkage spec file (TOML)"``). Every reader of a
+    user's file starts here."""
+    problem = input_file_problem(path)
+    if problem is not None:
+        raise SpecError(f"{problem}; expected {what}", source=escape_line(str(path)))
+
+
 def read_toml(path: Path, what: str) -> dict[str, Any]:
     """The parsed TOML file ``path``; any problem becomes a :class:`SpecError` naming the file (and line).
 
     ``what`` says what the file should be, e.g. ``"a linkage spec file (TOML)"``.
     """
     expected = f"expected {what}"
-    if not path.exists():
-        raise SpecError(f"file not found; {expected}", source=str(path))
-    if not path.is_file():
-        raise SpecError(f"is a folder; {expected}", source=str(path))
+    check_input_file(path, what)
     try:
         if path.stat().st_size > MAX_FILE_BYTES:
             raise SpecError(

@@ -43,7 +43,8 @@ from numpy.typing import ArrayLike
 
 from linkwork.errors import RequestNotMetError, SpecError
 from linkwork.interrupts import when_safe
-from linkwork.io.toml_reader import escape_line, show
+from linkwork.io.toml_reader import show
+from linkwork.messages import show_path
 
 __all__ = [
     "MANIFEST",
@@ -131,11 +132,7 @@ def _names(value: Any) -> set[str]:
     )
 
 
-def _shown(path: Path) -> str:
-    """A path for a message: whole (up to 500 characters), quoted, control characters escaped."""
-    text = str(path)
-    text = text if len(text) <= 500 else text[:497] + "..."
-    return '"' + escape_line(text).replace('"', '\\"') + '"'
+_shown = show_path
 
 
 def _exists(path: Path) -> bool:
@@ -153,6 +150,24 @@ def check_output_folder(out: Path, names: Iterable[str] = (), flag: str = "--out
         :data:`MANIFEST`, or is a symbolic link.
     """
     out = Path(out)
+    with _unwritable_place(out, flag):
+        _check_output_folder(out, names, flag)
+
+
+@contextlib.contextmanager
+def _unwritable_place(out: Path, flag: str) -> Iterator[None]:
+    """Turn an ``OSError`` met while looking at an output path (a name too long, a loop of links, a folder on
+    the way that cannot be searched) into the one ``SpecError`` line naming ``flag`` and the path (exit 2)."""
+    try:
+        yield
+    except OSError as exc:
+        raise SpecError(
+            f"{flag} {_shown(out)}: cannot write there ({exc.strerror or exc}); expected a place linkwork may "
+            "create and write into"
+        ) from None
+
+
+def _check_output_folder(out: Path, names: Iterable[str], flag: str) -> None:
     if _exists(out) and not out.is_dir():
         raise SpecError(f"{flag} {_shown(out)}: is a file; expected a folder to write into")
     if not out.is_dir():
@@ -304,6 +319,11 @@ def check_output_file(file: Path, flag: str = "--out") -> None:
     """Refuse, before any work, a single output ``file`` that is a folder, a symbolic link, or an existing file
     linkwork did not write (not listed in the :data:`MANIFEST` of its folder)."""
     file = Path(file)
+    with _unwritable_place(file, flag):
+        _check_output_file(file, flag)
+
+
+def _check_output_file(file: Path, flag: str) -> None:
     if file.is_symlink():
         raise SpecError(
             f"{flag} {_shown(file)}: is a symbolic link; linkwork never writes through links, choose another file"

@@ -8,9 +8,11 @@ same ``OUT`` reads them and traces only the rest; a changed study starts afresh.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
+import tempfile
 from dataclasses import asdict
 from pathlib import Path
 from types import TracebackType
@@ -18,6 +20,7 @@ from typing import Any
 
 from linkwork.errors import SpecError
 from linkwork.io.toml_reader import show
+from linkwork.messages import show_path
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.search import MEASURE_COLUMNS, SearchStudy, evaluate, ranked
 
@@ -37,6 +40,9 @@ OUTPUT_NAMES = (
 
 RECORD_FORMAT = "linkwork-search-records/1"
 
+TEXT_MEASURES = ("stretch_pair", "end")
+"""The measure columns of a record that hold text (the others hold a number, or nothing)."""
+
 VIEWER_POINTS = 150
 """Points per branch in a gallery candidate's viewer page (thinned evenly, ends and bifurcations kept): pages stay
 small and quick to write; ``linkwork trace --html`` of the candidate gives every point."""
@@ -49,21 +55,47 @@ class SearchRecords:
     def __init__(self, out: Path, search: SearchStudy) -> None:
         self.file = Path(out) / RECORDS
         self.fingerprint = search.fingerprint()
+        self.columns = columns(search)
+        self.points = search.study.points()
         self.rows: dict[int, dict[str, Any]] = {}
         self.restarted = False
         self._fh: Any = None
 
     def __enter__(self) -> SearchRecords:
+        self._check_place()
         if self.file.exists():
             self._read()
         if not self.rows:
             self.file.parent.mkdir(parents=True, exist_ok=True)
-            part = self.file.with_suffix(".part")
             header = {"format": RECORD_FORMAT, "study": self.fingerprint}
-            part.write_text(json.dumps(header) + "\n", encoding="utf-8")
-            os.replace(part, self.file)
+            # a new file of its own, renamed into place: a link planted under any name is never written through
+            fd, part = tempfile.mkstemp(prefix=".records-", dir=self.file.parent)
+            try:
+                with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                    fh.write(json.dumps(header) + "\n")
+                os.replace(part, self.file)
+            finally:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(part)
         self._fh = self.file.open("a", encoding="utf-8")
         return self
+
+    def _check_place(self) -> None:
+        """Refuse records that are not linkwork's to write: ``.linkwork-search`` or its ``records.jsonl`` a
+        symbolic link (the records would be written through it, into a user's folder or file) or not what they
+        should be (a user's file named ``.linkwork-search``)."""
+        out = self.file.parent.parent
+        for entry, kind in ((self.file.parent, "folder"), (self.file, "file")):
+            if entry.is_symlink():
+                raise SpecError(
+                    f"--out {show_path(out)}: {show(str(entry.relative_to(out)))} is a symbolic link; linkwork "
+                    "never writes through links, move it away or choose another --out"
+                )
+            if entry.exists() and not (entry.is_dir() if kind == "folder" else entry.is_file()):
+                raise SpecError(
+                    f"--out {show_path(out)}: {show(str(entry.relative_to(out)))} exists and is not the {kind} "
+                    "linkwork search keeps its records in; move it away or choose another --out"
+                )
 
     def _read(self) -> None:
         lines = self.file.read_text(encoding="utf-8").splitlines()
@@ -84,8 +116,30 @@ class SearchRecords:
                 row = json.loads(line)
             except ValueError:  # a line cut short by an interruption: that candidate is traced again
                 continue
-            if isinstance(row, dict) and isinstance(row.get("index"), int):
+            if self._sound(row):  # else damaged (by hand, by a disk): that candidate is traced again
                 self.rows[row["index"]] = row
+
+    def _sound(self, row: Any) -> bool:
+        """Whether ``row`` is a record as :func:`~linkwork.studies.search.evaluate` writes it, of the candidate
+        its ``index`` names: every column, the index within the grid, the grid point's own parameters, and a
+        number (or nothing) in every measure column but the two of text."""
+        if not isinstance(row, dict) or not set(self.columns) <= set(row):
+            return False
+        index = row["index"]
+        if type(index) is not int or not 0 <= index < len(self.points):
+            return False
+        if any(row[k] != v for k, v in self.points[index].items()):
+            return False
+        if (
+            type(row["passes"]) is not bool
+            or not isinstance(row["reason"], str)
+            or not isinstance(row["error"], str)
+        ):
+            return False
+        numbers = [k for k in (*MEASURE_COLUMNS, "shortfall") if k not in TEXT_MEASURES]
+        if any(row[k] is not None and (type(row[k]) not in (int, float)) for k in numbers):
+            return False
+        return all(row[k] is None or isinstance(row[k], str) for k in TEXT_MEASURES)
 
     def add(self, rows: list[dict[str, Any]]) -> None:
         """Append finished candidates' rows."""

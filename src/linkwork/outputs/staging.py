@@ -5,6 +5,7 @@ here for the output modules."""
 from __future__ import annotations
 
 import os
+import re
 from typing import Any
 
 from rich.align import AlignMethod
@@ -32,6 +33,14 @@ FILE_WIDTH = 10_000
 """The width (characters) of the console when standard output is a file or a pipe and ``COLUMNS`` is not set."""
 
 
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f\u0085\u2028\u2029]")
+
+
+def _escaped(text: str) -> str:
+    """``text`` with every control character but a line break and a tab written as an escape."""
+    return _CONTROL.sub(lambda m: repr(m.group(0))[1:-1], text)
+
+
 class _SummaryConsole(Console):
     """A console as wide as a terminal on a terminal, and :data:`FILE_WIDTH` wide on a file or a pipe (unless
     ``COLUMNS`` says otherwise), so a table saved to a file keeps its full headers and rows ("transmission", not
@@ -56,6 +65,12 @@ class _SummaryConsole(Console):
     @size.setter
     def size(self, new_size: tuple[int, int]) -> None:
         self._width, self._height = new_size
+
+    def print(self, *objects: Any, **options: Any) -> None:
+        """Print as rich does, with the control characters of every plain string escaped (``\\x1b``) but line
+        breaks and tabs: a path or a name a user gave (``-o $'a\\x1b[31m'``) can never send escape sequences to
+        the terminal or move the cursor (``\\r``) from a summary line."""
+        super().print(*(_escaped(o) if isinstance(o, str) else o for o in objects), **options)
 
     def rule(
         self,
