@@ -37,6 +37,8 @@ Array = NDArray[np.float64]
 _MAX_TURN = np.radians(10.0)
 """The default ``max_turn`` of :func:`trace`, and its cosine (the settings' ``cos_turn``), computed once."""
 _COS_MAX_TURN = float(np.cos(_MAX_TURN))
+_TARGET_TEXT = StopReason.TARGET.text
+"""The end reason of a branch that reached its target (read once: ``StopReason.text`` hashes the enum)."""
 
 
 def trace(
@@ -97,7 +99,7 @@ def trace(
     if target is not None:
         sign = 1.0 if target >= 0 else -1.0
     # A fresh array either way (the kept tangent is read-only and shared; the kernels get a writeable one).
-    t_start = -start.tangent if start.tangent[d_unknown] * sign < 0 else start.tangent.copy()
+    t_start = -start.tangent if start.components[d_unknown] * sign < 0 else start.tangent.copy()
     lo, hi = _limits_in_unknowns(mech, limits) if limits else (start.lo, start.hi)
     cos_turn = _COS_MAX_TURN if max_turn is _MAX_TURN else float(np.cos(max_turn))
     settings = record(
@@ -150,7 +152,8 @@ def start_point(mech: Mechanism, backend: Backend) -> tuple[float, Array, Array,
 class PathStart(NamedTuple):
     """What every trace of one mechanism takes from its start, for one backend and tolerances (the start closes
     and its mobility is one): the path's rank ``r_path`` (the range basis's width), the number of singular values
-    ``n_sigma``, the start's null vector ``tangent`` (``V^T[-1]``, not yet oriented) and range ``basis`` (the
+    ``n_sigma``, the start's null vector ``tangent`` (``V^T[-1]``, not yet oriented; its ``components`` as Python
+    floats, for the test that orients it) and range ``basis`` (the
     first ``r_path`` columns of ``U``, C-contiguous), which unknowns are ``periodic`` and the bounds ``lo, hi``
     of a trace without limits (the arrays of :func:`_periodic` and :func:`_limits_in_unknowns`), all read-only:
     one look-up a call instead of five."""
@@ -158,6 +161,7 @@ class PathStart(NamedTuple):
     r_path: int
     n_sigma: int
     tangent: Array
+    components: tuple[float, ...]
     basis: Array
     periodic: NDArray[np.bool_]
     lo: Array
@@ -178,9 +182,13 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
         basis = np.ascontiguousarray(U0[:, :r_path])
         basis.flags.writeable = False
         lo, hi = _limits_in_unknowns(mech, None)
-        return PathStart(r_path, len(s0), Vt0[-1], basis, _periodic(mech), lo, hi)  # Vt0[-1]: read-only too
+        tangent = Vt0[-1]  # read-only, as Vt0
+        return PathStart(r_path, len(s0), tangent, tuple(tangent.tolist()), basis, _periodic(mech), lo, hi)
 
-    return mech.derived(("path start", backend.compiled, tol), build)
+    # Keyed by the tolerances' value; the default ones (a module constant) by identity, saving the hash of
+    # their twenty-odd fields on almost every call.
+    key = ("path start", backend.compiled) if tol is DEFAULT else ("path start", backend.compiled, tol)
+    return mech.derived(key, build)
 
 
 def _periodic(mech: Mechanism) -> NDArray[np.bool_]:
@@ -202,22 +210,35 @@ def _drive_and_target(
         drive = until[0]  # (then the target's joint is the drive: looked up once)
     if drive is None:
         drive = mech.joint_names[int(np.flatnonzero(mech.groups >= 0)[0])]
-    d_joint = mech.index(drive)
-    d_unknown = int(mech.groups[d_joint])
+    d_joint, d_unknown, d_offset = _joint(mech, drive)
     if d_unknown < 0:
         raise SpecError(f"the drive joint {mech.joint_names[d_joint]} is fixed; choose a free joint")
     target = None
     if until is not None:
-        t_joint = d_joint if until[0] is drive else mech.index(until[0])
-        if t_joint != d_joint and mech.groups[t_joint] != d_unknown:
+        t_joint, t_unknown, t_offset = (
+            (d_joint, d_unknown, d_offset) if until[0] is drive else _joint(mech, until[0])
+        )
+        if t_joint != d_joint and t_unknown != d_unknown:
             raise SpecError(
                 f"until names joint {mech.joint_names[t_joint]} but the drive is {mech.joint_names[d_joint]}; "
                 "they must be the same joint (or coupled)"
             )
-        target = float(until[1]) - mech.offsets[t_joint]
+        target = float(until[1]) - t_offset
     if steps is not None and (target is None or steps < 1):
         raise SpecError("steps (the paper's equal drive steps) needs until=(joint, value) and steps >= 1")
     return d_joint, d_unknown, target
+
+
+def _joint(mech: Mechanism, joint: str | int) -> tuple[int, int, np.float64]:
+    """A joint's index, its unknown (``-1``: fixed) and its offset (the value at the reference, a numpy scalar):
+    :meth:`Mechanism.index`, ``groups`` and ``offsets`` read once per mechanism and joint name (an unknown name
+    raises on every call; a joint given by index is looked up afresh)."""
+
+    def build() -> tuple[int, int, np.float64]:
+        j = mech.index(joint)
+        return j, int(mech.groups[j]), mech.offsets[j]
+
+    return mech.derived(("joint", joint), build) if isinstance(joint, str) else build()
 
 
 def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, compiled: bool) -> int:
@@ -371,7 +392,7 @@ def _closed_form_trace(
     # The three records are built by `record` (every field at once, Branch's and TraceStats' defaults written
     # out): the same instances as their constructors make, in a third of the time.
     branch = record(
-        Branch, id=0, parent=None, bifurcation=None, direction=1, steps=steps, end_reason=StopReason.TARGET.text,
+        Branch, id=0, parent=None, bifurcation=None, direction=1, steps=steps, end_reason=_TARGET_TEXT,
         mobility=mobility, end_kind=StopReason.TARGET, end_joint=mech.joint_names[j],
         end_value=float(rows.angles[-1, j]), end_point=None,
     )  # fmt: skip
