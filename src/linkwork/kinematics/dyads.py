@@ -252,17 +252,17 @@ def closed_form_rows(
     if arrays is None:
         return None
     tol = settings.tol
-    values = [0.0] * N_SETTINGS
-    values[S_STEP] = settings.target / steps
-    values[S_TARGET] = settings.target
-    values[S_STEPS] = steps
-    values[S_HMAX] = settings.max_step
-    values[S_DET_BASIS] = _basis_sign(mech, basis)
-    values[S_MIN_RATIO] = tol.local_min
-    values[S_MIN_DRIVE] = MIN_DRIVE
-    values[S_MIN_MARGIN] = MIN_MARGIN
-    values[S_LOOSE] = tol.loose
-    run = np.array(values, dtype=float)
+    # The settings that hold for every trace of the mechanism from this start with these tolerances are kept;
+    # the call's own (its step, target, number of steps and longest step) are written into a copy.
+    fixed = mech.derived(
+        ("closed-form settings", basis.shape, basis.tobytes(), tol.local_min, tol.loose),
+        lambda: _fixed_settings(mech, basis, tol.local_min, tol.loose),
+    )
+    run = fixed.copy()
+    run[S_STEP] = settings.target / steps
+    run[S_TARGET] = settings.target
+    run[S_STEPS] = steps
+    run[S_HMAX] = settings.max_step
     periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)
     _count, status, angles, sigma, res, tau, s, full_rank = dyad_solver.closed_form_path(
         arrays[0], arrays[1], (run, np.ascontiguousarray(t0, dtype=float), settings.lo, settings.hi, periodic)
@@ -274,6 +274,21 @@ def closed_form_rows(
         sigma, full_rank = np.ascontiguousarray(sigma[:, :k]), False
     # The kernel's test holds every row to rank k; numerical_rank agrees with a floor at or below loose.
     return ClosedFormRows(angles, sigma, res, tau, s, bool(full_rank) and tol.floor <= tol.loose)
+
+
+def _fixed_settings(mech: Mechanism, basis: Array, local_min: float, loose: float) -> Array:
+    """The settings vector of :func:`~linkwork.kinematics.dyad_solver.closed_form_path` with what does not change
+    from one trace to the next written (the start's basis sign, the tolerances, :data:`MIN_DRIVE` and
+    :data:`MIN_MARGIN`) and zeros in the call's own entries; read-only (:func:`closed_form_rows` copies it)."""
+    values = [0.0] * N_SETTINGS
+    values[S_DET_BASIS] = _basis_sign(mech, basis)
+    values[S_MIN_RATIO] = local_min
+    values[S_MIN_DRIVE] = MIN_DRIVE
+    values[S_MIN_MARGIN] = MIN_MARGIN
+    values[S_LOOSE] = loose
+    fixed = np.array(values, dtype=float)
+    fixed.flags.writeable = False
+    return fixed
 
 
 def _path_arrays(
