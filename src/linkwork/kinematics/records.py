@@ -32,7 +32,8 @@ def _field_names(cls: type) -> frozenset[str]:
 def record(cls: type[R], **values: Any) -> R:
     """``cls(**values)`` for a frozen dataclass ``cls`` without ``__post_init__``, given every one of its fields
     (a missing or unknown name raises :class:`TypeError`): the same instance (equal, with the same ``__dict__``)
-    in a third of the time. The values are not converted or checked, as the generated ``__init__`` does not."""
+    in under half the time (1.2 against 2.8 us for a ``Trace``). The values are not converted or checked, as
+    the generated ``__init__`` does not convert or check them either."""
     names = _FIELDS.get(cls) or _field_names(cls)
     if values.keys() != names:
         missing, unknown = sorted(names - values.keys()), sorted(values.keys() - names)

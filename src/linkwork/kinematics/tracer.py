@@ -153,10 +153,9 @@ class PathStart(NamedTuple):
     """What every trace of one mechanism takes from its start, for one backend and tolerances (the start closes
     and its mobility is one): the path's rank ``r_path`` (the range basis's width), the number of singular values
     ``n_sigma``, the start's null vector ``tangent`` (``V^T[-1]``, not yet oriented; its ``components`` as Python
-    floats, for the test that orients it) and range ``basis`` (the
-    first ``r_path`` columns of ``U``, C-contiguous), which unknowns are ``periodic`` and the bounds ``lo, hi``
-    of a trace without limits (the arrays of :func:`_periodic` and :func:`_limits_in_unknowns`), all read-only:
-    one look-up a call instead of five."""
+    floats, for the test that orients it), the range ``basis`` (the first ``r_path`` columns of ``U``,
+    C-contiguous), which unknowns are ``periodic`` and the bounds ``lo, hi`` of a trace without limits (the arrays
+    of :func:`_periodic` and :func:`_limits_in_unknowns`), all read-only: one look-up a call instead of five."""
 
     r_path: int
     n_sigma: int
@@ -390,7 +389,7 @@ def _closed_form_trace(
         mobility = _branch_mobility(m - ranks)
     j = mech.first_joints[settings.drive]  # as BranchMarcher.end reports the drive at the last point
     # The three records are built by `record` (every field at once, Branch's and TraceStats' defaults written
-    # out): the same instances as their constructors make, in a third of the time.
+    # out): the same instances as their constructors make, in under half the time.
     branch = record(
         Branch, id=0, parent=None, bifurcation=None, direction=1, steps=steps, end_reason=_TARGET_TEXT,
         mobility=mobility, end_kind=StopReason.TARGET, end_joint=mech.joint_names[j],
