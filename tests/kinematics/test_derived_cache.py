@@ -235,3 +235,38 @@ def test_the_closed_form_trace_reports_what_the_marcher_would(
     assert np.array_equal(fast.rank, general.rank) and np.array_equal(fast.step, general.step)
     for array in (fast.angles, fast.sigma, fast.residual, fast.rank, fast.step, fast.branch, fast.test):
         assert array.flags.c_contiguous and array.flags.writeable
+
+
+def test_the_kept_path_start_is_per_backend_and_tolerances_and_refusals_are_not_kept() -> None:
+    """What a trace keeps of its start (path rank, null vector, range basis) is the start's, by a fresh numpy SVD
+    of the numpy closure Jacobian; it is kept per tolerances: tolerances that see the start's smallest singular
+    value as zero refuse the start (mobility 2) on every call, after and before traces with the defaults (kept
+    under their own key, as a module constant)."""
+    mech = lw.load("four-bar")
+    turn(mech)
+    _, sigma = reference_start(mech)
+    jac = closure.reduce(mech, closure.jacobian(mech, np.zeros(mech.n_joints)))
+    starts = [v for k, v in vars(mech)["_derived"].items() if isinstance(k, tuple) and k[0] == "path start"]
+    assert len(starts) == 1
+    (start,) = starts
+    assert start.r_path == numerical_rank(sigma) == 3 and start.n_sigma == len(sigma)
+    assert abs(float(np.linalg.norm(start.tangent)) - 1.0) < 1e-14
+    assert float(np.max(np.abs(jac @ start.tangent))) < 1e-13 * float(sigma[0])
+    np.testing.assert_allclose(start.basis.T @ start.basis, np.eye(3), rtol=0.0, atol=1e-14)
+    between = float(sigma[1] + sigma[2]) / (2.0 * float(sigma[0]))  # (0.27: zero below this, non-zero above)
+    blind = replace(DEFAULT, floor=between, loose=between)
+    for _ in range(2):
+        with pytest.raises(lw.LinkworkError, match="mobility 2"):
+            turn_with(mech, blind)
+        assert_same(turn(mech), turn(lw.load("four-bar")))
+    assert_same(
+        turn_with(mech, DEFAULT.with_closure(1e-6)),
+        turn_with(lw.load("four-bar"), DEFAULT.with_closure(1e-6)),
+    )
+    keys = [k for k in vars(mech)["_derived"] if isinstance(k, tuple) and k[0] == "path start"]
+    assert sorted(keys, key=len) == [("path start", True), ("path start", True, DEFAULT.with_closure(1e-6))]
+
+
+def turn_with(mech: Mechanism, tol: Tolerances) -> Trace:
+    """:func:`turn` with the tolerances ``tol``."""
+    return lw.trace(mech, until=("A", float(mech.offsets[mech.index("A")]) + 2.0 * np.pi), steps=90, tol=tol)

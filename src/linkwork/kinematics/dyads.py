@@ -16,7 +16,7 @@ import math
 import types
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -243,34 +243,29 @@ def closed_form_rows(
     ``t0`` the start's tangent and ``basis`` the start's range basis (its determinant orients the march's test
     function).
     """
-    m = mech.n_unknowns
     compiled = getattr(kernels, "compiled", isinstance(kernels, types.ModuleType))  # a backend, or the module
     if not compiled or settings.target is None or steps < 1:
         return None  # plain-Python kernels while numba's cache is cold: the tracer as before
-    if settings.r_path != mech.n_equations or m != mech.n_equations + 1:
+    if settings.r_path != mech.n_equations or mech.n_unknowns != mech.n_equations + 1:
         return None
-    plan = mech.derived(("dyad plan", drive), lambda: _frozen_plan(mech, drive))
-    if plan is None:
+    arrays = mech.derived(("closed-form arrays", drive), lambda: _path_arrays(mech, drive))
+    if arrays is None:
         return None
     tol = settings.tol
-    values = [0.0] * N_SETTINGS
-    values[S_STEP] = settings.target / steps
-    values[S_TARGET] = settings.target
-    values[S_STEPS] = steps
-    values[S_HMAX] = settings.max_step
-    values[S_DET_BASIS] = _basis_sign(mech, basis)
-    values[S_MIN_RATIO] = tol.local_min
-    values[S_MIN_DRIVE] = MIN_DRIVE
-    values[S_MIN_MARGIN] = MIN_MARGIN
-    values[S_LOOSE] = tol.loose
-    run = np.array(values, dtype=float)
-    twists, lj, ls, lp, _, groups = mech.kernel_arrays
-    flat = (twists, lj, ls, lp, groups)
+    # The settings that hold for every trace of the mechanism from this start with these tolerances are kept;
+    # the call's own (its step, target, number of steps and longest step) are written into a copy.
+    fixed = mech.derived(
+        ("closed-form settings", basis.shape, basis.tobytes(), tol.local_min, tol.loose),
+        lambda: _fixed_settings(mech, basis, tol.local_min, tol.loose),
+    )
+    run = fixed.copy()
+    run[S_STEP] = settings.target / steps
+    run[S_TARGET] = settings.target
+    run[S_STEPS] = steps
+    run[S_HMAX] = settings.max_step
     periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)
     _count, status, angles, sigma, res, tau, s, full_rank = dyad_solver.closed_form_path(
-        flat,
-        plan.arrays(),
-        (run, np.ascontiguousarray(t0, dtype=float), settings.lo, settings.hi, periodic),
+        arrays[0], arrays[1], (run, np.ascontiguousarray(t0, dtype=float), settings.lo, settings.hi, periodic)
     )
     if status != CLEAN:
         return None
@@ -279,3 +274,31 @@ def closed_form_rows(
         sigma, full_rank = np.ascontiguousarray(sigma[:, :k]), False
     # The kernel's test holds every row to rank k; numerical_rank agrees with a floor at or below loose.
     return ClosedFormRows(angles, sigma, res, tau, s, bool(full_rank) and tol.floor <= tol.loose)
+
+
+def _fixed_settings(mech: Mechanism, basis: Array, local_min: float, loose: float) -> Array:
+    """The settings vector of :func:`~linkwork.kinematics.dyad_solver.closed_form_path` with what does not change
+    from one trace to the next written (the start's basis sign, the tolerances, :data:`MIN_DRIVE` and
+    :data:`MIN_MARGIN`) and zeros in the call's own entries; read-only (:func:`closed_form_rows` copies it)."""
+    values = [0.0] * N_SETTINGS
+    values[S_DET_BASIS] = _basis_sign(mech, basis)
+    values[S_MIN_RATIO] = local_min
+    values[S_MIN_DRIVE] = MIN_DRIVE
+    values[S_MIN_MARGIN] = MIN_MARGIN
+    values[S_LOOSE] = loose
+    fixed = np.array(values, dtype=float)
+    fixed.flags.writeable = False
+    return fixed
+
+
+def _path_arrays(
+    mech: Mechanism, drive: int
+) -> tuple[tuple[NDArray[Any], ...], tuple[NDArray[Any], ...]] | None:
+    """The mechanism and plan tuples of :func:`~linkwork.kinematics.dyad_solver.closed_form_path` for the drive
+    joint ``drive`` (read-only arrays; ``None`` when ``mech`` is not a driver and dyads): kept on the mechanism
+    by :func:`closed_form_rows`, which then builds only the settings and the start's tangent a call."""
+    plan = mech.derived(("dyad plan", drive), lambda: _frozen_plan(mech, drive))
+    if plan is None:
+        return None
+    twists, lj, ls, lp, _, groups = mech.kernel_arrays
+    return (twists, lj, ls, lp, groups), plan.arrays()

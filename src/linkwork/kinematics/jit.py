@@ -66,7 +66,10 @@ class Backend:
 
 def mode() -> str:
     """The kernel mode from ``LINKWORK_JIT`` (``auto`` when unset); an unknown value is reported and ignored."""
-    value = os.environ.get("LINKWORK_JIT", "auto").strip().lower() or "auto"
+    value = os.environ.get("LINKWORK_JIT")
+    if value is None:  # the usual case, read on every trace: no string work
+        return "auto"
+    value = value.strip().lower() or "auto"
     if value not in MODES:
         log.warning("LINKWORK_JIT=%s is not one of %s; using auto", value, ", ".join(MODES))
         return "auto"

@@ -13,6 +13,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +25,7 @@ from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
+from linkwork.kinematics.records import record
 from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_result import Branch, Trace
 from linkwork.kinematics.trace_stats import TraceStats
@@ -31,6 +33,12 @@ from linkwork.kinematics.workspace import Workspace
 from linkwork.progress import Progress
 
 Array = NDArray[np.float64]
+
+_MAX_TURN = np.radians(10.0)
+"""The default ``max_turn`` of :func:`trace`, and its cosine (the settings' ``cos_turn``), computed once."""
+_COS_MAX_TURN = float(np.cos(_MAX_TURN))
+_TARGET_TEXT = StopReason.TARGET.text
+"""The end reason of a branch that reached its target (read once: ``StopReason.text`` hashes the enum)."""
 
 
 def trace(
@@ -41,7 +49,7 @@ def trace(
     *,
     max_step: float = np.radians(2.0),
     min_step: float = 1e-9,
-    max_turn: float = np.radians(10.0),
+    max_turn: float = _MAX_TURN,
     max_steps: int = 5000,
     branches: bool = False,
     limits: Mapping[str, tuple[float, float]] | None = None,
@@ -85,23 +93,21 @@ def trace(
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
     backend = select_backend(warm_up=warm_up)
     started = time.perf_counter()
-    r0, U0, s0, Vt0 = start_point(mech, backend)
-    if r0 > tol.start_slack * tol.closure:
-        raise LinkworkError(f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first")
-    r_path = _path_rank(mech, s0, m, tol, backend.compiled)
-    t_start = Vt0[-1].copy()
+    start = _path_start(mech, backend, tol)
+    r_path = start.r_path
     sign = 1.0
     if target is not None:
         sign = 1.0 if target >= 0 else -1.0
-    if t_start[d_unknown] * sign < 0:
-        t_start = -t_start
-    lo, hi = _limits_in_unknowns(mech, limits)
-    settings = MarchSettings(
-        drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=float(np.cos(max_turn)),
-        r_path=r_path, n_sigma=len(s0), periodic=_periodic(mech), lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
+    # A fresh array either way (the kept tangent is read-only and shared; the kernels get a writeable one).
+    t_start = -start.tangent if start.components[d_unknown] * sign < 0 else start.tangent.copy()
+    lo, hi = _limits_in_unknowns(mech, limits) if limits else (start.lo, start.hi)
+    cos_turn = _COS_MAX_TURN if max_turn is _MAX_TURN else float(np.cos(max_turn))
+    settings = record(
+        MarchSettings, drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=cos_turn,
+        r_path=r_path, n_sigma=start.n_sigma, periodic=start.periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
     )  # fmt: skip
     paper = steps is not None
-    basis0 = np.ascontiguousarray(U0[:, :r_path])  # read-only (the start's, shared): the marches get copies
+    basis0 = start.basis  # read-only (the start's, shared): the marches get copies
     if paper and steps is not None and steps <= max_steps:
         # A planar driver-and-dyads mechanism: the same rows in closed form, unless a singular point is near.
         rows = closed_form_rows(mech, backend, d_joint, settings, steps, t_start, basis0)
@@ -143,6 +149,47 @@ def start_point(mech: Mechanism, backend: Backend) -> tuple[float, Array, Array,
     return mech.derived(("trace start", backend.compiled), evaluate)
 
 
+class PathStart(NamedTuple):
+    """What every trace of one mechanism takes from its start, for one backend and tolerances (the start closes
+    and its mobility is one): the path's rank ``r_path`` (the range basis's width), the number of singular values
+    ``n_sigma``, the start's null vector ``tangent`` (``V^T[-1]``, not yet oriented; its ``components`` as Python
+    floats, for the test that orients it), the range ``basis`` (the first ``r_path`` columns of ``U``,
+    C-contiguous), which unknowns are ``periodic`` and the bounds ``lo, hi`` of a trace without limits (the arrays
+    of :func:`_periodic` and :func:`_limits_in_unknowns`), all read-only: one look-up a call instead of five."""
+
+    r_path: int
+    n_sigma: int
+    tangent: Array
+    components: tuple[float, ...]
+    basis: Array
+    periodic: NDArray[np.bool_]
+    lo: Array
+    hi: Array
+
+
+def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart:
+    """The :class:`PathStart` of ``mech``, checked (a start that does not close, is rigid or has a mobility above
+    one raises, on every call: nothing is kept then), once per mechanism, backend and tolerances."""
+
+    def build() -> PathStart:
+        r0, U0, s0, Vt0 = start_point(mech, backend)
+        if r0 > tol.start_slack * tol.closure:
+            raise LinkworkError(
+                f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first"
+            )
+        r_path = _path_rank(mech, s0, mech.n_unknowns, tol, backend.compiled)
+        basis = np.ascontiguousarray(U0[:, :r_path])
+        basis.flags.writeable = False
+        lo, hi = _limits_in_unknowns(mech, None)
+        tangent = Vt0[-1]  # read-only, as Vt0
+        return PathStart(r_path, len(s0), tangent, tuple(tangent.tolist()), basis, _periodic(mech), lo, hi)
+
+    # Keyed by the tolerances' value; the default ones (a module constant) by identity, saving the hash of
+    # their twenty-odd fields on almost every call.
+    key = ("path start", backend.compiled) if tol is DEFAULT else ("path start", backend.compiled, tol)
+    return mech.derived(key, build)
+
+
 def _periodic(mech: Mechanism) -> NDArray[np.bool_]:
     """Which unknowns are revolute (compared modulo a turn), read-only, once per mechanism."""
 
@@ -159,25 +206,38 @@ def _drive_and_target(
 ) -> tuple[int, int, float | None]:
     """The drive joint, its unknown and the target in the unknowns (checked against each other and ``steps``)."""
     if until is not None and drive is None:
-        drive = until[0]
+        drive = until[0]  # (then the target's joint is the drive: looked up once)
     if drive is None:
         drive = mech.joint_names[int(np.flatnonzero(mech.groups >= 0)[0])]
-    d_joint = mech.index(drive)
-    d_unknown = int(mech.groups[d_joint])
+    d_joint, d_unknown, d_offset = _joint(mech, drive)
     if d_unknown < 0:
         raise SpecError(f"the drive joint {mech.joint_names[d_joint]} is fixed; choose a free joint")
     target = None
     if until is not None:
-        t_joint = mech.index(until[0])
-        if t_joint != d_joint and mech.groups[t_joint] != d_unknown:
+        t_joint, t_unknown, t_offset = (
+            (d_joint, d_unknown, d_offset) if until[0] is drive else _joint(mech, until[0])
+        )
+        if t_joint != d_joint and t_unknown != d_unknown:
             raise SpecError(
                 f"until names joint {mech.joint_names[t_joint]} but the drive is {mech.joint_names[d_joint]}; "
                 "they must be the same joint (or coupled)"
             )
-        target = float(until[1]) - mech.offsets[t_joint]
+        target = float(until[1]) - t_offset
     if steps is not None and (target is None or steps < 1):
         raise SpecError("steps (the paper's equal drive steps) needs until=(joint, value) and steps >= 1")
     return d_joint, d_unknown, target
+
+
+def _joint(mech: Mechanism, joint: str | int) -> tuple[int, int, np.float64]:
+    """A joint's index, its unknown (``-1``: fixed) and its offset (the value at the reference, a numpy scalar):
+    :meth:`Mechanism.index`, ``groups`` and ``offsets`` read once per mechanism and joint name (an unknown name
+    raises on every call; a joint given by index is looked up afresh)."""
+
+    def build() -> tuple[int, int, np.float64]:
+        j = mech.index(joint)
+        return j, int(mech.groups[j]), mech.offsets[j]
+
+    return mech.derived(("joint", joint), build) if isinstance(joint, str) else build()
 
 
 def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, compiled: bool) -> int:
@@ -328,35 +388,25 @@ def _closed_form_trace(
         ranks = numerical_ranks(sigma, tol, backend.compiled)
         mobility = _branch_mobility(m - ranks)
     j = mech.first_joints[settings.drive]  # as BranchMarcher.end reports the drive at the last point
-    branch = Branch(
-        0, None, None, 1, steps, StopReason.TARGET.text, mobility=mobility,
-        end_kind=StopReason.TARGET, end_joint=mech.joint_names[j], end_value=float(rows.angles[-1, j]),
+    # The three records are built by `record` (every field at once, Branch's and TraceStats' defaults written
+    # out): the same instances as their constructors make, in under half the time.
+    branch = record(
+        Branch, id=0, parent=None, bifurcation=None, direction=1, steps=steps, end_reason=_TARGET_TEXT,
+        mobility=mobility, end_kind=StopReason.TARGET, end_joint=mech.joint_names[j],
+        end_value=float(rows.angles[-1, j]), end_point=None,
     )  # fmt: skip
-    stats = TraceStats(
-        start_rank=settings.r_path,
-        start_mobility=m - settings.r_path,
-        mode="paper",
-        closure_tol=tol.closure,
-        max_misfit=float(max(0.0, float(residual.max()))),
-        has_target=until is not None,
-        points=count,
-        seconds=time.perf_counter() - started,
-    )
-    return Trace(
-        mechanism=mech,
-        drive=mech.joint_names[d_joint],
-        angles=rows.angles,
-        sigma=sigma,
-        residual=residual,
-        branch=np.zeros(count, dtype=np.int64),
-        step=np.arange(count, dtype=np.int64),
-        arclength=rows.arclength,
-        test=rows.test,
-        rank=ranks,
-        bifurcations=(),
-        branches=(branch,),
-        stats=stats,
-    )
+    stats = record(
+        TraceStats, start_rank=settings.r_path, start_mobility=m - settings.r_path, mode="paper",
+        closure_tol=tol.closure, max_misfit=float(max(0.0, float(np.maximum.reduce(residual)))),
+        sign_changes_without_rank_drop=0, branches_not_retraced=0, has_target=until is not None, unmet=None,
+        points=count, seconds=time.perf_counter() - started,
+    )  # fmt: skip
+    return record(
+        Trace, mechanism=mech, drive=mech.joint_names[d_joint], angles=rows.angles, sigma=sigma,
+        residual=residual, branch=np.zeros(count, dtype=np.int64), step=np.arange(count, dtype=np.int64),
+        arclength=rows.arclength, test=rows.test, rank=ranks, bifurcations=(), branches=(branch,), stats=stats,
+        folds=(),
+    )  # fmt: skip
 
 
 def _angles(mech: Mechanism, U: Array, compiled: bool = False) -> Array:
