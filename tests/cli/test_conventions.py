@@ -174,6 +174,16 @@ def test_a_joint_coupled_to_itself_is_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "t").exists()
 
 
+def test_an_animation_without_figures_is_refused(tmp_path: Path) -> None:
+    """``--animate --no-plots`` wrote no animation and said nothing (exit 0): the animation is one of the
+    figures, so the pair contradicts itself; one line, exit 2, nothing written."""
+    result = runner.invoke(app, ["trace", "four-bar", "--animate", "--no-plots", "-o", str(tmp_path / "t")])
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: --animate") and "--no-plots" in lines[0]
+    assert not (tmp_path / "t").exists()
+
+
 @pytest.mark.parametrize("kind", ["a file", "a name too long"])
 def test_a_cache_folder_that_cannot_be_written_stops_compile_at_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str

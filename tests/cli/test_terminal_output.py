@@ -122,3 +122,24 @@ def test_a_users_path_in_a_summary_line_sends_no_control_characters(
     assert result.exit_code == 0, result.stderr
     assert "\x1b" not in result.stdout and "\r" not in result.stdout
     assert "a\\x1b[31mred\\rX" in result.stdout
+
+
+def test_a_closed_standard_output_ends_the_command_with_141_quietly() -> None:
+    """``linkwork linkages | head``: the reader closes the pipe before linkwork writes its table; the command
+    ends with exit code 141 (``128 + SIGPIPE``, as the README's exit codes say) and nothing on stderr (rich's own
+    handling exits 1, a code linkwork does not have; Python's would print a BrokenPipeError traceback)."""
+    import subprocess
+    import sys
+
+    from linkwork.outputs.staging import CLOSED_PIPE
+
+    with subprocess.Popen(
+        [sys.executable, "-c", "from linkwork.cli import app; app()", "linkages"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    ) as proc:
+        assert proc.stdout is not None and proc.stderr is not None
+        proc.stdout.close()  # before the table is written: importing linkwork takes far longer than this
+        err = proc.stderr.read()
+        assert proc.wait(timeout=120) == CLOSED_PIPE == 141
+    assert err == b""

@@ -153,6 +153,10 @@ def trace(
     check_range("--max-steps", max_steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
     if steps is not None:
         check_range("--steps", steps, 1, MAX_TRACE_STEPS, "a whole number of steps")
+    if animate and no_plots:  # the animation is one of the figures: asking for it and for none contradicts
+        raise fail(
+            "--animate: the animation is a figure and --no-plots leaves the figures out; expected one of the two"
+        )
     target = parse_until(until)
     limits_file = _parse_limits(limit)
     if not (math.isfinite(closure_tol) and closure_tol > 0):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 from typing import Any
 
 from rich.align import AlignMethod
@@ -41,6 +42,10 @@ def _escaped(text: str) -> str:
     return _CONTROL.sub(lambda m: repr(m.group(0))[1:-1], text)
 
 
+CLOSED_PIPE = 141
+"""The exit code of a command whose standard output was closed by its reader (``128 + SIGPIPE``)."""
+
+
 class _SummaryConsole(Console):
     """A console as wide as a terminal on a terminal, and :data:`FILE_WIDTH` wide on a file or a pipe (unless
     ``COLUMNS`` says otherwise), so a table saved to a file keeps its full headers and rows ("transmission", not
@@ -71,6 +76,16 @@ class _SummaryConsole(Console):
         breaks and tabs: a path or a name a user gave (``-o $'a\\x1b[31m'``) can never send escape sequences to
         the terminal or move the cursor (``\\r``) from a summary line."""
         super().print(*(_escaped(o) if isinstance(o, str) else o for o in objects), **options)
+
+    def on_broken_pipe(self) -> None:
+        """The reader of the standard output closed it (``linkwork linkages | head``): quiet from here on, as
+        rich is, and exit code 141 (``128 + SIGPIPE``, the shell's code for a writer whose pipe closed, like 130
+        and 143 for Ctrl-C and SIGTERM), not rich's 1, which linkwork's exit codes do not have. Whatever the
+        command wrote to files before is kept."""
+        self.quiet = True
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        raise SystemExit(CLOSED_PIPE)
 
     def rule(
         self,
