@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 __all__ = [
     "COLUMN_PREFIX",
+    "FORMULA_START",
     "MAX_NAME_CHARS",
     "MJCF_RESERVED",
     "NameMap",
@@ -49,6 +50,10 @@ MAX_NAME_CHARS = 100
 
 COLUMN_PREFIX = "joint:"
 """The prefix of a CSV column whose joint name clashes with a fixed column (``step`` is written ``joint:step``)."""
+
+FORMULA_START = frozenset("=+-@\t\r")
+"""Characters that make a spreadsheet read a cell as a formula when it starts with one (``=HYPERLINK(...)``):
+a CSV column name starting with one is written with :data:`COLUMN_PREFIX`."""
 
 MJCF_RESERVED = frozenset({"world"})
 """Body names MuJoCo reserves (the world body)."""
@@ -148,9 +153,10 @@ def csv_columns(
 ) -> NameMap:
     """The column stem of every name in a CSV file with ``fixed`` columns (and columns matching the regular
     expressions ``patterns``, e.g. ``sigma_\\d+``): a name whose column (the name plus any of ``suffixes``)
-    would be a fixed one, or that starts with :data:`COLUMN_PREFIX`, is written with that prefix. The mapping is
-    one to one (a prefixed stem never equals an unprefixed one), so reading the file back finds every name's
-    column again through this same function."""
+    would be a fixed one, that starts with :data:`COLUMN_PREFIX`, or that starts with a character a spreadsheet
+    takes for a formula (:data:`FORMULA_START`: a file opened in a spreadsheet must not run a user's name as a
+    formula), is written with that prefix. The mapping is one to one (a prefixed stem never equals an unprefixed
+    one), so reading the file back finds every name's column again through this same function."""
     compiled = [re.compile(p) for p in patterns]
     written: dict[str, str] = {}
     reasons: dict[str, str] = {}
@@ -158,15 +164,18 @@ def csv_columns(
         columns = [name + s for s in suffixes]
         clash = [c for c in columns if c in fixed or any(p.fullmatch(c) for p in compiled)]
         encodable = not _SURROGATE.search(name)
-        if clash or name.startswith(COLUMN_PREFIX) or not encodable:
+        formula = name[:1] in FORMULA_START
+        if clash or name.startswith(COLUMN_PREFIX) or formula or not encodable:
             # a lone surrogate (only a Python caller can make one) cannot be written as UTF-8: its escape is
             written[name] = COLUMN_PREFIX + name.encode("utf-8", "backslashreplace").decode("utf-8")
             reasons[name] = (
                 f"{clash[0]!r} is a fixed column"
                 if clash
-                else f"starts with {COLUMN_PREFIX!r}"
-                if encodable
                 else "not encodable as UTF-8"
+                if not encodable
+                else f"starts with {name[:1]!r}, which a spreadsheet reads as a formula"
+                if formula
+                else f"starts with {COLUMN_PREFIX!r}"
             )
         else:
             written[name] = name

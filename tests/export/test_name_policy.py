@@ -26,6 +26,7 @@ from linkwork.kinematics.mechanism import Mechanism
 from linkwork.linkages.registry import REGISTRY
 from linkwork.names import (
     COLUMN_PREFIX,
+    FORMULA_START,
     MJCF_RESERVED,
     csv_columns,
     describe,
@@ -190,7 +191,9 @@ def test_csv_columns_are_one_to_one_and_avoid_fixed_columns(joints: list[str]) -
     for j in joints:
         col = path[j]
         assert col not in PATH_FIXED and not re.fullmatch(r"sigma_\d+", col)
-        assert col == j or col == COLUMN_PREFIX + j
+        escaped = j.encode("utf-8", "backslashreplace").decode("utf-8")  # a lone surrogate: its escape
+        assert col == j or col == COLUMN_PREFIX + escaped
+        assert col[:1] not in FORMULA_START  # never a formula in a spreadsheet
     sweep = joint_columns(joints, grid=["twist"])
     cols = [f"{sweep[j]}{s}" for j in joints for s in ("_min", "_max")]
     assert len(set(cols)) == len(cols) and not set(cols) & {*SWEEP_FIXED, "twist"}
@@ -211,6 +214,27 @@ def test_a_joint_named_like_a_fixed_column_keeps_its_values(tmp_path: Path) -> N
     assert float(first["joint:step"]) == pytest.approx(np.degrees(trace.angles[0, 0]), rel=1e-15)
     line = describe(path_columns(mech.joint_names))
     assert line is not None and '"step" written as "joint:step"' in line
+
+
+def test_a_joint_named_like_a_formula_is_never_one_in_a_spreadsheet(tmp_path: Path) -> None:
+    """A joint named ``=HYPERLINK(...)`` (or starting with ``+``, ``-``, ``@``): a spreadsheet opening path.csv
+    would run its column name as a formula; it is written ``joint:=HYPERLINK(...)``, the report says why, and the
+    column is read back (``path_columns``) with the joint's values."""
+    names = ['=HYPERLINK("http://x","y")', "+1", "-A", "@SUM(A1)"]
+    mech = four_bar(names, ["ground", "crank", "coupler", "rocker"])
+    trace = lw.trace(mech, max_steps=5)
+    write_path_csv(trace, tmp_path / "path.csv")
+    with open(tmp_path / "path.csv", newline="") as fh:
+        header = next(csv.reader(fh))
+    assert not [c for c in header if c[:1] in FORMULA_START]
+    assert {COLUMN_PREFIX + n for n in names} <= set(header)
+    columns = path_columns(mech.joint_names)
+    line = describe(columns)
+    assert line is not None and "a spreadsheet reads as a formula" in line
+    frame = np.genfromtxt(tmp_path / "path.csv", delimiter=",", names=None, skip_header=1)
+    for j, name in enumerate(names):
+        k = header.index(columns[name])
+        np.testing.assert_allclose(frame[:, k], np.degrees(trace.angles[:, j]), rtol=1e-15)
 
 
 def test_world_is_mapped_and_reported() -> None:
