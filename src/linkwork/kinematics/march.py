@@ -34,6 +34,10 @@ TURNING = int(StopReason.TURNING)
 NO_PROGRESS = int(StopReason.NO_PROGRESS)
 NO_EVENT = -1  # step_event: the step ends nothing
 TURNED = -2  # predict's ``held`` when the drive has turned back in paper mode
+MAX_PARTS = 1024
+"""Paper mode: the most equal parts a row's drive step is taken in where the whole step jumps or fails (next to
+a fold of the drive the path moves as the square root of the drive's distance to the fold); beyond, the march
+fails there."""
 
 MECHANISM = ("twists", "loop_joint", "loop_sign", "loop_ptr", "rows", "groups")
 """The members of the mechanism tuple every kernel takes (see :mod:`linkwork.kinematics.kernels`)."""
@@ -41,7 +45,7 @@ CORRECTOR = ("tol", "exact", "roundoff", "truncate", "max_iter")
 """The members of :func:`correct`'s settings tuple."""
 MARCH_ARGUMENTS = {
     "mech": MECHANISM,
-    "start": ("u0", "t0", "u_home", "basis"),
+    "start": ("u0", "t0", "u_home", "basis", "reach"),
     "steps": (
         "paper", "drive", "h0", "hmin", "hmax", "cos_turn", "target", "has_target", "advance", "stall_steps",
         "stall_length", "max_steps", "r_path", "detect", "check_closed",
@@ -388,10 +392,9 @@ def snap_home(u, u_home, periodic, out):
     """``out``: the start ``u_home`` written in the continuous angles of ``u`` (revolute unknowns differ from it
     by whole turns), the last row of a closed path."""
     for a in range(u.shape[0]):
-        diff = u_home[a] - u[a]
-        if periodic[a]:
-            diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # compiled copy of linkwork.geometry.angles.wrap
-        out[a] = u[a] + diff
+        turns = np.round((u[a] - u_home[a]) * (0.5 / np.pi)) if periodic[a] else 0.0
+        # the start itself where no whole turn separates them (bit for bit), else the start plus the turns
+        out[a] = u_home[a] + 2.0 * np.pi * turns if turns != 0.0 else u_home[a]
 
 
 @kernel()
@@ -473,13 +476,14 @@ def march(mech, start, steps, corrector, bounds, out):
     """March from ``(u0, t0)`` for at most ``max_steps`` steps; row 0 of the outputs is the start.
 
     The arguments are tuples (:data:`MARCH_ARGUMENTS` names their members): ``mech`` the mechanism's arrays (see
-    :mod:`~linkwork.kinematics.kernels`); ``start = (u0, t0, u_home, basis)``; ``steps = (paper, drive, h0,
+    :mod:`~linkwork.kinematics.kernels`); ``start = (u0, t0, u_home, basis, reach)``; ``steps = (paper, drive, h0,
     hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length, max_steps, r_path, detect,
     check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi)``;
     ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s)``, the rows written. numba unpacks each tuple once
     per call; the inner kernels get the tuples they need.
 
-    ``u_home`` is where the path began (for closed-path detection across several calls).
+    ``u_home`` is where the path began and ``reach = [far, longest]`` how far the path has gone from it and its
+    longest step (zeros for a new path; updated in place), for closed-path detection across several calls.
 
     An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h`` along
     the tangent (the corrector pulled it back); an adaptive march stops with ``NO_PROGRESS`` when its last
@@ -491,7 +495,7 @@ def march(mech, start, steps, corrector, bounds, out):
     otherwise adaptive arclength steps in ``[hmin, hmax]`` with the minimum-norm corrector. Returns
     ``(count, code, h)``: rows written, the stop code and the last step length.
     """
-    u0, t0, u_home, basis = start
+    u0, t0, u_home, basis, reach = start
     (
         paper, drive, h0, hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length,
         max_steps, r_path, detect, check_closed,
@@ -520,16 +524,23 @@ def march(mech, start, steps, corrector, bounds, out):
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
     s_total = 0.0
     basis_try = basis.copy()
-    far = wrapped_distance(u0, u_home, periodic)
+    far = max(reach[0], wrapped_distance(u0, u_home, periodic))
+    longest = reach[1]  # the longest step of the path (a closed path has gone several of them from its start)
     recent = np.zeros(max(stall_steps, 1))  # lengths of the last stall_steps steps (a ring)
     count = 1
+    # Paper mode: a row's equal drive step is taken in ``parts`` equal parts where one step jumps or fails (next
+    # to a fold the tangent's prediction ``h / t_drive`` is far too long); only the last part writes a row. The
+    # row's start is kept to go back to.
+    parts, part = 1, 0
+    u_row, t_row, basis_row = u.copy(), t.copy(), basis.copy()
     while count <= max_steps:
         # ---- predictor (Sec. 4.1)
-        step, landing, held = predict(u, t, h, paper, drive, target, has_target, count == 1, u_try)
+        first = count == 1 and part == 0
+        step, landing, held = predict(u, t, h / parts, paper, drive, target, has_target, first, u_try)
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
         if (
-            paper and count >= 2
+            paper and count >= 2 and parts == 1
         ):  # the last two points and their tangents predict better than the tangent alone
             extrapolate(out[0][count - 2], out[1][count - 2], u, t, drive, u_try, 0.1 * abs(step))
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
@@ -545,19 +556,37 @@ def march(mech, start, steps, corrector, bounds, out):
             turn, dist, ahead = step_geometry(u, t, u_try, t_new)
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, step, cos_turn, advance)
+            elif paper:
+                ok = not jumps(u, u_try, periodic)
         if not ok:
-            if paper:
-                return count, FAILED, h
+            if paper:  # the row's step again from its start, in twice as many parts
+                if parts >= MAX_PARTS:
+                    return count, FAILED, h
+                parts, part = 2 * parts, 0
+                u[:] = u_row
+                t[:] = t_row
+                basis[:, :] = basis_row
+                continue
             h *= 0.5
             if h < hmin:
                 return count, FAILED, h
             continue
         # ---- accept the step
         s_total += dist
+        longest = max(longest, dist)
+        reach[1] = longest
         for a in range(m):
             u[a] = u_try[a]
             t[a] = t_new[a]
         basis[:, :] = basis_try
+        if paper and part < parts - 1:  # a part of the row's step: on to the next, no row
+            part += 1
+            continue
+        if paper:
+            parts, part = 1, 0
+            u_row[:] = u
+            t_row[:] = t
+            basis_row[:, :] = basis
         write_row(out, count, u, t, sig, r, tau_new, s_total)
         recent[count % recent.shape[0]] = dist
         count += 1
@@ -570,7 +599,8 @@ def march(mech, start, steps, corrector, bounds, out):
         if check_closed:
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
             far = max(far, d)
-            if far > 4.0 * hmax and d < 1.5 * abs(h):
+            reach[0] = far
+            if back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
                 close_path(u, u_home, periodic, count - 1, out_u, out_sigma, out_res, out_tau)
                 return count, CLOSED, h
         # ---- step control: grow an easy adaptive step (judged in the unknowns, so that it does not depend on the
@@ -578,6 +608,36 @@ def march(mech, start, steps, corrector, bounds, out):
         if not paper and easy and turn > np.sqrt(cos_turn):
             h = min(h * 1.5, hmax)
     return count, BUDGET, h
+
+
+@kernel(inline="always")
+def jumps(u, u_try, periodic):
+    """Whether a paper-mode step from ``u`` to ``u_try`` turned a revolute unknown by more than a quarter turn:
+    the corrector went to another part of the path (or the same configuration counted whole turns on), where a
+    step along the path would have moved it less; the step is then taken in parts."""
+    for a in range(u.shape[0]):
+        if periodic[a] and abs(u_try[a] - u[a]) > 0.5 * np.pi:
+            return True
+    return False
+
+
+@kernel(inline="always")
+def back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
+    """Whether the point ``u``, ``d`` from the path's start ``u_home`` (``far`` the farthest the path went), closes
+    the path.
+
+    Adaptive steps: within one and a half steps of the start after going more than four of the longest steps
+    taken away (so that a small closed loop, shorter than a few ``hmax``, is recognised too). Paper mode: the
+    drive back at its start value to round-off after whole turns, and every other unknown within half a step
+    (equal drive steps close a path only by landing on its start: a step near the start, or the one before the
+    last of a full turn, is not the start)."""
+    if not paper:
+        return far > 4.0 * longest and d < 1.5 * abs(h)
+    turned = u[drive] - u_home[drive]
+    if not periodic[drive] or abs(turned) < np.pi:
+        return False
+    off = (turned + np.pi) % (2.0 * np.pi) - np.pi
+    return abs(off) <= 1e-9 * max(1.0, abs(turned)) and d < 0.5 * abs(h)
 
 
 @kernel(inline="always")

@@ -182,8 +182,10 @@ class BranchMarcher:
         h0: float,
         n: int,
         check_closed: bool,
+        reach: Array,
     ) -> Chunk:
-        """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place)."""
+        """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place; ``reach
+        = [far, longest]``: how far the path has gone from ``u_home`` and its longest step, updated in place)."""
         cfg, tol, m = self.cfg, self.cfg.tol, len(u)
         out = Chunk(
             u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
@@ -208,7 +210,7 @@ class BranchMarcher:
             check_closed,
         )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
-            ws.kernel_arrays(), (u, t, u_home, basis), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi),
+            ws.kernel_arrays(), (u, t, u_home, basis, reach), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi),
             (out.u, out.t, out.sigma, out.res, out.tau, out.s),
         )  # fmt: skip
         return out
@@ -270,6 +272,7 @@ class BranchMarcher:
         for the drive, the located point it ended on or ``None``)."""
         u, t = u0.copy(), t0.copy()
         u_home = u0.copy() if opened_at is None else opened_at[0].copy()
+        reach = np.zeros(2)  # how far the path has gone from u_home, and its longest step (march.back_home)
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
         while True:
@@ -277,7 +280,7 @@ class BranchMarcher:
             if n <= 0 and not first:
                 return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
             basis_prev = basis.copy()
-            chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
+            chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed, reach)
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
             if chunk.code == StopReason.CLOSED:
                 home.copy_to(chunk, chunk.count - 1)
@@ -351,6 +354,7 @@ class BranchMarcher:
             elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
                 # A full turn of the drive: the target is further round.
                 u_home = chunk.u[chunk.count - 1].copy()
+                reach[:] = 0.0
             elif chunk.code != StopReason.BUDGET or self.budget <= 0:
                 if limit is not None:
                     return n_steps, StopReason.LIMIT, limit[1], limit[0], None
