@@ -103,3 +103,25 @@ def test_paper_mode_first_step_near_a_fold(tmp_path: Path, target: float) -> Non
     assert trace.stats.unmet is None
     a = np.degrees(np.asarray(trace.angles)[:, 0])
     assert np.max(np.abs(np.diff(a))) < 90.0  # the closed form: at most 33 deg a step, on the last one
+
+
+@pytest.mark.xfail(
+    strict=True, reason="closed-path detection near a bifurcation point: false and missed closures"
+)
+@pytest.mark.parametrize("theta", [181.0, 182.0])
+def test_change_point_started_next_to_its_crossing_closes_after_two_turns(
+    tmp_path: Path, theta: float
+) -> None:
+    """Grashof's change-point four-bar (4, 1.5, 3, 2.5) goes round its whole loop in two crank turns, through the
+    crossing at A = 180 deg and again at 540 (the path from A = 60 closes at 780). Started at 181 or 182 deg it
+    must close at A = theta + 720 and report the crossing.
+
+    Got: theta = 181, 'closed path' at A = 541 (the row at 541 lies on the branch crossing the start's, 1.8 deg
+    from the start, and is snapped onto it) with no bifurcation reported; theta = 182, no closure at 902 (the
+    march restarted after passing the known point at 900 and its `far` guard was not yet armed) and a false one
+    at 1262, a 3.9-deg step snapped across from the other branch."""
+    case = FourBar("change-point", 4.0, 1.5, 3.0, 2.5, theta)
+    trace = lw.trace(load(tmp_path, "cp", case.mech.toml()))
+    assert trace.branches[0].end_kind == lw.StopReason.CLOSED
+    assert np.degrees(trace.branches[0].end_value) == pytest.approx(theta + 720.0, abs=1e-9)
+    assert len(trace.bifurcations) == 1
