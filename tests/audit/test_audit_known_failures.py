@@ -125,3 +125,22 @@ def test_change_point_started_next_to_its_crossing_closes_after_two_turns(
     assert trace.branches[0].end_kind == lw.StopReason.CLOSED
     assert np.degrees(trace.branches[0].end_value) == pytest.approx(theta + 720.0, abs=1e-9)
     assert len(trace.bifurcations) == 1
+
+
+@pytest.mark.xfail(
+    strict=True, reason="closed-path guard `far` restarts with every march chunk (CLI: every 100 steps)"
+)
+@pytest.mark.parametrize("max_step", [1.085, 1.089])
+def test_closure_does_not_depend_on_progress_chunks(tmp_path: Path, max_step: float) -> None:
+    """The audit's crank-rocker closes after one crank turn (about 503 rows) however the march is chunked.
+
+    Got, with a progress callback (what the CLI always passes: chunks of 100 steps, each re-arming the
+    closed-path guard from its own first point): 1006, 1505 and 4501 rows, the crank turned 2, 3 and 9 times.
+    Without one, 504, 503 and 502 rows. The built-in four-bar shows it on the command line:
+    `linkwork trace four-bar --max-step 1.408` runs out of steps (5001 rows, A = 4584 deg)."""
+    case = FourBar("crank-rocker", 4.0, 1.3, 3.7, 2.9, 35.0)
+    mech = load(tmp_path, "cr", case.mech.toml())
+    plain = lw.trace(mech, max_step=max_step * RAD)
+    chunked = lw.trace(mech, max_step=max_step * RAD, max_steps=1200, progress=lambda *a: None)
+    assert chunked.branches[0].end_kind == lw.StopReason.CLOSED
+    assert len(chunked.angles) == len(plain.angles)
