@@ -1,5 +1,6 @@
-"""Failures the audit found in the tracer (kinematics/, the lead's area), as strict expected failures: each passes
-(and so fails the suite, strict) once the tracer is fixed, when its mark should go. See changes/audit.md.
+"""Failures the audit found in the tracer (kinematics/), as regression tests; the two not fixed yet are strict
+expected failures (each passes, and so fails the suite, once the tracer is fixed, when its mark should go). See
+changes/audit.md and CHANGELOG.md.
 
 Each reference is the audit's own: the paper mode's promise of N equal drive steps, the law of cosines for a
 four-bar's extremes, and the same linkage written in another length unit.
@@ -24,9 +25,6 @@ def load(tmp_path: Path, name: str, text: str) -> lw.Mechanism:
     return lw.load(str(spec))
 
 
-@pytest.mark.xfail(
-    strict=True, reason="paper mode: the closed-path snap fires on the first step / skips the last"
-)
 @pytest.mark.parametrize("steps", [36, 360])
 def test_paper_mode_full_turn_takes_equal_steps(tmp_path: Path, steps: int) -> None:
     """A double crank's output crank D driven one full turn in N equal steps: N + 1 rows, D at k * 360 / N.
@@ -70,9 +68,6 @@ def test_slider_crank_steps_do_not_depend_on_the_length_unit(tmp_path: Path) -> 
     assert len(t1.angles) == len(t1000.angles)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="closed-path detection needs the path to go 4 max-steps from its start"
-)
 def test_small_closed_loop_is_recognised(tmp_path: Path) -> None:
     """A nearly rigid non-Grashof four-bar (ground 2.9999, the others 1): its whole loop is about 8 deg of
     arclength and the input rocks within +-0.6616 deg (law of cosines). The path must close after one lap.
@@ -86,9 +81,6 @@ def test_small_closed_loop_is_recognised(tmp_path: Path) -> None:
     assert len(trace.folds) == 2
 
 
-@pytest.mark.xfail(
-    strict=True, reason="paper mode: the first predictor step near a fold overshoots by whole turns"
-)
 @pytest.mark.parametrize("target", [-30.0, -54.958143662771])
 def test_paper_mode_first_step_near_a_fold(tmp_path: Path, target: float) -> None:
     """The crank-rocker's rocker D starts 0.00127 deg below its upper extreme (law of cosines) and is driven down
@@ -105,9 +97,6 @@ def test_paper_mode_first_step_near_a_fold(tmp_path: Path, target: float) -> Non
     assert np.max(np.abs(np.diff(a))) < 90.0  # the closed form: at most 33 deg a step, on the last one
 
 
-@pytest.mark.xfail(
-    strict=True, reason="closed-path detection near a bifurcation point: false and missed closures"
-)
 @pytest.mark.parametrize("theta", [181.0, 182.0])
 def test_change_point_started_next_to_its_crossing_closes_after_two_turns(
     tmp_path: Path, theta: float
@@ -127,9 +116,6 @@ def test_change_point_started_next_to_its_crossing_closes_after_two_turns(
     assert len(trace.bifurcations) == 1
 
 
-@pytest.mark.xfail(
-    strict=True, reason="closed-path guard `far` restarts with every march chunk (CLI: every 100 steps)"
-)
 @pytest.mark.parametrize("max_step", [1.085, 1.089])
 def test_closure_does_not_depend_on_progress_chunks(tmp_path: Path, max_step: float) -> None:
     """The audit's crank-rocker closes after one crank turn (about 503 rows) however the march is chunked.

@@ -482,8 +482,9 @@ def march(mech, start, steps, corrector, bounds, out):
     ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s)``, the rows written. numba unpacks each tuple once
     per call; the inner kernels get the tuples they need.
 
-    ``u_home`` is where the path began and ``reach = [far, longest]`` how far the path has gone from it and its
-    longest step (zeros for a new path; updated in place), for closed-path detection across several calls.
+    ``u_home`` is where the path began and ``reach = [far, longest, t_home...]`` how far the path has gone from it,
+    its longest step and its tangent there (``2 + m`` zeros for a new path; updated in place), for closed-path
+    detection across several calls.
 
     An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h`` along
     the tangent (the corrector pulled it back); an adaptive march stops with ``NO_PROGRESS`` when its last
@@ -522,6 +523,9 @@ def march(mech, start, steps, corrector, bounds, out):
     tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
+    if reach[1] == 0.0:  # a new path (no step taken yet): its tangent at the start, for the closure's alignment
+        reach[2:] = t
+    t_home = reach[2:]
     s_total = 0.0
     basis_try = basis.copy()
     far = max(reach[0], wrapped_distance(u0, u_home, periodic))
@@ -600,7 +604,11 @@ def march(mech, start, steps, corrector, bounds, out):
             d = wrapped_distance(u, u_home, periodic)  # to the start of the path
             far = max(far, d)
             reach[0] = far
-            if back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
+            align = 0.0
+            for a in range(m):
+                align += t[a] * t_home[a]
+            aligned = align > 2.0 * cos_turn * cos_turn - 1.0  # within two steps' largest turn of the start's
+            if aligned and back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
                 close_path(u, u_home, periodic, count - 1, out_u, out_sigma, out_res, out_tau)
                 return count, CLOSED, h
         # ---- step control: grow an easy adaptive step (judged in the unknowns, so that it does not depend on the
@@ -624,7 +632,8 @@ def jumps(u, u_try, periodic):
 @kernel(inline="always")
 def back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
     """Whether the point ``u``, ``d`` from the path's start ``u_home`` (``far`` the farthest the path went), closes
-    the path.
+    the path (its tangent aligned with the start's, checked before: a branch crossing the start's branch through a
+    bifurcation point next to the start passes near it at an angle).
 
     Adaptive steps: within one and a half steps of the start after going more than four of the longest steps
     taken away (so that a small closed loop, shorter than a few ``hmax``, is recognised too). Paper mode: the

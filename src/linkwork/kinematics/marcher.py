@@ -185,7 +185,8 @@ class BranchMarcher:
         reach: Array,
     ) -> Chunk:
         """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place; ``reach
-        = [far, longest]``: how far the path has gone from ``u_home`` and its longest step, updated in place)."""
+        = [far, longest, t_home...]``: how far the path has gone from ``u_home``, its longest step and its
+        tangent there, updated in place)."""
         cfg, tol, m = self.cfg, self.cfg.tol, len(u)
         out = Chunk(
             u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
@@ -272,7 +273,8 @@ class BranchMarcher:
         for the drive, the located point it ended on or ``None``)."""
         u, t = u0.copy(), t0.copy()
         u_home = u0.copy() if opened_at is None else opened_at[0].copy()
-        reach = np.zeros(2)  # how far the path has gone from u_home, and its longest step (march.back_home)
+        # how far the path has gone from u_home, its longest step and its tangent there (march.back_home)
+        reach = np.zeros(2 + len(u0))
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
         while True:
