@@ -7,14 +7,20 @@ then crashes with a segmentation fault instead of stopping cleanly, and nothing 
 Ctrl-C in about thirty during ``linkwork demo``, measured). :func:`when_safe` wraps a handler so that a signal
 arriving there is held and delivered again a moment later, until it lands in code outside the compiler; every
 handler linkwork installs goes through it.
+
+:func:`held_signals` is the other half: while a long computation runs, the first SIGINT or SIGTERM is only
+recorded (:func:`requested`), and the computation, which looks at it between its steps (the tracer between two
+calls of its compiled march), ends there with what it computed, its end saying so; the command writes that and
+exits with :func:`exit_code` (130 or 143). A second signal raises :class:`Interrupted` at once.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from types import FrameType
 from typing import Any
 
@@ -62,3 +68,87 @@ def install_safe_interrupt() -> None:
     the main thread only, where Python runs signal handlers)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, when_safe(signal.default_int_handler))
+
+
+EXIT_SIGINT = 130
+"""The exit code of a command stopped by Ctrl-C (SIGINT): ``128 + 2``, the shell's."""
+EXIT_SIGTERM = 143
+"""The exit code of a command stopped by SIGTERM: ``128 + 15``, the shell's."""
+
+
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM that stops a command at once (a :class:`BaseException`, like :class:`KeyboardInterrupt`):
+    a second signal while the first is held, or one during a study's run."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(signal.Signals(signum).name)
+
+
+def exit_code(signum: int) -> int:
+    """The exit code of a command stopped by ``signum``: :data:`EXIT_SIGTERM` for SIGTERM, else
+    :data:`EXIT_SIGINT`."""
+    return EXIT_SIGTERM if signum == signal.SIGTERM else EXIT_SIGINT
+
+
+def stop_text(signum: int) -> str:
+    """The words of a stop by ``signum``: ``interrupted (SIGTERM)``."""
+    return f"interrupted ({signal.Signals(signum).name})"
+
+
+class Hold:
+    """What :func:`held_signals` recorded: ``signum``, the first SIGINT or SIGTERM received while it held them
+    (0: none), kept after the block ends."""
+
+    def __init__(self) -> None:
+        self.signum = 0
+
+    @property
+    def stopped(self) -> str:
+        """``interrupted (SIGTERM)``, or ``""`` when no signal came."""
+        return stop_text(self.signum) if self.signum else ""
+
+
+_CURRENT: list[Hold] = []
+"""The hold in force (at most one: a nested :func:`held_signals` shares the outer one)."""
+
+
+def requested() -> int:
+    """The SIGINT or SIGTERM received while :func:`held_signals` holds them (0: none, and always 0 outside it): a
+    computation that sees it ends at its next step, keeping what it computed."""
+    return _CURRENT[0].signum if _CURRENT else 0
+
+
+def holding() -> bool:
+    """Whether :func:`held_signals` holds the signals now (a computation then returns to Python often enough to
+    look at :func:`requested`)."""
+    return bool(_CURRENT)
+
+
+@contextlib.contextmanager
+def held_signals() -> Iterator[Hold]:
+    """While the block runs, the first SIGINT or SIGTERM is recorded (:func:`requested`, and the :class:`Hold`
+    handed out) instead of stopping the process, so that the computation ends at its next step with what it
+    has; a second raises :class:`Interrupted` at once. Only in the main thread (elsewhere nothing is held and the
+    hold stays empty); nested, the outer hold is handed out again."""
+    if _CURRENT:
+        yield _CURRENT[0]
+        return
+    hold = Hold()
+    if threading.current_thread() is not threading.main_thread():
+        yield hold
+        return
+
+    def record(signum: int, frame: FrameType | None) -> None:
+        if hold.signum:
+            raise Interrupted(signum)
+        hold.signum = signum
+
+    before = {sig: signal.signal(sig, when_safe(record)) for sig in (signal.SIGINT, signal.SIGTERM)}
+    _CURRENT.append(hold)
+    try:
+        yield hold
+    finally:
+        _CURRENT.clear()
+        for sig, handler in before.items():
+            signal.signal(sig, handler)

@@ -37,8 +37,8 @@ except ImportError:  # pragma: no cover - older typer uses click itself
 EXIT_CODES = (
     "Exit codes: 0 done as asked; 2 bad input (one line on stderr names the file, key or flag and what was "
     "expected); 3 the request could not be met (target not reached, no design or mechanism passes): one line "
-    "says why, and everything computed so far is written; 130 / 143 interrupted (Ctrl-C / SIGTERM); 141 the "
-    "standard output closed by its reader (| head)."
+    "says why, and everything computed so far is written; 130 / 143 interrupted (Ctrl-C / SIGTERM; trace, "
+    "robustness and sweep write what they computed); 141 the standard output closed by its reader (| head)."
 )
 
 

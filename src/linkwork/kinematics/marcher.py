@@ -10,11 +10,13 @@ Gan & Pellegrino 2006; branch switching after Kumar & Pellegrino 2000).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork import interrupts
 from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
@@ -52,6 +54,11 @@ class MarchSettings:
     tol: Tolerances
     drive_joint: int = -1
 
+
+#: A closed path turning the drive towards a target further round stops when the whole cycles still needed, at
+#: this fraction of the fewest steps a cycle took so far, are more than the steps left: cycles after the first
+#: start at full step length and repeat it, so the margin only covers round-off in the step control.
+CYCLE_SLACK = 0.9
 
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
 #: branch along which the drive stays put (to round-off) that component only changes sign by noise.
@@ -170,6 +177,14 @@ class BranchMarcher:
         self.spurious = 0
         self.arrivals: list[tuple[int, Array]] = []  # (point id, unit direction a traced branch arrived in)
         self.retraced = 0  # queued branches not traced: an arc already traced, run the other way
+        self.interrupted = 0  # the signal that cut the trace short (0: none; see interrupts.held_signals)
+
+    def stop_requested(self) -> bool:
+        """Whether a signal held by the command line asks the trace to end now (noted in ``interrupted``)."""
+        signum = interrupts.requested()
+        if signum:
+            self.interrupted = signum
+        return bool(signum)
 
     # ---- one compiled call
     def march_chunk(
@@ -272,10 +287,20 @@ class BranchMarcher:
         u_home = u0.copy() if opened_at is None else opened_at[0].copy()
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
+        cycle_from, fewest = (
+            0,
+            0,
+        )  # the step the current cycle of the drive began at; the fewest steps of a cycle
+        # Back in Python every 100 steps when someone watches: a progress bar, or a held signal to end on.
+        chunk_steps = 100 if (self.progress or interrupts.holding()) else self.budget
         while True:
-            n = max(min(self.budget, 100 if self.progress else self.budget), 0)
+            n = max(min(self.budget, chunk_steps), 0)
             if n <= 0 and not first:
                 return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
+            signum = 0 if first else interrupts.requested()
+            if signum:  # a SIGINT or SIGTERM held by the command line: end here, keeping every point marched
+                self.interrupted = signum
+                return n_steps, StopReason.INTERRUPTED, interrupts.stop_text(signum), None, None
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed)
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
@@ -349,8 +374,14 @@ class BranchMarcher:
                 if known is not None:  # through a known point and on: the arcs on both sides are traced
                     self._passed(known, chunk)
             elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
-                # A full turn of the drive: the target is further round.
+                # A full turn of the drive: the target is further round, unless the budget cannot go that far.
+                cycle = n_steps - cycle_from
+                fewest = cycle if fewest == 0 else min(fewest, cycle)
+                beyond = self._target_beyond_budget(chunk, u_home, fewest)
+                if beyond is not None:
+                    return n_steps, StopReason.BUDGET, beyond, None, None
                 u_home = chunk.u[chunk.count - 1].copy()
+                cycle_from = n_steps
             elif chunk.code != StopReason.BUDGET or self.budget <= 0:
                 if limit is not None:
                     return n_steps, StopReason.LIMIT, limit[1], limit[0], None
@@ -518,6 +549,32 @@ class BranchMarcher:
         now = chunk.u[chunk.count - 1, d]
         turned = now - u_home[d]
         return abs(turned) > np.pi and (cfg.target - now) * turned > 0.0
+
+    def _target_beyond_budget(self, chunk: Chunk, u_home: Array, cycle_steps: int) -> str | None:
+        """Why the target cannot be reached with the steps left, when a closed path (the chunk's last row back at
+        ``u_home``, the drive turned by whole turns towards the target) shows it: every further cycle turns the
+        drive as this one did and takes at least about ``cycle_steps`` steps (the fewest a cycle took so far), so
+        the whole cycles still needed, at :data:`CYCLE_SLACK` of those steps each, are more than the budget left.
+        ``None`` when the target may still be reached (the march goes round again)."""
+        cfg, d = self.cfg, self.cfg.drive
+        target = cfg.target
+        if target is None or cycle_steps <= 0:
+            return None
+        now = float(chunk.u[chunk.count - 1, d])
+        turned = now - float(u_home[d])
+        cycles = (target - now) / turned  # positive: the path turns towards the target
+        needed = math.floor(cycles) * float(cycle_steps)
+        if needed * CYCLE_SLACK <= self.budget:
+            return None
+        j = cfg.drive_joint if cfg.drive_joint >= 0 else self.first_joint[d]
+        name = self.mech.joint_names[j]
+        per_cycle = (
+            f"{np.degrees(abs(turned)):.2f} deg" if self.mech.joint_types[j] == "R" else f"{abs(turned):.6g}"
+        )
+        return (
+            f"step budget: {cycles:.3g} more cycles of the path to go (about {needed:.3g} steps; one cycle took "
+            f"{cycle_steps} steps and turns {name} by {per_cycle}), {self.budget} of {self.max_steps} steps left"
+        )
 
     def _end_reason(self, chunk: Chunk, paper: bool) -> str:
         """The end reason a user reads for a chunk's stop code."""
@@ -744,6 +801,10 @@ class BranchMarcher:
         """Trace every queued branch (breadth first) while the step budget lasts."""
         cfg = self.cfg
         while self.queue and self.budget > 0:
+            if (
+                self.stop_requested()
+            ):  # the rest of the queue is not traced: the trace says it was interrupted
+                return
             job = self.queue.pop(0)
             if self._traced_already(job):
                 self.retraced += 1
