@@ -224,3 +224,32 @@ def test_trace_help_says_what_is_written_when_a_request_is_not_met() -> None:
     text = " ".join(ANSI.sub("", result.stdout).split())
     assert "nothing is written" not in text
     assert "--max-steps" in text and "130 / 143" in text
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--until", "A=420", "--steps", "6000"], "more than the step budget max_steps (5000, --max-steps)"),
+        (["--until", "A=100000", "--steps", "200"], "expected at most 90 deg a step (steps >= 1111)"),
+        (["--until", "A=1e300", "--steps", "5000"], "expected at most 90 deg a step"),
+    ],
+    ids=["steps-beyond-budget", "steps-of-500-deg", "steps-of-1e296-deg"],
+)
+def test_equal_steps_that_cannot_trace_the_path_are_bad_input(
+    tmp_path: Path, args: list[str], fragment: str
+) -> None:
+    """Paper mode's request contradicts itself: refused before any step (exit 2), nothing written."""
+    out = tmp_path / "out"
+    result = invoke("trace", "four-bar", *args, "--no-plots", "-o", str(out))
+    assert result.exit_code == 2, result.stderr
+    assert fragment in one_error_line(result.stderr)
+    assert not out.exists()
+
+
+def test_equal_steps_several_turns_round_reach_the_target(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", "four-bar", "--until", "A=3600", "--steps", "100", "--no-plots", "-o", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = read_report(out / "report.json")
+    assert report["branches"][0]["steps"] == 100
+    assert report["branches"][0]["end"]["A"] == pytest.approx(3600.0, abs=1e-9)

@@ -266,3 +266,54 @@ def test_other_cranks_refuse_far_targets_and_reach_near_ones(mech: Mechanism) ->
     for sign in (1.0, -1.0):
         assert_far_target_refused_after_one_cycle(mech, free, sign)
     assert_reachable_turns_reached(mech, free)
+
+
+# ------------------------------------------------------------------------------------ paper mode
+@pytest.mark.parametrize("name", CRANKS)
+@pytest.mark.parametrize("turns", [2.5, 3.0, -2.25], ids=["2.5-turns", "3-turns", "back-2.25-turns"])
+def test_equal_steps_several_turns_round_land_on_the_target_in_that_many_steps(name: str, turns: float) -> None:
+    """A crank's target turns away in equal drive steps: reached, in exactly the steps asked (each closure of the
+    path snaps a step short; the steps after it are evened out onto the target, which they used to pass)."""
+    mech = lw.load(name)
+    free = free_trace(name)
+    d = mech.index(free.drive)
+    start = float(free.angles[0, d])
+    target = start + np.sign(cycle_of(free)[1]) * turns * 2 * np.pi  # type: ignore[index]
+    steps = round(abs(turns) * 360 / 4.0)  # 4 deg steps
+    tr = lw.trace(mech, until=(free.drive, target), steps=steps)
+    assert tr.stats.unmet is None, tr.stats.unmet
+    assert tr.branches[0].steps == steps
+    assert abs(tr.angles[-1, d] - target) <= TARGET_TOL * abs(target)
+    drive_steps = np.diff(tr.angles[:, d]) * np.sign(target - start)
+    nominal = abs(target - start) / steps
+    # always towards the target; a closing step is snapped onto the start (the march's rule: up to two steps long)
+    assert np.all(drive_steps > 0.2 * nominal) and np.all(drive_steps < 2.0 * nominal)
+    assert np.median(drive_steps) == pytest.approx(nominal, rel=0.05)
+
+
+def test_equal_steps_beyond_the_budget_or_a_quarter_turn_are_refused_before_any_step() -> None:
+    mech = lw.load("four-bar")
+    start = float(mech.offsets[0])
+    with pytest.raises(lw.SpecError, match=r"steps \(6000, --steps\).*max_steps \(5000, --max-steps\)"):
+        lw.trace(mech, until=("A", start + 1.0), steps=6000)
+    with pytest.raises(lw.SpecError, match=r"expected at most 90 deg a step \(steps >= 12\)"):
+        lw.trace(mech, until=("A", start + np.radians(1000.0)), steps=11)
+    lw.trace(mech, until=("A", start + np.radians(1000.0)), steps=12)  # 83.3 deg a step: allowed
+
+
+@pytest.mark.parametrize("name", BUILT_INS)
+def test_equal_steps_of_any_size_never_crash(name: str) -> None:
+    """Large equal steps over one to several turns: a trace (reached, or ended with a reason) or a refusal, never
+    another exception (a march failing at the first step of a later chunk left an empty block: IndexError)."""
+    mech = lw.load(name)
+    d = mech.joint_names[int(np.flatnonzero(mech.groups >= 0)[0])]
+    j = mech.index(d)
+    if mech.joint_types[j] != "R":
+        pytest.skip("a prismatic drive")
+    start = float(mech.offsets[j])
+    for step_deg in (30.0, 60.0, 89.0):
+        for turns in (0.9, 1.7, 2.3):
+            steps = math.ceil(turns * 360.0 / step_deg)
+            tr = lw.trace(mech, until=(d, start + np.radians(turns * 360.0)), steps=steps)
+            assert_rows_consistent(tr)
+            assert tr.branches[0].end_kind is not None

@@ -287,10 +287,11 @@ class BranchMarcher:
         u_home = u0.copy() if opened_at is None else opened_at[0].copy()
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
-        cycle_from, fewest = (
-            0,
-            0,
-        )  # the step the current cycle of the drive began at; the fewest steps of a cycle
+        # A drive turning round towards its target: the step its current cycle began at, the fewest steps a cycle
+        # took, and paper mode's count of equal steps to the target.
+        cycle_from, fewest = 0, 0
+        target = self.cfg.target
+        paper_steps = round(abs(target / h0)) if (paper and target is not None and h0 != 0.0) else 0
         # Back in Python every 100 steps when someone watches: a progress bar, or a held signal to end on.
         chunk_steps = 100 if (self.progress or interrupts.holding()) else self.budget
         while True:
@@ -382,6 +383,8 @@ class BranchMarcher:
                     return n_steps, StopReason.BUDGET, beyond, None, None
                 u_home = chunk.u[chunk.count - 1].copy()
                 cycle_from = n_steps
+                if paper:  # the closing step was snapped short onto the start: equal steps to the target
+                    chunk.h = self._steps_onto_target(chunk, paper_steps - n_steps)
             elif chunk.code != StopReason.BUDGET or self.budget <= 0:
                 if limit is not None:
                     return n_steps, StopReason.LIMIT, limit[1], limit[0], None
@@ -550,6 +553,17 @@ class BranchMarcher:
         turned = now - u_home[d]
         return abs(turned) > np.pi and (cfg.target - now) * turned > 0.0
 
+    def _steps_onto_target(self, chunk: Chunk, left: int) -> float:
+        """Paper mode, after a closed cycle of a drive turning towards its target: the equal drive step that lands
+        on the target from the chunk's last row in the ``left`` steps the paper's count leaves (at least one). A
+        path closes by snapping its last row onto the start (a step shorter than the others), so the march's equal
+        steps, which land on the target only when it is on their grid, would otherwise step past it."""
+        target = self.cfg.target
+        if target is None:
+            return chunk.h
+        to_go = target - float(chunk.u[chunk.count - 1, self.cfg.drive])
+        return to_go / max(1, left)
+
     def _target_beyond_budget(self, chunk: Chunk, u_home: Array, cycle_steps: int) -> str | None:
         """Why the target cannot be reached with the steps left, when a closed path (the chunk's last row back at
         ``u_home``, the drive turned by whole turns towards the target) shows it: every further cycle turns the
@@ -594,6 +608,8 @@ class BranchMarcher:
         rows, count = self.rows, chunk.count
         s_base = rows.s[-1][-1] if (not first and rows.s) else 0.0
         begin = 0 if first else 1
+        if count <= begin:  # a march that failed at its first step adds no row (no empty last block)
+            return
         rows.u.append(chunk.u[begin:count])
         rows.sigma.append(chunk.sigma[begin:count])
         if chunk.rank is None:

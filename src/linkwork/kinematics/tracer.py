@@ -10,6 +10,7 @@ into a higher-dimensional component.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Mapping
 from dataclasses import replace
@@ -38,6 +39,9 @@ Array = NDArray[np.float64]
 _MAX_TURN = np.radians(10.0)
 """The default ``max_turn`` of :func:`trace`, and its cosine (the settings' ``cos_turn``), computed once."""
 _COS_MAX_TURN = float(np.cos(_MAX_TURN))
+MAX_PAPER_STEP = np.radians(90.0)
+"""The largest equal drive step of paper mode (radians, a revolute drive), as ``--max-step``'s bound: a step of a
+quarter turn or more jumps across the path instead of following it."""
 _TARGET_TEXT = StopReason.TARGET.text
 """The end reason of a branch that reached its target (read once: ``StopReason.text`` hashes the enum)."""
 
@@ -90,6 +94,11 @@ def trace(
     if m == 0:
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
     d_joint, d_unknown, target = _drive_and_target(mech, drive, until, steps)
+    if steps is not None and steps > max_steps:  # the target is `steps` steps away: never within the budget
+        raise SpecError(
+            f"steps ({steps}, --steps) equal drive steps to until need more than the step budget max_steps "
+            f"({max_steps}, --max-steps); expected steps <= max_steps"
+        )
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
     backend = select_backend(warm_up=warm_up)
@@ -226,6 +235,16 @@ def _drive_and_target(
         target = float(until[1]) - t_offset
     if steps is not None and (target is None or steps < 1):
         raise SpecError("steps (the paper's equal drive steps) needs until=(joint, value) and steps >= 1")
+    if steps is not None and target is not None and mech.joint_types[d_joint] == "R":
+        step = abs(target) / steps
+        if step > MAX_PAPER_STEP:  # a predictor-corrector step of more than a quarter turn traces no path
+            deg = float(np.degrees(step))
+            fewest = abs(target) / MAX_PAPER_STEP
+            count = str(math.ceil(fewest)) if fewest < 1e15 else f"{fewest:.3g}"
+            raise SpecError(
+                f"steps ({steps}) equal steps of {mech.joint_names[d_joint]} to until: {deg:.6g} deg a step; "
+                f"expected at most {np.degrees(MAX_PAPER_STEP):g} deg a step (steps >= {count})"
+            )
     return d_joint, d_unknown, target
 
 
