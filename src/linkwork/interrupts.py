@@ -64,10 +64,19 @@ def when_safe(handler: Handler) -> Handler:
 
 
 def install_safe_interrupt() -> None:
-    """Make Ctrl-C raise :class:`KeyboardInterrupt` only outside the compiler (the command line's default; in
-    the main thread only, where Python runs signal handlers)."""
+    """Make Ctrl-C raise :class:`KeyboardInterrupt`, and SIGTERM :class:`Interrupted`, only outside the compiler
+    (the command line's default; in the main thread only, where Python runs signal handlers). SIGTERM's default
+    ends the process on the spot, without a word and without running any ``finally``; as an exception it ends the
+    command with one line and exit code 143, cleaning up on the way (a Dask cluster shut down, a staging folder
+    removed)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, when_safe(signal.default_int_handler))
+        signal.signal(signal.SIGTERM, when_safe(_terminate))
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM where no signal is held: stop the command at once (see :func:`install_safe_interrupt`)."""
+    raise Interrupted(signum, again=False)
 
 
 EXIT_SIGINT = 130
@@ -78,17 +87,29 @@ EXIT_SIGTERM = 143
 
 class Interrupted(BaseException):
     """SIGINT or SIGTERM that stops a command at once (a :class:`BaseException`, like :class:`KeyboardInterrupt`):
-    a second signal while the first is held, or one during a study's run."""
+    ``again``, a second signal while the first is held (:func:`held_signals`, a study's run); otherwise a SIGTERM
+    where none is held (:func:`install_safe_interrupt`)."""
 
-    def __init__(self, signum: int) -> None:
+    def __init__(self, signum: int, *, again: bool = True) -> None:
         self.signum = signum
+        self.again = again
         super().__init__(signal.Signals(signum).name)
 
 
+class Terminated(SystemExit):
+    """SIGTERM or SIGHUP while files are written (:mod:`linkwork.io.writer` removes its staging on the way out):
+    a ``SystemExit`` with code ``128 + signum``, so that a script ends as the shell expects, and the command line
+    says why in one line."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(exit_code(signum))
+
+
 def exit_code(signum: int) -> int:
-    """The exit code of a command stopped by ``signum``: :data:`EXIT_SIGTERM` for SIGTERM, else
-    :data:`EXIT_SIGINT`."""
-    return EXIT_SIGTERM if signum == signal.SIGTERM else EXIT_SIGINT
+    """The exit code of a command stopped by ``signum``, the shell's ``128 + signum``: :data:`EXIT_SIGINT` for
+    SIGINT, :data:`EXIT_SIGTERM` for SIGTERM."""
+    return 128 + int(signum)
 
 
 def stop_text(signum: int) -> str:

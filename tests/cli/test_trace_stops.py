@@ -253,3 +253,32 @@ def test_equal_steps_several_turns_round_reach_the_target(tmp_path: Path) -> Non
     report = read_report(out / "report.json")
     assert report["branches"][0]["steps"] == 100
     assert report["branches"][0]["end"]["A"] == pytest.approx(3600.0, abs=1e-9)
+
+
+# ------------------------------------------------------------------------------------ every other command
+@pytest.mark.parametrize(
+    ("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"]
+)
+def test_a_signal_during_a_mechanization_is_one_line_and_keeps_the_chain(
+    tmp_path: Path, sig: int, code: int
+) -> None:
+    """A command that keeps nothing of the step it is in (here synth's mechanization, after the chain is written)
+    still stops with one line and 143 / 130, not SIGTERM's silent kill without cleanup; what was written before
+    (the chain) is kept, nothing is half-written, no staging folder is left."""
+    out = tmp_path / "out"
+    proc = start_linkwork(["synth", "wing/mechanize.toml", "--no-plots", "-o", str(out)])
+    deadline = time.monotonic() + 120.0
+    while not (out / "chain.json").exists():  # the chain is written before the mechanization starts
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the chain was never written"
+        time.sleep(0.1)
+    time.sleep(2.0)  # well into the mechanization (half a minute with the plain-Python kernels)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == code, err
+    assert one_error_line(err) == f"error: interrupted ({signal.Signals(sig).name})"
+    json.loads((out / "chain.json").read_text(encoding="utf-8"))
+    assert not (out / "mechanization.json").exists()
+    assert not list(tmp_path.glob(".linkwork-*"))
+    assert [p.name for p in out.glob(".linkwork-*")] == [MANIFEST]  # no staging inside either

@@ -20,7 +20,7 @@ from rich.console import Console
 from rich.text import Text
 
 from linkwork.errors import LinkworkError, RequestNotMetError
-from linkwork.interrupts import EXIT_SIGINT, Interrupted, exit_code
+from linkwork.interrupts import EXIT_SIGINT, Interrupted, Terminated, exit_code, stop_text
 from linkwork.io.toml_reader import escape_line, show
 from linkwork.limits import Limit
 from linkwork.messages import show_path
@@ -100,8 +100,11 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             KeyboardInterrupt
         ):  # Ctrl-C where no signal is held (a study's run and a trace keep their results)
             raise fail("interrupted (SIGINT)", code=EXIT_SIGINT) from None
-        except Interrupted as exc:  # a second signal while the first was held: stop at once
-            raise fail(f"interrupted twice ({exc}); stopped at once", code=exit_code(exc.signum)) from None
+        except Terminated as exc:  # SIGTERM while files were written: the staging is gone, say why
+            raise fail(stop_text(exc.signum), code=exit_code(exc.signum)) from None
+        except Interrupted as exc:  # SIGTERM where none is held, or a second signal while the first was held
+            text = f"interrupted twice ({exc}); stopped at once" if exc.again else f"interrupted ({exc})"
+            raise fail(text, code=exit_code(exc.signum)) from None
 
     return wrapper
 
