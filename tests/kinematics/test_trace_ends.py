@@ -271,7 +271,9 @@ def test_other_cranks_refuse_far_targets_and_reach_near_ones(mech: Mechanism) ->
 # ------------------------------------------------------------------------------------ paper mode
 @pytest.mark.parametrize("name", CRANKS)
 @pytest.mark.parametrize("turns", [2.5, 3.0, -2.25], ids=["2.5-turns", "3-turns", "back-2.25-turns"])
-def test_equal_steps_several_turns_round_land_on_the_target_in_that_many_steps(name: str, turns: float) -> None:
+def test_equal_steps_several_turns_round_land_on_the_target_in_that_many_steps(
+    name: str, turns: float
+) -> None:
     """A crank's target turns away in equal drive steps: reached, in exactly the steps asked (each closure of the
     path snaps a step short; the steps after it are evened out onto the target, which they used to pass)."""
     mech = lw.load(name)
