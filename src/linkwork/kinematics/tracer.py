@@ -10,7 +10,6 @@ into a higher-dimensional component.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Mapping
 from dataclasses import replace
@@ -39,9 +38,6 @@ Array = NDArray[np.float64]
 _MAX_TURN = np.radians(10.0)
 """The default ``max_turn`` of :func:`trace`, and its cosine (the settings' ``cos_turn``), computed once."""
 _COS_MAX_TURN = float(np.cos(_MAX_TURN))
-MAX_PAPER_STEP = np.radians(90.0)
-"""The largest equal drive step of paper mode (radians, a revolute drive), as ``--max-step``'s bound: a step of a
-quarter turn or more jumps across the path instead of following it."""
 _TARGET_TEXT = StopReason.TARGET.text
 """The end reason of a branch that reached its target (read once: ``StopReason.text`` hashes the enum)."""
 
@@ -235,16 +231,6 @@ def _drive_and_target(
         target = float(until[1]) - t_offset
     if steps is not None and (target is None or steps < 1):
         raise SpecError("steps (the paper's equal drive steps) needs until=(joint, value) and steps >= 1")
-    if steps is not None and target is not None and mech.joint_types[d_joint] == "R":
-        step = abs(target) / steps
-        if step > MAX_PAPER_STEP:  # a predictor-corrector step of more than a quarter turn traces no path
-            deg = float(np.degrees(step))
-            fewest = abs(target) / MAX_PAPER_STEP
-            count = str(math.ceil(fewest)) if fewest < 1e15 else f"{fewest:.3g}"
-            raise SpecError(
-                f"steps ({steps}) equal steps of {mech.joint_names[d_joint]} to until: {deg:.6g} deg a step; "
-                f"expected at most {np.degrees(MAX_PAPER_STEP):g} deg a step (steps >= {count})"
-            )
     return d_joint, d_unknown, target
 
 
@@ -468,9 +454,7 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, an
         why = "" if end.kind == StopReason.CLOSED else f" (it turns back near {show(float(angles[-1, j]))})"
         return f"{name} never reaches {show(until[1])} on this path{why}: its range is {span}"
     budget, _, why = end.text.partition(": ")
-    if (
-        end.kind == StopReason.BUDGET and budget == StopReason.BUDGET.text and why
-    ):  # foreseen on a closed path
+    if end.kind == StopReason.BUDGET and budget == StopReason.BUDGET.text and why:  # foreseen at a closure
         return f"{name} cannot reach {show(until[1])} within the step budget (max_steps, --max-steps): {why}"
     return f"{name} did not reach {show(until[1])}: the path ended with '{end.text}' (range so far {span})"
 
