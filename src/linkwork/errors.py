@@ -18,6 +18,7 @@ class SpecError(LinkworkError, ValueError):
     def __init__(self, message: str, *, source: str | None = None, key: str | None = None) -> None:
         self.source = source
         self.key = key
+        self.detail = message  # what is wrong, without the file and the key (a reader may re-key it)
         where = ": ".join(part for part in (source, key) if part)
         super().__init__(f"{where}: {message}" if where else message)
 

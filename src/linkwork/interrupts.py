@@ -7,14 +7,20 @@ then crashes with a segmentation fault instead of stopping cleanly, and nothing 
 Ctrl-C in about thirty during ``linkwork demo``, measured). :func:`when_safe` wraps a handler so that a signal
 arriving there is held and delivered again a moment later, until it lands in code outside the compiler; every
 handler linkwork installs goes through it.
+
+:func:`held_signals` is the other half: while a long computation runs, the first SIGINT or SIGTERM is only
+recorded (:func:`requested`), and the computation, which looks at it between its steps (the tracer between two
+calls of its compiled march), ends there with what it computed, its end saying so; the command writes that and
+exits with :func:`exit_code` (130 or 143). A second signal raises :class:`Interrupted` at once.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from types import FrameType
 from typing import Any
 
@@ -58,7 +64,112 @@ def when_safe(handler: Handler) -> Handler:
 
 
 def install_safe_interrupt() -> None:
-    """Make Ctrl-C raise :class:`KeyboardInterrupt` only outside the compiler (the command line's default; in
-    the main thread only, where Python runs signal handlers)."""
+    """Make Ctrl-C raise :class:`KeyboardInterrupt`, and SIGTERM :class:`Interrupted`, only outside the compiler
+    (the command line's default; in the main thread only, where Python runs signal handlers). SIGTERM's default
+    ends the process on the spot, without a word and without running any ``finally``; as an exception it ends the
+    command with one line and exit code 143, cleaning up on the way (a Dask cluster shut down, a staging folder
+    removed)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, when_safe(signal.default_int_handler))
+        signal.signal(signal.SIGTERM, when_safe(_terminate))
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM where no signal is held: stop the command at once (see :func:`install_safe_interrupt`)."""
+    raise Interrupted(signum, again=False)
+
+
+EXIT_SIGINT = 130
+"""The exit code of a command stopped by Ctrl-C (SIGINT): ``128 + 2``, the shell's."""
+EXIT_SIGTERM = 143
+"""The exit code of a command stopped by SIGTERM: ``128 + 15``, the shell's."""
+
+
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM that stops a command at once (a :class:`BaseException`, like :class:`KeyboardInterrupt`):
+    ``again``, a second signal while the first is held (:func:`held_signals`, a study's run); otherwise a SIGTERM
+    where none is held (:func:`install_safe_interrupt`)."""
+
+    def __init__(self, signum: int, *, again: bool = True) -> None:
+        self.signum = signum
+        self.again = again
+        super().__init__(signal.Signals(signum).name)
+
+
+class Terminated(SystemExit):
+    """SIGTERM or SIGHUP while files are written (:mod:`linkwork.io.writer` removes its staging on the way out):
+    a ``SystemExit`` with code ``128 + signum``, so that a script ends as the shell expects, and the command line
+    says why in one line."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(exit_code(signum))
+
+
+def exit_code(signum: int) -> int:
+    """The exit code of a command stopped by ``signum``, the shell's ``128 + signum``: :data:`EXIT_SIGINT` for
+    SIGINT, :data:`EXIT_SIGTERM` for SIGTERM."""
+    return 128 + int(signum)
+
+
+def stop_text(signum: int) -> str:
+    """The words of a stop by ``signum``: ``interrupted (SIGTERM)``."""
+    return f"interrupted ({signal.Signals(signum).name})"
+
+
+class Hold:
+    """What :func:`held_signals` recorded: ``signum``, the first SIGINT or SIGTERM received while it held them
+    (0: none), kept after the block ends."""
+
+    def __init__(self) -> None:
+        self.signum = 0
+
+    @property
+    def stopped(self) -> str:
+        """``interrupted (SIGTERM)``, or ``""`` when no signal came."""
+        return stop_text(self.signum) if self.signum else ""
+
+
+_CURRENT: list[Hold] = []
+"""The hold in force (at most one: a nested :func:`held_signals` shares the outer one)."""
+
+
+def requested() -> int:
+    """The SIGINT or SIGTERM received while :func:`held_signals` holds them (0: none, and always 0 outside it): a
+    computation that sees it ends at its next step, keeping what it computed."""
+    return _CURRENT[0].signum if _CURRENT else 0
+
+
+def holding() -> bool:
+    """Whether :func:`held_signals` holds the signals now (a computation then returns to Python often enough to
+    look at :func:`requested`)."""
+    return bool(_CURRENT)
+
+
+@contextlib.contextmanager
+def held_signals() -> Iterator[Hold]:
+    """While the block runs, the first SIGINT or SIGTERM is recorded (:func:`requested`, and the :class:`Hold`
+    handed out) instead of stopping the process, so that the computation ends at its next step with what it
+    has; a second raises :class:`Interrupted` at once. Only in the main thread (elsewhere nothing is held and the
+    hold stays empty); nested, the outer hold is handed out again."""
+    if _CURRENT:
+        yield _CURRENT[0]
+        return
+    hold = Hold()
+    if threading.current_thread() is not threading.main_thread():
+        yield hold
+        return
+
+    def record(signum: int, frame: FrameType | None) -> None:
+        if hold.signum:
+            raise Interrupted(signum)
+        hold.signum = signum
+
+    before = {sig: signal.signal(sig, when_safe(record)) for sig in (signal.SIGINT, signal.SIGTERM)}
+    _CURRENT.append(hold)
+    try:
+        yield hold
+    finally:
+        _CURRENT.clear()
+        for sig, handler in before.items():
+            signal.signal(sig, handler)

@@ -101,7 +101,7 @@ HELD_SIGNAL = textwrap.dedent(
             time.sleep(10)
             stage = "never interrupted"
     except (KeyboardInterrupt, SystemExit) as exc:
-        print(stage, type(exc).__name__, flush=True)
+        print(stage, "SystemExit" if isinstance(exc, SystemExit) else type(exc).__name__, flush=True)
     """
 )
 

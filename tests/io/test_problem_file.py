@@ -141,7 +141,7 @@ def test_closed_problem_accepts_closed_curves(folder: Path) -> None:
             'seed = 7\nnames = ["one"]',
             "names: lists 1 names for 2 profiles; expected one per profile",
         ),
-        ("seed = 7", 'seed = 7\nnames = ["one", "one"]', "names: repeats a name"),
+        ("seed = 7", 'seed = 7\nnames = ["one", "one"]', 'names: repeats "one" (names[0] and names[1])'),
         ("seed = 7", 'seed = 7\nnames = ["one", 2]', "names[1]: expected a list of 2 non-empty names, got 2"),
         ('"a.csv", "sub/b.csv"', '"a.csv"', "profiles: lists 1 profile(s); expected at least 2 profiles"),
         (

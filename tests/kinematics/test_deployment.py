@@ -156,11 +156,13 @@ def test_cli_deployed_at_refusals(tmp_path: Path) -> None:
     out = tmp_path / "o"
     bad = runner.invoke(app, ["trace", "hedgepeth-rods", "--deployed-at", "A", "--no-plots", "-o", str(out)])
     assert bad.exit_code == 2 and "--deployed-at" in bad.output
+    assert not out.exists()  # bad input: nothing written
     off = runner.invoke(
         app, ["trace", "hedgepeth-rods", "--deployed-at", "A=400", "--no-plots", "-o", str(out)]
     )
     assert off.exit_code == 3 and "goes from 0 to 360" in off.output
-    assert not out.exists()  # nothing written
+    report = json.loads((out / "report.json").read_text())  # the trace is kept, the deployment not measured
+    assert report["deployment"] is None and "goes from 0 to 360" in report["deployment_unmet"]
 
 
 def test_a_frame_traced_from_its_flat_start_is_deployed_there() -> None:

@@ -27,7 +27,7 @@ from linkwork.cli import (
     trace,
 )
 from linkwork.cli.common import check_flags, fail, repeated_option
-from linkwork.interrupts import install_safe_interrupt
+from linkwork.interrupts import Interrupted, exit_code, install_safe_interrupt
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
     from typer._click import exceptions as click_exceptions
@@ -37,8 +37,8 @@ except ImportError:  # pragma: no cover - older typer uses click itself
 EXIT_CODES = (
     "Exit codes: 0 done as asked; 2 bad input (one line on stderr names the file, key or flag and what was "
     "expected); 3 the request could not be met (target not reached, no design or mechanism passes): one line "
-    "says why, and everything computed so far is written; 130 / 143 interrupted (Ctrl-C / SIGTERM); 141 the "
-    "standard output closed by its reader (| head)."
+    "says why, and everything computed so far is written; 130 / 143 interrupted (Ctrl-C / SIGTERM; trace, "
+    "robustness and sweep write what they computed); 141 the standard output closed by its reader (| head)."
 )
 
 
@@ -78,6 +78,9 @@ class OneLineErrors(help.Group):
         except typer.Abort:
             fail("aborted", code=1)
             sys.exit(1)
+        except Interrupted as exc:  # SIGTERM before or after a command's own work (its own is caught there)
+            fail(f"interrupted ({exc})", code=exit_code(exc.signum))
+            sys.exit(exit_code(exc.signum))
         except (
             OSError
         ) as exc:  # printing the help or a usage line failed: the standard output is full or gone

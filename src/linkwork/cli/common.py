@@ -10,7 +10,6 @@ from __future__ import annotations
 import contextlib
 import errno
 import math
-import signal
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from functools import wraps
@@ -21,6 +20,7 @@ from rich.console import Console
 from rich.text import Text
 
 from linkwork.errors import LinkworkError, RequestNotMetError
+from linkwork.interrupts import EXIT_SIGINT, Interrupted, Terminated, exit_code, stop_text
 from linkwork.io.toml_reader import escape_line, show
 from linkwork.limits import Limit
 from linkwork.messages import show_path
@@ -96,15 +96,15 @@ def friendly_errors(func: Callable[P, R]) -> Callable[P, R]:
             raise fail(message, code=code) from None
         except MemoryError:
             raise fail("ran out of memory; the request is too large for this machine", code=3) from None
-        except KeyboardInterrupt:  # Ctrl-C outside a study's run (which keeps its results itself)
-            raise fail("interrupted (SIGINT)", code=130) from None
-        except BaseException as exc:
-            from linkwork.studies.engine import EXIT_SIGTERM, Interrupted
-
-            if not isinstance(exc, Interrupted):
-                raise
-            code = EXIT_SIGTERM if exc.signum == signal.SIGTERM else 130
-            raise fail(f"interrupted twice ({exc}); stopped at once", code=code) from None
+        except (
+            KeyboardInterrupt
+        ):  # Ctrl-C where no signal is held (a study's run and a trace keep their results)
+            raise fail("interrupted (SIGINT)", code=EXIT_SIGINT) from None
+        except Terminated as exc:  # SIGTERM while files were written: the staging is gone, say why
+            raise fail(stop_text(exc.signum), code=exit_code(exc.signum)) from None
+        except Interrupted as exc:  # SIGTERM where none is held, or a second signal while the first was held
+            text = f"interrupted twice ({exc}); stopped at once" if exc.again else f"interrupted ({exc})"
+            raise fail(text, code=exit_code(exc.signum)) from None
 
     return wrapper
 

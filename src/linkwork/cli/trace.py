@@ -23,6 +23,7 @@ from linkwork.cli.common import (
 )
 from linkwork.cli.out_folder import out_help, run_folder, spec_label
 from linkwork.errors import RequestNotMetError
+from linkwork.interrupts import exit_code, held_signals
 from linkwork.messages import show
 from linkwork.outputs.staging import check_output_folder, console
 
@@ -36,6 +37,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from linkwork.io.spec import LoadedSpec
+    from linkwork.kinematics.deployment import Deployment
     from linkwork.kinematics.mechanism import Mechanism
     from linkwork.kinematics.trace_result import Trace
 
@@ -137,9 +139,11 @@ def trace(
     linkage's name with its --set values or the spec file's name).
 
     Exit codes: 0 done as asked; 2 bad input (one line saying which file, key or flag and what was expected);
-    3 the request could not be met (the --until target is never reached on the path: its range is printed),
-    after path.csv, report.json and the figures of what was traced are written; or the --deployed-at value is
-    not reached on branch 0 (its range there is printed, nothing is written).
+    3 the request could not be met (the --until target is never reached on the path, or would need more steps
+    than --max-steps; the --deployed-at value is not reached on branch 0: the range is printed), after
+    path.csv, report.json and the figures of what was traced are written; 130 / 143 interrupted by Ctrl-C /
+    SIGTERM while tracing: the path traced so far is written (report.json's "stopped" and the branch's end say
+    so); a second signal stops at once, writing nothing.
     """
     import numpy as np
 
@@ -180,22 +184,44 @@ def trace(
             f"start corrected onto the loop: residual {loaded.assembly.residual_before:.2e} -> "
             f"{loaded.assembly.residual_after:.2e}, joints moved by up to {worst:.3g} deg"
         )
-    traced = _run_with_progress(
-        run_trace, mech, total=steps if steps is not None else max_steps, drive=drive, until=until_rad,
-        steps=steps, max_step=float(np.radians(max_step)), max_steps=max_steps, branches=branches, limits=limits,
-        closure_tol=closure_tol,
-    )  # fmt: skip
+    # Ctrl-C or SIGTERM while tracing ends the trace at its next chunk of steps, keeping what was traced.
+    with held_signals() as hold:
+        traced = _run_with_progress(
+            run_trace, mech, total=steps if steps is not None else max_steps, drive=drive, until=until_rad,
+            steps=steps, max_step=float(np.radians(max_step)), max_steps=max_steps, branches=branches,
+            limits=limits, closure_tol=closure_tol,
+        )  # fmt: skip
     from linkwork.outputs.trace import print_trace_summary, write_trace_outputs
 
-    deployment = traced.deployment(deployed_rad)  # a value not on branch 0: exit 3 before writing anything
+    deployment, deployment_unmet = _deployment(traced, deployed_rad)
     figures = write_trace_outputs(
-        traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate, deployment=deployment
-    )
+        traced, out, loaded.assembly, plots=not no_plots, html=html, animate=animate, deployment=deployment,
+        deployment_unmet=deployment_unmet,
+    )  # fmt: skip
     print_trace_summary(traced)
     written = ["path.csv", "report.json", "points.csv", "mechanism.toml", *[f.name for f in figures]]
     console.print(f"wrote {', '.join(written)} to {out}/")
+    if hold.signum:  # the signal wins over a target not reached: the trace was cut short on purpose
+        raise fail(
+            f"{hold.stopped}: the {len(traced.branch)} points traced so far are written to {out}/ "
+            "(report.json says where each branch stopped)",
+            code=exit_code(hold.signum),
+        )
     if traced.stats.unmet is not None:
         raise RequestNotMetError(traced.stats.unmet)
+    if deployment_unmet is not None:
+        raise RequestNotMetError(deployment_unmet)
+
+
+def _deployment(traced: Trace, deployed_at: tuple[str, float] | None) -> tuple[Deployment | None, str | None]:
+    """The deployment measures at ``--deployed-at`` (default: the last point of branch 0), or ``(None, why)``
+    when branch 0 never reaches that value (the trace is written all the same, then the command exits 3)."""
+    if deployed_at is None:
+        return None, None
+    try:
+        return traced.deployment(deployed_at), None
+    except RequestNotMetError as exc:
+        return None, str(exc)
 
 
 def _parse_deployed_at(text: str | None) -> tuple[str, float] | None:

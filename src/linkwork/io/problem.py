@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from linkwork.errors import SpecError
 from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
 from linkwork.io.toml_reader import TomlReader, escape_line, input_file_problem, key_path, read_toml, show
 from linkwork.mechanization.options import OPTION_KEYS, options_from_values
@@ -192,9 +193,51 @@ def _profile_files(reader: TomlReader, table: dict[str, Any]) -> list[str]:
 
 
 def _names(reader: TomlReader, table: dict[str, Any], files: list[str]) -> list[str]:
-    """``names``, or the profile files' stems."""
+    """``names``, or each profile file's name without its folder and extension (its stem)."""
+    if "names" not in table:
+        return names_from_files(reader, files)
     expected = f"a list of {len(files)} non-empty names"
-    return reader.string_list(table, "names", "", expected=expected, default=[Path(f).stem for f in files])
+    return reader.string_list(table, "names", "", expected=expected, default=None)
+
+
+def names_from_files(reader: TomlReader, files: list[str]) -> list[str]:
+    """The profiles' names of a problem without a ``names`` key: each file's stem (``a/wing.csv`` is ``wing``).
+
+    Two files with the same stem (``a/wing.csv`` and ``b/wing.csv``, or ``wing.csv`` and ``wing.dat``) would give
+    two profiles one name: that is refused here, at ``profiles``, naming both files (names are compared exactly,
+    as everywhere in linkwork; where a format ignores case, the name policy keeps them apart, e.g. the DXF
+    layers of :func:`linkwork.names.dxf_layers`)."""
+    names = [Path(f).stem for f in files]
+    first: dict[str, int] = {}
+    for index, name in enumerate(names):
+        earlier = first.setdefault(name, index)
+        if earlier != index:
+            raise reader.error(
+                "profiles",
+                f"profiles[{earlier}] {show(files[earlier])} and profiles[{index}] {show(files[index])} would both "
+                f"be named {show(name)} (without a names key a profile is named after its file, without the "
+                "folder and extension); expected distinct file names, or a names key with one name per profile",
+            )
+    return names
+
+
+def _named_after_files(reader: TomlReader, exc: SpecError, files: list[str]) -> SpecError:
+    """A broken rule of ``names`` (:class:`Problem`'s) when the names are the files' stems: said of the file
+    that gave the name, at ``profiles[i]``, since the problem file has no ``names`` key."""
+    key = exc.key or "names"
+    index = key[len("names[") : -1] if key.startswith("names[") else ""
+    if index.isdigit() and int(index) < len(files):
+        i = int(index)
+        return reader.error(
+            key_path("profiles", i),
+            f"the profile is named {show(Path(files[i]).stem)} after its file {show(files[i])} (there is no names "
+            f"key), and a name is {exc.detail}; rename the file or add a names key",
+        )
+    return reader.error(
+        "profiles",
+        f"the profiles are named after their files (there is no names key), and the names are refused: "
+        f"{exc.detail}; rename the files or add a names key",
+    )
 
 
 def _load_profiles(reader: TomlReader, folder: Path, files: list[str], kind: ProfileKind) -> list[Any]:
@@ -252,6 +295,11 @@ def load_problem(path: str | Path) -> Problem:
     names = _names(reader, table, files)
     # The rules of the problem, checked before the profile files are read (placeholder polylines of length 0
     # pass every profile rule), so that a bad setting is reported first.
-    Problem(profiles=(np.zeros((2, 2)),) * len(files), names=tuple(names), source=path, **settings)
+    try:
+        Problem(profiles=(np.zeros((2, 2)),) * len(files), names=tuple(names), source=path, **settings)
+    except SpecError as exc:
+        if "names" in table or not (exc.key or "").startswith("names"):
+            raise
+        raise _named_after_files(reader, exc, files) from None
     profiles = _load_profiles(reader, path.parent, files, settings["kind"])
     return Problem(profiles=tuple(profiles), names=tuple(names), source=path, **settings)

@@ -90,10 +90,15 @@ def branch_range(trace: Trace, branch: int) -> dict[str, list[float]]:
 
 @trace_keyword
 def report_dict(
-    trace: Trace, assembly: Any | None = None, deployment: Deployment | None = None
+    trace: Trace,
+    assembly: Any | None = None,
+    deployment: Deployment | None = None,
+    *,
+    deployment_unmet: str | None = None,
 ) -> dict[str, Any]:
     """The content of ``report.json`` (``deployment``: the measures of :meth:`Trace.deployment`, default
-    deployed configuration unless given)."""
+    deployed configuration unless given; ``deployment_unmet``: why the deployed configuration asked for is not on
+    the path, and then ``deployment`` is ``null``)."""
     mech = trace.mechanism
     names = list(mech.joint_names)
     cond = trace.condition()
@@ -115,6 +120,8 @@ def report_dict(
         "max_misfit": float(trace.stats.max_misfit),
         "target_reached": (trace.stats.unmet is None) if trace.stats.has_target else None,
         "unmet": trace.stats.unmet,
+        "complete": trace.stats.stopped is None,
+        "stopped": trace.stats.stopped,
         "max_condition": trace.max_condition,
         "max_condition_raw": trace.max_condition_raw,
         "condition_at_end": float(cond[-1]) if len(cond) else None,
@@ -123,7 +130,8 @@ def report_dict(
         "branches": [_branch_entry(trace, br) for br in trace.branches],
         "seconds": trace.stats.seconds,
     }
-    out["deployment"] = deployment_entry(trace, deployment)
+    out["deployment"] = None if deployment_unmet else deployment_entry(trace, deployment)
+    out["deployment_unmet"] = deployment_unmet
     if assembly is not None:
         out["assembly"] = _assembly_entry(assembly, names)
     return out
@@ -233,10 +241,16 @@ def _assembly_entry(assembly: Any, names: list[str]) -> dict[str, Any]:
 
 @trace_keyword
 def write_report_json(
-    trace: Trace, file: Path, assembly: Any | None = None, deployment: Deployment | None = None
+    trace: Trace,
+    file: Path,
+    assembly: Any | None = None,
+    deployment: Deployment | None = None,
+    *,
+    deployment_unmet: str | None = None,
 ) -> None:
-    """Write ``report.json``."""
-    Path(file).write_text(json_text(report_dict(trace, assembly, deployment)), encoding="utf-8")
+    """Write ``report.json`` (see :func:`report_dict`)."""
+    report = report_dict(trace, assembly, deployment, deployment_unmet=deployment_unmet)
+    Path(file).write_text(json_text(report), encoding="utf-8")
 
 
 @trace_keyword

@@ -42,7 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from linkwork.errors import RequestNotMetError, SpecError
-from linkwork.interrupts import when_safe
+from linkwork.interrupts import Terminated, when_safe
 from linkwork.io.toml_reader import show
 from linkwork.messages import show_path
 
@@ -189,10 +189,12 @@ def _check_output_folder(out: Path, names: Iterable[str], flag: str) -> None:
 
 @contextlib.contextmanager
 def _cleanup_on_signals() -> Iterator[None]:
-    """While writing, turn SIGTERM (and SIGHUP) into an exception, so the staging is removed."""
+    """While writing, turn SIGTERM (and SIGHUP) into an exception, so the staging is removed: a
+    :class:`~linkwork.interrupts.Terminated`, the ``SystemExit(128 + signum)`` the command line reports in one
+    line."""
 
     def stop(signum: int, frame: FrameType | None) -> None:
-        raise SystemExit(128 + signum)
+        raise Terminated(signum)
 
     if threading.current_thread() is not threading.main_thread():
         yield

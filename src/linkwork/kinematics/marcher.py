@@ -10,11 +10,13 @@ Gan & Pellegrino 2006; branch switching after Kumar & Pellegrino 2000).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork import interrupts
 from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
@@ -52,6 +54,11 @@ class MarchSettings:
     tol: Tolerances
     drive_joint: int = -1
 
+
+#: A closed path turning the drive towards a target further round stops when the whole cycles still needed, at
+#: this fraction of the fewest steps a cycle took so far, are more than the steps left: cycles after the first
+#: start at full step length and repeat it, so the margin only covers round-off in the step control.
+CYCLE_SLACK = 0.9
 
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
 #: branch along which the drive stays put (to round-off) that component only changes sign by noise.
@@ -170,6 +177,14 @@ class BranchMarcher:
         self.spurious = 0
         self.arrivals: list[tuple[int, Array]] = []  # (point id, unit direction a traced branch arrived in)
         self.retraced = 0  # queued branches not traced: an arc already traced, run the other way
+        self.interrupted = 0  # the signal that cut the trace short (0: none; see interrupts.held_signals)
+
+    def stop_requested(self) -> bool:
+        """Whether a signal held by the command line asks the trace to end now (noted in ``interrupted``)."""
+        signum = interrupts.requested()
+        if signum:
+            self.interrupted = signum
+        return bool(signum)
 
     # ---- one compiled call
     def march_chunk(
@@ -277,10 +292,21 @@ class BranchMarcher:
         reach = np.zeros(2 + len(u0))
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
+        # A drive turning round towards its target: the step its current cycle began at, the fewest steps a cycle
+        # took, and paper mode's count of equal steps to the target.
+        cycle_from, fewest = 0, 0
+        target = self.cfg.target
+        paper_steps = round(abs(target / h0)) if (paper and target is not None and h0 != 0.0) else 0
+        # Back in Python every 100 steps when someone watches: a progress bar, or a held signal to end on.
+        chunk_steps = 100 if (self.progress or interrupts.holding()) else self.budget
         while True:
-            n = max(min(self.budget, 100 if self.progress else self.budget), 0)
+            n = max(min(self.budget, chunk_steps), 0)
             if n <= 0 and not first:
                 return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
+            signum = 0 if first else interrupts.requested()
+            if signum:  # a SIGINT or SIGTERM held by the command line: end here, keeping every point marched
+                self.interrupted = signum
+                return n_steps, StopReason.INTERRUPTED, interrupts.stop_text(signum), None, None
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed, reach)
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
@@ -354,9 +380,17 @@ class BranchMarcher:
                 if known is not None:  # through a known point and on: the arcs on both sides are traced
                     self._passed(known, chunk)
             elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
-                # A full turn of the drive: the target is further round.
+                # A full turn of the drive: the target is further round, unless the budget cannot go that far.
+                cycle = n_steps - cycle_from
+                fewest = cycle if fewest == 0 else min(fewest, cycle)
+                beyond = self._target_beyond_budget(chunk, u_home, fewest)
+                if beyond is not None:
+                    return n_steps, StopReason.BUDGET, beyond, None, None
                 u_home = chunk.u[chunk.count - 1].copy()
                 reach[:] = 0.0
+                cycle_from = n_steps
+                if paper:  # the steps left evened out onto the target from the closing row
+                    chunk.h = self._steps_onto_target(chunk, paper_steps - n_steps)
             elif chunk.code != StopReason.BUDGET or self.budget <= 0:
                 if limit is not None:
                     return n_steps, StopReason.LIMIT, limit[1], limit[0], None
@@ -525,6 +559,43 @@ class BranchMarcher:
         turned = now - u_home[d]
         return abs(turned) > np.pi and (cfg.target - now) * turned > 0.0
 
+    def _steps_onto_target(self, chunk: Chunk, left: int) -> float:
+        """Paper mode, after a closed cycle of a drive turning towards its target: the equal drive step that lands
+        on the target from the chunk's last row in the ``left`` steps the paper's count leaves (at least one). A
+        path closes by snapping its last row onto the start (a step shorter than the others), so the march's equal
+        steps, which land on the target only when it is on their grid, would otherwise step past it."""
+        target = self.cfg.target
+        if target is None:
+            return chunk.h
+        to_go = target - float(chunk.u[chunk.count - 1, self.cfg.drive])
+        return to_go / max(1, left)
+
+    def _target_beyond_budget(self, chunk: Chunk, u_home: Array, cycle_steps: int) -> str | None:
+        """Why the target cannot be reached with the steps left, when a closed path (the chunk's last row back at
+        ``u_home``, the drive turned by whole turns towards the target) shows it: every further cycle turns the
+        drive as this one did and takes at least about ``cycle_steps`` steps (the fewest a cycle took so far), so
+        the whole cycles still needed, at :data:`CYCLE_SLACK` of those steps each, are more than the budget left.
+        ``None`` when the target may still be reached (the march goes round again)."""
+        cfg, d = self.cfg, self.cfg.drive
+        target = cfg.target
+        if target is None or cycle_steps <= 0:
+            return None
+        now = float(chunk.u[chunk.count - 1, d])
+        turned = now - float(u_home[d])
+        cycles = (target - now) / turned  # positive: the path turns towards the target
+        needed = math.floor(cycles) * float(cycle_steps)
+        if needed * CYCLE_SLACK <= self.budget:
+            return None
+        j = cfg.drive_joint if cfg.drive_joint >= 0 else self.first_joint[d]
+        name = self.mech.joint_names[j]
+        per_cycle = (
+            f"{np.degrees(abs(turned)):.2f} deg" if self.mech.joint_types[j] == "R" else f"{abs(turned):.6g}"
+        )
+        return (
+            f"step budget: {cycles:.3g} more cycles of the path to go (about {needed:.3g} steps; one cycle took "
+            f"{cycle_steps} steps and turns {name} by {per_cycle}), {self.budget} of {self.max_steps} steps left"
+        )
+
     def _end_reason(self, chunk: Chunk, paper: bool) -> str:
         """The end reason a user reads for a chunk's stop code."""
         if chunk.code == StopReason.FAILED:
@@ -543,6 +614,8 @@ class BranchMarcher:
         rows, count = self.rows, chunk.count
         s_base = rows.s[-1][-1] if (not first and rows.s) else 0.0
         begin = 0 if first else 1
+        if count <= begin:  # a march that failed at its first step adds no row (no empty last block)
+            return
         rows.u.append(chunk.u[begin:count])
         rows.sigma.append(chunk.sigma[begin:count])
         if chunk.rank is None:
@@ -750,6 +823,10 @@ class BranchMarcher:
         """Trace every queued branch (breadth first) while the step budget lasts."""
         cfg = self.cfg
         while self.queue and self.budget > 0:
+            if (
+                self.stop_requested()
+            ):  # the rest of the queue is not traced: the trace says it was interrupted
+                return
             job = self.queue.pop(0)
             if self._traced_already(job):
                 self.retraced += 1

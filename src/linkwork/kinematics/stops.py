@@ -2,8 +2,9 @@
 
 The compiled march (:func:`linkwork.kinematics.march.march`) returns one of the first eight values; the marcher
 adds the reasons only it can see (a known point reached, a higher-dimensional component entered, a branch that
-could not leave its bifurcation point). Every traced branch ends with an :class:`End`: its kind, the joint the
-reason is about and that joint's value there, and the sentence a person reads (``Branch.end_reason``).
+could not leave its bifurcation point, a signal the command line held). Every traced branch ends with an
+:class:`End`: its kind, the joint the reason is about and that joint's value there, and the sentence a person
+reads (``Branch.end_reason``).
 """
 
 from __future__ import annotations
@@ -38,6 +39,9 @@ class StopReason(IntEnum):
     """The branch entered a higher-dimensional component of the configuration space."""
     NOT_LEFT = 10
     """A queued branch could not leave its bifurcation point (no corrected first step)."""
+    INTERRUPTED = 11
+    """A SIGINT or SIGTERM arrived while the command line held them (:func:`linkwork.interrupts.held_signals`):
+    the branch ends at the last point marched, which is kept (the text names the signal)."""
 
     @property
     def text(self) -> str:
@@ -57,6 +61,7 @@ _TEXT = {
     StopReason.KNOWN_POINT: "reached bifurcation",
     StopReason.COMPONENT: "entered a component",
     StopReason.NOT_LEFT: "could not leave the bifurcation",
+    StopReason.INTERRUPTED: "interrupted",
 }
 
 

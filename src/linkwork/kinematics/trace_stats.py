@@ -29,6 +29,9 @@ class TraceStats:
         target). The command line exits with code 3 when ``unmet`` is set.
     points, seconds
         Rows of the result, and the seconds tracing took (compiling or loading kernels excluded).
+    stopped
+        Why the trace stopped before its end, ``"interrupted (SIGTERM)"`` (a signal the command line held, see
+        :func:`linkwork.interrupts.held_signals`: what was traced is kept); ``None`` when it ran to its end.
 
     Read access by key (``stats["unmet"]``, ``"unmet" in stats``, ``stats.get(...)``) still works for one release,
     with a :class:`DeprecationWarning`: ``"unmet" in stats`` is true only when the target was not met, as when
@@ -46,6 +49,7 @@ class TraceStats:
     unmet: str | None = None
     points: int = 0
     seconds: float = 0.0
+    stopped: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Every field by name (``unmet`` ``None`` when the target was met)."""

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, SpecError
+from linkwork.interrupts import stop_text
 from linkwork.kinematics import kernels
 from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
@@ -89,6 +90,11 @@ def trace(
     if m == 0:
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
     d_joint, d_unknown, target = _drive_and_target(mech, drive, until, steps)
+    if steps is not None and steps > max_steps:  # the target is `steps` steps away: never within the budget
+        raise SpecError(
+            f"steps ({steps}, --steps) equal drive steps to until need more than the step budget max_steps "
+            f"({max_steps}, --max-steps); expected steps <= max_steps"
+        )
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
     backend = select_backend(warm_up=warm_up)
@@ -125,7 +131,7 @@ def trace(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
     )
     marcher.branches.append(Branch.ended(0, None, None, 1, n0, end0))
-    if branches and target is None and end0.kind != StopReason.CLOSED:
+    if branches and target is None and end0.kind != StopReason.CLOSED and not marcher.stop_requested():
         # The start is in the middle of its branch: trace the other direction too.
         n1, end1 = marcher.run_branch(
             1, np.zeros(m), -t_start, basis0.copy(), paper=False, h0=max_step / 4.0, stop_at_known=True
@@ -343,6 +349,7 @@ def _assemble(
         unmet=unmet,
         points=len(U),
         seconds=time.perf_counter() - started,
+        stopped=stop_text(marcher.interrupted) if marcher.interrupted else None,
     )
     return Trace(
         mechanism=mech,
@@ -399,7 +406,7 @@ def _closed_form_trace(
         TraceStats, start_rank=settings.r_path, start_mobility=m - settings.r_path, mode="paper",
         closure_tol=tol.closure, max_misfit=float(max(0.0, float(np.maximum.reduce(residual)))),
         sign_changes_without_rank_drop=0, branches_not_retraced=0, has_target=until is not None, unmet=None,
-        points=count, seconds=time.perf_counter() - started,
+        points=count, seconds=time.perf_counter() - started, stopped=None,
     )  # fmt: skip
     return record(
         Trace, mechanism=mech, drive=mech.joint_names[d_joint], angles=rows.angles, sigma=sigma,
@@ -446,6 +453,9 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, an
     if end.kind in (StopReason.CLOSED, StopReason.TURNING):
         why = "" if end.kind == StopReason.CLOSED else f" (it turns back near {show(float(angles[-1, j]))})"
         return f"{name} never reaches {show(until[1])} on this path{why}: its range is {span}"
+    budget, _, why = end.text.partition(": ")
+    if end.kind == StopReason.BUDGET and budget == StopReason.BUDGET.text and why:  # foreseen at a closure
+        return f"{name} cannot reach {show(until[1])} within the step budget (max_steps, --max-steps): {why}"
     return f"{name} did not reach {show(until[1])}: the path ended with '{end.text}' (range so far {span})"
 
 

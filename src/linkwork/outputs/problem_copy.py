@@ -45,11 +45,10 @@ def copy_problem(problem_file: str | Path, folder: str | Path) -> list[Path]:
         targets = profiles
         shutil.copyfile(source, folder / PROBLEM_FILE)
     else:
-        targets = []
-        for index, name in enumerate(profiles, start=1):
-            base = Path(name).name
-            targets.append(base if base not in targets else f"{index}_{base}")
+        targets = copy_names(profiles)
         table = {**table, "profiles": targets}
+        if "names" not in table:  # a copy renamed (``2_wing.dat``) keeps its profile's name (``wing``)
+            table["names"] = [Path(name).stem for name in profiles]  # as load_problem names them
         lines = [f"# copy of {source.name} written by linkwork synth (profiles copied next to it)"]
         lines += [_toml_line(key, value) for key, value in table.items()]
         (folder / PROBLEM_FILE).write_text("\n".join(lines) + "\n", encoding="utf-8")
@@ -60,3 +59,19 @@ def copy_problem(problem_file: str | Path, folder: str | Path) -> list[Path]:
         shutil.copyfile(source.parent / name, destination)
         written.append(destination)
     return written
+
+
+def copy_names(profiles: list[str]) -> list[str]:
+    """The file name of each profile's copy beside the problem: its own file name, or, when that is already
+    taken (two folders holding a ``wing.dat``, or ``Wing.dat`` and ``wing.dat``, one file on a file system that
+    ignores case), ``<i>_<name>`` with ``i`` its position counted from 1 (and more ``_`` until it is free)."""
+    taken: set[str] = set()
+    names: list[str] = []
+    for index, profile in enumerate(profiles, start=1):
+        name = Path(profile).name
+        candidate = name
+        while candidate.casefold() in taken:
+            candidate = f"{index}_{candidate}"
+        taken.add(candidate.casefold())
+        names.append(candidate)
+    return names

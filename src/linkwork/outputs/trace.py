@@ -28,12 +28,17 @@ def write_trace_outputs(
     html: bool = False,
     animate: bool = False,
     deployment: Deployment | None = None,
+    *,
+    deployment_unmet: str | None = None,
 ) -> list[Path]:
     """Write path.csv, report.json, (if matplotlib is there) the figures and the deployment sequence of the
     first branch (``sequence.png``, like Figs. 11, 13, 16), with ``animate`` an animation of every branch
     (``motion.gif``, and ``motion.mp4`` when an ffmpeg is found), and with ``html`` the interactive viewer
     ``viewer.html`` into ``out``, all or nothing; ``deployment`` (default ``trace.deployment()``) goes into
-    report.json and ``stretch.png``. Returns the figures, animation and viewer written."""
+    report.json and ``stretch.png``; ``deployment_unmet`` says why the deployed configuration asked for is not on
+    the path (report.json's ``deployment`` is then ``null`` and ``stretch.png`` is left out). A trace stopped
+    early (``trace.stats.stopped``: a signal) is written the same way: what was traced. Returns the figures,
+    animation and viewer written."""
     from linkwork.io.readback import path_columns, points_columns
     from linkwork.io.results import write_path_csv, write_points_csv, write_report_json
     from linkwork.kinematics.points import points_columns as position_names
@@ -47,7 +52,9 @@ def write_trace_outputs(
         console.print(renamed)
     with staged_output(out) as stage:
         write_path_csv(trace, stage / "path.csv")
-        write_report_json(trace, stage / "report.json", assembly, deployment)
+        write_report_json(
+            trace, stage / "report.json", assembly, deployment, deployment_unmet=deployment_unmet
+        )
         write_points_csv(trace, stage / "points.csv")
         write_trace_mechanism(trace.mechanism, stage)
         if plots:
@@ -58,7 +65,8 @@ def write_trace_outputs(
 
                 figures = write_trace_figures(trace, stage)
                 figures.append(deployment_sequence(trace, stage / "sequence.png"))
-                figures.append(plot_stretch(trace, stage / "stretch.png", deployment))
+                if deployment_unmet is None:
+                    figures.append(plot_stretch(trace, stage / "stretch.png", deployment))
                 if animate:
                     from linkwork.viz.animate import animate_path
 

@@ -31,7 +31,7 @@ from types import FrameType
 from typing import Any, TypeVar
 
 from linkwork.errors import LinkworkError, RequestNotMetError, SpecError
-from linkwork.interrupts import when_safe
+from linkwork.interrupts import EXIT_SIGINT, EXIT_SIGTERM, Interrupted, when_safe
 from linkwork.progress import Progress
 
 T = TypeVar("T")
@@ -55,17 +55,6 @@ each worker, taken from the cores the workers compute on; with these settings, a
 
 POLL = 0.5
 """Seconds between checks of the cluster's health while waiting for results."""
-
-EXIT_SIGINT = 130
-EXIT_SIGTERM = 143
-
-
-class Interrupted(BaseException):
-    """SIGINT or SIGTERM during a run (a :class:`BaseException`, like :class:`KeyboardInterrupt`)."""
-
-    def __init__(self, signum: int) -> None:
-        self.signum = signum
-        super().__init__(signal.Signals(signum).name)
 
 
 @dataclass

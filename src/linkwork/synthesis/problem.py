@@ -273,8 +273,17 @@ def _name_rules(p: Problem) -> list[tuple[str, str]]:
                     f"expected a name without line breaks or control characters, got {show(name)}",
                 )
             ]
-    if len(set(p.names)) != len(p.names):
-        return [("names", "repeats a name; expected a different name for every profile")]
+    first: dict[str, int] = {}
+    for index, name in enumerate(p.names):
+        earlier = first.setdefault(name, index)
+        if earlier != index:
+            return [
+                (
+                    "names",
+                    f"repeats {show(name)} (names[{earlier}] and names[{index}]); expected a different name for "
+                    "every profile",
+                )
+            ]
     return []
 
 

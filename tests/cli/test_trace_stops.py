@@ -1,0 +1,286 @@
+"""How ``linkwork trace`` stops when it cannot finish as asked, and what it keeps:
+
+* SIGTERM or Ctrl-C while tracing (a real process, a real signal) writes the path traced so far, complete and
+  valid (path.csv, points.csv, report.json saying where and why it stopped, mechanism.toml), leaves no staging
+  folder, and exits 143 / 130 with one line;
+* a target on a crank further round than the step budget goes is refused after one cycle (exit 3, one line naming
+  --max-steps), not after the whole budget;
+* a --deployed-at value branch 0 never reaches: the trace is written, then exit 3 with the range.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner, Result
+
+from linkwork.cli import app
+from linkwork.io.readback import read_points_csv, read_report
+from linkwork.outputs.staging import MANIFEST
+
+runner = CliRunner()
+ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+
+
+def invoke(*args: str) -> Result:
+    result = runner.invoke(app, list(args))
+    assert "Traceback" not in result.stdout + result.stderr
+    return result
+
+
+def one_error_line(stderr: str) -> str:
+    lines = ANSI.sub("", stderr).strip().splitlines()
+    lines = [line for line in lines if not line.startswith("note:")]  # a kernel announcement
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("error: "), lines[0]
+    return lines[0]
+
+
+def read_path_rows(file: Path) -> tuple[list[str], np.ndarray]:
+    """path.csv's header and rows, every row as long as the header and every cell a finite number."""
+    with open(file, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    header, body = rows[0], rows[1:]
+    assert body and all(len(row) == len(header) for row in body)
+    values = np.array(body, dtype=float)
+    assert np.all(np.isfinite(values))
+    return header, values
+
+
+def assert_complete_trace_folder(out: Path) -> dict[str, object]:
+    """The folder holds a whole trace: files parse, rows agree with each other and with report.json."""
+    report = read_report(out / "report.json")
+    header, rows = read_path_rows(out / "path.csv")
+    assert len(rows) == report["points"]
+    branch, step = rows[:, header.index("branch")], rows[:, header.index("step")]
+    for entry in report["branches"]:
+        mine = step[branch == entry["id"]]
+        assert len(mine) >= 1 and np.all(np.diff(mine) == 1)
+        assert mine[-1] == entry["steps"]
+    points = read_points_csv(out / "points.csv")
+    assert len(points.rows) == len(rows)
+    tomllib.loads((out / "mechanism.toml").read_text(encoding="utf-8"))
+    manifest = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
+    written = {"path.csv", "report.json", "points.csv", "mechanism.toml"}
+    assert written <= set(manifest["parts"]["run"]) <= {p.name for p in out.iterdir()}
+    return report
+
+
+# ------------------------------------------------------------------------------------ signals
+LONG_TRACES = {
+    # adaptive steps of 0.01 deg: hundreds of thousands of steps, minutes with the plain-Python kernels
+    "adaptive": ["hedgepeth-rods", "--max-step", "0.01", "--max-steps", "1000000"],
+    "branches": ["guest-frame", "--branches", "--max-step", "0.01", "--max-steps", "1000000"],
+    "target": ["four-bar", "--until", "A=100000", "--max-step", "0.01", "--max-steps", "1000000"],
+}
+
+
+def start_linkwork(args: list[str]) -> subprocess.Popen[str]:
+    script = Path(sys.executable).with_name("linkwork")
+    if not script.exists():
+        pytest.skip("the linkwork script is not installed")
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(sys.path),
+        "NO_COLOR": "1",
+        "PYTHONUNBUFFERED": "1",
+        "LINKWORK_JIT": "python",  # slow and steady: the trace is surely still running when the signal comes
+    }
+    return subprocess.Popen(
+        [str(script), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+
+
+def wait_until_tracing(proc: subprocess.Popen[str], timeout: float = 120.0) -> None:
+    """Wait for the line ``linkwork trace`` prints before it starts tracing, then a moment more."""
+    assert proc.stdout is not None
+    deadline = time.monotonic() + timeout
+    line = proc.stdout.readline()
+    while "unknowns" not in line:
+        assert line or proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the trace never started"
+        line = proc.stdout.readline()
+    time.sleep(1.5)
+
+
+@pytest.mark.parametrize("case", sorted(LONG_TRACES))
+@pytest.mark.parametrize(
+    ("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"]
+)
+def test_a_signal_while_tracing_writes_the_path_so_far(
+    tmp_path: Path, case: str, sig: int, code: int
+) -> None:
+    out = tmp_path / "out"
+    proc = start_linkwork(["trace", *LONG_TRACES[case], "--no-plots", "-o", str(out)])
+    wait_until_tracing(proc)
+    assert proc.poll() is None, "the trace ended before the signal: make it longer"
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    name = signal.Signals(sig).name
+    assert proc.returncode == code, err
+    assert "Traceback" not in err
+    line = one_error_line(err)
+    assert line.startswith(f"error: interrupted ({name}): the ") and str(out) in line
+    report = assert_complete_trace_folder(out)
+    assert report["complete"] is False and report["stopped"] == f"interrupted ({name})"
+    kinds = [b["end_kind"] for b in report["branches"]]
+    assert "interrupted" in kinds or case == "branches"  # with --branches the queue may be what was cut
+    assert f"the {report['points']} points traced so far" in line
+    if case == "target":
+        assert report["target_reached"] is False and "interrupted" in str(report["unmet"])
+    assert not list(tmp_path.glob(".linkwork-*")), "a staging folder was left behind"
+
+
+def test_a_trace_that_is_not_interrupted_is_complete(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", "four-bar", "--no-plots", "-o", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = assert_complete_trace_folder(out)
+    assert report["complete"] is True and report["stopped"] is None
+
+
+# ------------------------------------------------------------------------------------ targets beyond the budget
+@pytest.mark.parametrize("value", ["1e300", "-1e300", "100000", "1e6"])
+def test_a_crank_target_beyond_the_budget_is_refused_after_one_cycle(tmp_path: Path, value: str) -> None:
+    out = tmp_path / "out"
+    started = time.perf_counter()
+    result = invoke("trace", "four-bar", "--until", f"A={value}", "--no-plots", "-o", str(out))
+    assert result.exit_code == 3, result.stderr
+    line = one_error_line(result.stderr)
+    assert line.startswith("error: A cannot reach") and "--max-steps" in line and "cycles" in line
+    report = assert_complete_trace_folder(out)
+    free = invoke("trace", "four-bar", "--no-plots", "-o", str(tmp_path / "free"))
+    cycle = read_report(tmp_path / "free" / "report.json")["branches"][0]["steps"]
+    assert free.exit_code == 0
+    assert report["branches"][0]["steps"] <= cycle + 10  # one cycle, not the 5000 steps of the budget
+    assert report["target_reached"] is False and report["unmet"] == line.removeprefix("error: ")
+    assert time.perf_counter() - started < 60.0
+
+
+def test_a_crank_target_a_few_turns_away_is_reached(tmp_path: Path) -> None:
+    result = invoke("trace", "four-bar", "--until", "A=1500", "--no-plots", "-o", str(tmp_path / "out"))
+    assert result.exit_code == 0, result.stderr
+    report = read_report(tmp_path / "out" / "report.json")
+    assert report["target_reached"] is True
+    assert report["branches"][0]["end"]["A"] == pytest.approx(1500.0, abs=1e-9)
+
+
+# ------------------------------------------------------------------------------------ --deployed-at never reached
+HOOP = ["hedgepeth-rods", "--set", "n=6", "--until", "A=128.6822"]
+
+
+@pytest.mark.parametrize(
+    ("args", "at"),
+    [
+        (HOOP, "A=500"),  # beyond the drive's range
+        (HOOP, "A=-500"),  # before it
+        (HOOP, "B=1e9"),  # another joint
+        (["slider-crank"], "D=1e6"),  # a prismatic joint: a length
+    ],
+    ids=["above", "below", "other-joint", "prismatic"],
+)
+@pytest.mark.parametrize("plots", [False, True], ids=["no-plots", "plots"])
+def test_a_deployed_value_never_reached_writes_the_trace_then_exits_3(
+    tmp_path: Path, args: list[str], at: str, plots: bool
+) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", *args, "--deployed-at", at, *([] if plots else ["--no-plots"]), "-o", str(out))
+    if result.exit_code == 2 and "not a joint" in result.stderr:
+        pytest.fail(result.stderr)
+    assert result.exit_code == 3, result.stderr
+    line = one_error_line(result.stderr)
+    joint = at.partition("=")[0]
+    assert f"deployed at {joint}=" in line and "not on the deployment path" in line and " goes from " in line
+    report = assert_complete_trace_folder(out)
+    assert report["deployment"] is None
+    assert report["deployment_unmet"] == line.removeprefix("error: ")
+    assert not (out / "stretch.png").exists()  # a stretch against a deployed shape that is not there
+    if plots:
+        assert (out / "angles.png").exists()
+
+
+def test_a_deployed_value_on_the_path_is_measured_there(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", *HOOP, "--deployed-at", "A=100", "--no-plots", "-o", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = read_report(out / "report.json")
+    assert report["deployment_unmet"] is None
+    assert report["deployment"]["deployed"]["at"] == {"joint": "A", "value": 100.0}
+
+
+def test_trace_help_says_what_is_written_when_a_request_is_not_met() -> None:
+    result = invoke("trace", "--help")
+    text = " ".join(ANSI.sub("", result.stdout).split())
+    assert "nothing is written" not in text
+    assert "--max-steps" in text and "130 / 143" in text
+
+
+def test_more_equal_steps_than_the_budget_are_bad_input(tmp_path: Path) -> None:
+    """Paper mode's target is --steps steps away: more than --max-steps can never reach it. Refused before any
+    step (exit 2), nothing written, instead of marching the whole budget."""
+    out = tmp_path / "out"
+    result = invoke("trace", "four-bar", "--until", "A=420", "--steps", "6000", "--no-plots", "-o", str(out))
+    assert result.exit_code == 2, result.stderr
+    assert "more than the step budget max_steps (5000, --max-steps)" in one_error_line(result.stderr)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "args", [["--until", "A=100000", "--steps", "200"], ["--until", "A=1e300", "--steps", "5000"]]
+)
+def test_huge_equal_steps_end_with_a_reason_and_keep_the_trace(tmp_path: Path, args: list[str]) -> None:
+    """500 deg a step crashed (IndexError traceback, exit 1); 2e296 deg a step: exit 3, the trace written."""
+    out = tmp_path / "out"
+    result = invoke("trace", "four-bar", *args, "--no-plots", "-o", str(out))
+    assert result.exit_code == 3, result.stderr
+    assert one_error_line(result.stderr).startswith("error: A did not reach")
+    assert_complete_trace_folder(out)
+
+
+def test_equal_steps_several_turns_round_reach_the_target(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = invoke("trace", "four-bar", "--until", "A=3600", "--steps", "100", "--no-plots", "-o", str(out))
+    assert result.exit_code == 0, result.stderr
+    report = read_report(out / "report.json")
+    assert report["branches"][0]["steps"] == 100
+    assert report["branches"][0]["end"]["A"] == pytest.approx(3600.0, abs=1e-9)
+
+
+# ------------------------------------------------------------------------------------ every other command
+@pytest.mark.parametrize(
+    ("sig", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"]
+)
+def test_a_signal_during_a_mechanization_is_one_line_and_keeps_the_chain(
+    tmp_path: Path, sig: int, code: int
+) -> None:
+    """A command that keeps nothing of the step it is in (here synth's mechanization, after the chain is written)
+    still stops with one line and 143 / 130, not SIGTERM's silent kill without cleanup; what was written before
+    (the chain) is kept, nothing is half-written, no staging folder is left."""
+    out = tmp_path / "out"
+    proc = start_linkwork(["synth", "wing/mechanize.toml", "--no-plots", "-o", str(out)])
+    deadline = time.monotonic() + 120.0
+    while not (out / "chain.json").exists():  # the chain is written before the mechanization starts
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the chain was never written"
+        time.sleep(0.1)
+    time.sleep(2.0)  # well into the mechanization (half a minute with the plain-Python kernels)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == code, err
+    assert one_error_line(err) == f"error: interrupted ({signal.Signals(sig).name})"
+    json.loads((out / "chain.json").read_text(encoding="utf-8"))
+    assert not (out / "mechanization.json").exists()
+    assert not list(tmp_path.glob(".linkwork-*"))
+    assert [p.name for p in out.glob(".linkwork-*")] == [MANIFEST]  # no staging inside either
