@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner, Result
 
+import linkwork as lw
 from linkwork.cli import app
 from linkwork.io.readback import read_points_csv, read_report
 from linkwork.outputs.staging import MANIFEST
@@ -236,16 +237,33 @@ def test_more_equal_steps_than_the_budget_are_bad_input(tmp_path: Path) -> None:
     assert not out.exists()
 
 
-@pytest.mark.parametrize(
-    "args", [["--until", "A=100000", "--steps", "200"], ["--until", "A=1e300", "--steps", "5000"]]
-)
-def test_huge_equal_steps_end_with_a_reason_and_keep_the_trace(tmp_path: Path, args: list[str]) -> None:
-    """500 deg a step crashed (IndexError traceback, exit 1); 2e296 deg a step: exit 3, the trace written."""
+def test_huge_equal_steps_end_with_a_reason_and_keep_the_trace(tmp_path: Path) -> None:
+    """2e296 deg a step (more than any number of parts of a step can follow): exit 3, the trace written."""
     out = tmp_path / "out"
-    result = invoke("trace", "four-bar", *args, "--no-plots", "-o", str(out))
+    result = invoke("trace", "four-bar", "--until", "A=1e300", "--steps", "5000", "--no-plots", "-o", str(out))
     assert result.exit_code == 3, result.stderr
     assert one_error_line(result.stderr).startswith("error: A did not reach")
     assert_complete_trace_folder(out)
+
+
+def test_equal_steps_longer_than_a_turn_follow_the_path(tmp_path: Path) -> None:
+    """500 deg a step crashed (IndexError traceback, exit 1), then failed; each step is now taken in parts along
+    the path: the crank's 200 rows 500 deg apart, every row on the start's assembly (the four-bar's closed form:
+    the coupler point C on both circles, the rocker's angle from C, on the side of the start)."""
+    out = tmp_path / "out"
+    args = ["--until", "A=100000", "--steps", "200", "--no-plots", "-o", str(out)]
+    result = invoke("trace", "four-bar", *args)
+    assert result.exit_code == 0, result.stderr
+    assert_complete_trace_folder(out)
+    rows = np.loadtxt(out / "path.csv", delimiter=",", skiprows=1, usecols=(3, 6))  # A, D
+    mech = lw.load("four-bar")
+    fine = lw.trace(mech, until=("A", float(mech.offsets[0]) + 2 * np.pi), steps=3600)  # 0.1 deg
+    a0 = np.degrees(mech.offsets[0])
+    assert len(rows) == 201
+    assert rows[-1, 0] == pytest.approx(100000.0, abs=1e-9)
+    on_grid = np.rint(((rows[:, 0] - a0) % 360.0) * 10).astype(int) % 3600
+    d_fine = np.degrees(fine.angles[on_grid, 3])
+    assert np.max(np.abs((rows[:, 1] - d_fine + 180.0) % 360.0 - 180.0)) < 1e-8
 
 
 def test_equal_steps_several_turns_round_reach_the_target(tmp_path: Path) -> None:
