@@ -240,7 +240,9 @@ def test_more_equal_steps_than_the_budget_are_bad_input(tmp_path: Path) -> None:
 def test_huge_equal_steps_end_with_a_reason_and_keep_the_trace(tmp_path: Path) -> None:
     """2e296 deg a step (more than any number of parts of a step can follow): exit 3, the trace written."""
     out = tmp_path / "out"
-    result = invoke("trace", "four-bar", "--until", "A=1e300", "--steps", "5000", "--no-plots", "-o", str(out))
+    result = invoke(
+        "trace", "four-bar", "--until", "A=1e300", "--steps", "5000", "--no-plots", "-o", str(out)
+    )
     assert result.exit_code == 3, result.stderr
     assert one_error_line(result.stderr).startswith("error: A did not reach")
     assert_complete_trace_folder(out)

@@ -51,7 +51,7 @@ MARCH_ARGUMENTS = {
         "stall_length", "max_steps", "r_path", "detect", "check_closed",
     ),
     "corrector": CORRECTOR,
-    "bounds": ("periodic", "lo", "hi"),
+    "bounds": ("periodic", "lo", "hi", "weight"),
     "out": ("out_u", "out_t", "out_sigma", "out_res", "out_tau", "out_s"),
 }  # fmt: skip
 """The tuples :func:`march` takes, in order, and their members."""
@@ -157,7 +157,7 @@ def correct_in(mech, u, held, corrector, work):
 
 
 @kernel()
-def correct_across(mech, u, t, corrector, work):
+def correct_across(mech, u, t, corrector, work, weight):
     """Gauss-Newton for the closure in the hyperplane through the predicted ``u`` normal to the tangent ``t``
     (pseudo-arclength), in place on ``u`` (``work`` as in :func:`evaluate_in`); returns ``(converged,
     iterations, residual)`` as :func:`correct_in`.
@@ -165,7 +165,8 @@ def correct_across(mech, u, t, corrector, work):
     Each step is the truncated-SVD least-squares solution (Eq. (28)) of the closure's Jacobian bordered by
     ``t``: the point it converges to, where the path crosses that hyperplane, does not depend on how the closure
     equations are weighted, so the steps are the same whatever the length unit and wherever the linkage stands
-    (a minimum-norm correction over all unknowns lands elsewhere on the path for each weighting).
+    (a minimum-norm correction over all unknowns lands elsewhere on the path for each weighting). The hyperplane
+    is normal in the step's metric (``weight``, :func:`weighted_norm`), so it is the same in any length unit.
     """
     tol, exact, roundoff, truncate, max_iter = corrector
     res, jac = work[1], work[2]
@@ -186,8 +187,8 @@ def correct_across(mech, u, t, corrector, work):
         for a in range(m):
             for e in range(E):
                 A[e, a] = jac[e, a]
-            A[E, a] = t[a]
-            gap += t[a] * (u[a] - u0[a])
+            A[E, a] = t[a] * (weight[a] * weight[a])
+            gap += A[E, a] * (u[a] - u0[a])
         for e in range(E):
             b[e] = res[e]
         b[E] = gap
@@ -351,38 +352,69 @@ def tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out):
 
 
 @kernel()
-def wrapped_distance(a, b, periodic):
-    """Euclidean distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to [-pi, pi)."""
+def wrapped_distance(a, b, periodic, weight):
+    """Distance between unknowns ``a`` and ``b`` with periodic (angle) differences wrapped to [-pi, pi), each
+    difference times its ``weight`` (1 for an angle, ``1 / L`` for a length: see :func:`weighted_norm`)."""
     d = 0.0
     for i in range(a.shape[0]):
         diff = a[i] - b[i]
         if periodic[i]:
             diff = (diff + np.pi) % (2.0 * np.pi) - np.pi  # compiled copy of linkwork.geometry.angles.wrap
+        diff = diff * weight[i]
         d += diff * diff
     return np.sqrt(d)
 
 
 @kernel()
-def step_geometry(u, t, u_try, t_new):
+def step_geometry(u, t, u_try, t_new, weight, weighted):
     """``(turn, dist, ahead)`` of a corrected step: the cosine between the tangents, the step's length and how far
-    it went along the old tangent."""
+    it went along the old tangent, in the step's metric (``weight``, see :func:`weighted_norm`; the unit tangents
+    as they are where every weight is 1)."""
     turn = 0.0
     dist = 0.0
     ahead = 0.0
     for a in range(u.shape[0]):
+        w2 = weight[a] * weight[a]
         du = u_try[a] - u[a]
-        turn += t_new[a] * t[a]
-        dist += du * du
-        ahead += t[a] * du
+        turn += t_new[a] * t[a] * w2
+        dist += du * du * w2
+        ahead += t[a] * du * w2
+    if weighted:
+        tn = weighted_norm(t, weight)
+        turn /= tn * weighted_norm(t_new, weight)
+        ahead /= tn
     return turn, np.sqrt(dist), ahead
 
 
-@kernel()
-def correction(u, t, step, u_try):
-    """How far the corrector moved the predicted point ``u + step t`` to ``u_try``."""
+@kernel(inline="always")
+def plain_length(u, u_try):
+    """The Euclidean length of the step from ``u`` to ``u_try`` in the unknowns as they are (the reported
+    arclength's; the step control's is weighted, :func:`weighted_norm`)."""
     acc = 0.0
     for a in range(u.shape[0]):
-        d = u_try[a] - u[a] - step * t[a]
+        du = u_try[a] - u[a]
+        acc += du * du
+    return np.sqrt(acc)
+
+
+@kernel(inline="always")
+def weighted_norm(t, weight):
+    """The length of ``t`` in the step's metric: each unknown times its weight, 1 for an angle and ``1 / L`` for
+    a length (``L`` the linkage's own length, :func:`linkwork.kinematics.normalization.length_scale`), so that
+    the steps are the same in any length unit."""
+    acc = 0.0
+    for a in range(t.shape[0]):
+        x = t[a] * weight[a]
+        acc += x * x
+    return np.sqrt(acc)
+
+
+@kernel()
+def correction(u, t, step, u_try, weight):
+    """How far the corrector moved the predicted point ``u + step t`` to ``u_try`` (in the step's metric)."""
+    acc = 0.0
+    for a in range(u.shape[0]):
+        d = (u_try[a] - u[a] - step * t[a]) * weight[a]
         acc += d * d
     return np.sqrt(acc)
 
@@ -398,13 +430,14 @@ def snap_home(u, u_home, periodic, out):
 
 
 @kernel()
-def predict(u, t, h, paper, drive, target, has_target, first, u_try):
+def predict(u, t, h, paper, drive, target, has_target, first, u_try, tn):
     """The predictor (Sec. 4.1): ``u_try = u + step t``; returns ``(step, landing, held)``.
 
     Paper mode: ``step`` moves the drive by exactly ``h`` (on the first step ``t`` is turned, in place, to
     point that way), the corrector holds the drive (``held``); ``held == TURNED`` means the drive has turned
     back.
-    Adaptive mode: ``step = h`` along the tangent. Either way a step that would pass the target is shortened to
+    Adaptive mode: ``step = h / tn`` along the tangent (``tn`` its length in the step's metric: a step of length
+    ``h`` there). Either way a step that would pass the target is shortened to
     land on it (``landing``; the drive then held at the target).
     """
     m = u.shape[0]
@@ -424,10 +457,10 @@ def predict(u, t, h, paper, drive, target, has_target, first, u_try):
             landing = True
         held = drive
     else:
-        step = h
+        step = h / tn
         if has_target and abs(t[drive]) > 1e-12:
             to_go = (target - u[drive]) / t[drive]
-            if 0.0 <= to_go <= h:
+            if 0.0 <= to_go <= step:
                 step = to_go
                 landing = True
                 held = drive
@@ -478,7 +511,7 @@ def march(mech, start, steps, corrector, bounds, out):
     The arguments are tuples (:data:`MARCH_ARGUMENTS` names their members): ``mech`` the mechanism's arrays (see
     :mod:`~linkwork.kinematics.kernels`); ``start = (u0, t0, u_home, basis, reach)``; ``steps = (paper, drive, h0,
     hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length, max_steps, r_path, detect,
-    check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi)``;
+    check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi, weight)``;
     ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s)``, the rows written. numba unpacks each tuple once
     per call; the inner kernels get the tuples they need.
 
@@ -501,7 +534,10 @@ def march(mech, start, steps, corrector, bounds, out):
         paper, drive, h0, hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length,
         max_steps, r_path, detect, check_closed,
     ) = steps  # fmt: skip
-    periodic, lo, hi = bounds
+    periodic, lo, hi, weight = bounds
+    weighted = False  # a prismatic unknown, measured in the linkage's own length (weight 1 / L)
+    for a in range(u0.shape[0]):
+        weighted = weighted or weight[a] != 1.0
     out_u, out_sigma, out_res, out_tau = out[0], out[2], out[3], out[4]
     loop_ptr, rows, groups = mech[3], mech[4], mech[5]
     m = u0.shape[0]
@@ -523,12 +559,14 @@ def march(mech, start, steps, corrector, bounds, out):
     tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
-    if reach[1] == 0.0:  # a new path (no step taken yet): its tangent at the start, for the closure's alignment
+    if (
+        reach[1] == 0.0
+    ):  # a new path (no step taken yet): its tangent at the start, for the closure's alignment
         reach[2:] = t
     t_home = reach[2:]
     s_total = 0.0
     basis_try = basis.copy()
-    far = max(reach[0], wrapped_distance(u0, u_home, periodic))
+    far = max(reach[0], wrapped_distance(u0, u_home, periodic, weight))
     longest = reach[1]  # the longest step of the path (a closed path has gone several of them from its start)
     recent = np.zeros(max(stall_steps, 1))  # lengths of the last stall_steps steps (a ring)
     count = 1
@@ -540,7 +578,9 @@ def march(mech, start, steps, corrector, bounds, out):
     while count <= max_steps:
         # ---- predictor (Sec. 4.1)
         first = count == 1 and part == 0
-        step, landing, held = predict(u, t, h / parts, paper, drive, target, has_target, first, u_try)
+        tn = weighted_norm(t, weight) if weighted else 1.0  # the tangent's length in the step's metric
+        step, landing, held = predict(u, t, h / parts, paper, drive, target, has_target, first, u_try, tn)
+        along = step * tn  # the prediction's length in that metric
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
         if (
@@ -549,17 +589,17 @@ def march(mech, start, steps, corrector, bounds, out):
             extrapolate(out[0][count - 2], out[1][count - 2], u, t, drive, u_try, 0.1 * abs(step))
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
-            ok, _, r = correct_across(mech, u_try, t, corrector, work)
+            ok, _, r = correct_across(mech, u_try, t, corrector, work, weight)
         else:
             ok, _, r = correct_in(mech, u_try, held, corrector, work)
         turn, dist, tau_new = 1.0, 0.0, 0.0
-        easy = ok and correction(u, t, step, u_try) <= 0.1 * abs(step)
+        easy = ok and correction(u, t, step, u_try, weight) <= 0.1 * abs(along)
         if ok:
             basis_try[:, :] = basis
             tau_new = tangent_and_test_in(jac, t, basis_try, r_path, t_new, sig, svd)
-            turn, dist, ahead = step_geometry(u, t, u_try, t_new)
+            turn, dist, ahead = step_geometry(u, t, u_try, t_new, weight, weighted)
             if not paper and not landing and h > hmin:
-                ok = step_acceptable(turn, dist, ahead, step, cos_turn, advance)
+                ok = step_acceptable(turn, dist, ahead, along, cos_turn, advance)
             elif paper:
                 ok = not jumps(u, u_try, periodic)
         if not ok:
@@ -576,7 +616,8 @@ def march(mech, start, steps, corrector, bounds, out):
                 return count, FAILED, h
             continue
         # ---- accept the step
-        s_total += dist
+        # the arclength reported is in the unknowns as they are (lengths in the length unit, as the closed form's)
+        s_total += dist if not weighted else plain_length(u, u_try)
         longest = max(longest, dist)
         reach[1] = longest
         for a in range(m):
@@ -601,7 +642,7 @@ def march(mech, start, steps, corrector, bounds, out):
         if code != NO_EVENT:
             return count, code, h
         if check_closed:
-            d = wrapped_distance(u, u_home, periodic)  # to the start of the path
+            d = wrapped_distance(u, u_home, periodic, weight)  # to the start of the path
             far = max(far, d)
             reach[0] = far
             align = 0.0

@@ -38,7 +38,8 @@ class MarchSettings:
     ``target`` is the drive's target in the unknowns (``None``: none); ``lo``/``hi`` are the limits in the
     unknowns (``-inf``/``inf`` where none); ``periodic`` marks the revolute unknowns (compared modulo a turn);
     ``drive_joint`` is the joint the user drives (``-1``: the first joint of the drive's unknown), whose value a
-    fold reports.
+    fold reports; ``weight`` each unknown's weight in the step's metric (1 for an angle, ``1 / L`` for a length,
+    ``L`` the linkage's own length: steps the same in any length unit; ``None``: every weight 1).
     """
 
     drive: int
@@ -53,12 +54,16 @@ class MarchSettings:
     hi: Array
     tol: Tolerances
     drive_joint: int = -1
+    weight: Array | None = None
 
 
 #: A closed path turning the drive towards a target further round stops when the whole cycles still needed, at
 #: this fraction of the fewest steps a cycle took so far, are more than the steps left: cycles after the first
 #: start at full step length and repeat it, so the margin only covers round-off in the step control.
 CYCLE_SLACK = 0.9
+
+#: Paper mode: the adaptive steps of the probe that looks for a fold of the drive past a failed equal step.
+FOLD_PROBE_STEPS = 60
 
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
 #: branch along which the drive stays put (to round-off) that component only changes sign by noise.
@@ -160,6 +165,10 @@ class BranchMarcher:
         workspace: Workspace | None = None,
     ) -> None:
         self.mech = mech
+        # The step metric's weights (writeable: the compiled march takes one array type)
+        self.weight = (
+            np.ones(len(settings.periodic)) if settings.weight is None else np.array(settings.weight)
+        )
         # The kernels the whole trace runs (chosen by its caller), in the caller's workspace when it has one.
         self.ws = workspace if workspace is not None else Workspace.of(mech, kernels)
         self.first_joint = mech.first_joints
@@ -226,7 +235,7 @@ class BranchMarcher:
             check_closed,
         )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
-            ws.kernel_arrays(), (u, t, u_home, basis, reach), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi),
+            ws.kernel_arrays(), (u, t, u_home, basis, reach), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight),
             (out.u, out.t, out.sigma, out.res, out.tau, out.s),
         )  # fmt: skip
         return out
@@ -391,6 +400,13 @@ class BranchMarcher:
                 cycle_from = n_steps
                 if paper:  # the steps left evened out onto the target from the closing row
                     chunk.h = self._steps_onto_target(chunk, paper_steps - n_steps)
+            elif (
+                paper
+                and chunk.code == StopReason.FAILED
+                and self._fold_ahead(chunk, basis, branch_id, n_steps)
+            ):
+                # the drive's next equal step is beyond a fold of the drive, located: its turning point
+                return n_steps, StopReason.TURNING, StopReason.TURNING.text, None, None
             elif chunk.code != StopReason.BUDGET or self.budget <= 0:
                 if limit is not None:
                     return n_steps, StopReason.LIMIT, limit[1], limit[0], None
@@ -595,6 +611,37 @@ class BranchMarcher:
             f"step budget: {cycles:.3g} more cycles of the path to go (about {needed:.3g} steps; one cycle took "
             f"{cycle_steps} steps and turns {name} by {per_cycle}), {self.budget} of {self.max_steps} steps left"
         )
+
+    def _fold_ahead(self, chunk: Chunk, basis: Array, branch_id: int, step: int) -> bool:
+        """Paper mode, the chunk's last equal drive step failed (in every number of parts): whether a fold of the
+        drive lies between its last row and the value that step asked for, where equal drive steps cannot go on.
+        A short adaptive march from the last row, towards larger drive values for a positive step, looks for the
+        drive turning back (:meth:`_scan_folds` locates it and records the fold, at step ``step``); its rows are
+        not kept. True when a fold was found short of the step's value."""
+        cfg, d, c = self.cfg, self.cfg.drive, chunk.count - 1
+        if c < 0 or chunk.h == 0.0:
+            return False
+        u, t = chunk.u[c].copy(), chunk.t[c].copy()
+        if t[d] * chunk.h < 0.0:
+            t = -t
+        h0 = min(cfg.max_step, abs(chunk.h)) / 4.0
+        probe = self.march_chunk(
+            u, t, u.copy(), basis.copy(), False, h0, FOLD_PROBE_STEPS, False, np.zeros(2 + len(u))
+        )
+        td = probe.t[: probe.count, d]
+        turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
+        if len(turned) == 0:
+            return False
+        k = int(turned[0])
+        reach = np.max(np.sign(chunk.h) * (probe.u[k : k + 2, d] - u[d]))
+        if reach >= abs(
+            chunk.h
+        ):  # the drive turns back beyond the value asked for: not what stopped the step
+            return False
+        probe.count = k + 2  # the fold's step only
+        before = len(self.folds)
+        self._scan_folds(probe, branch_id, step)
+        return len(self.folds) > before
 
     def _end_reason(self, chunk: Chunk, paper: bool) -> str:
         """The end reason a user reads for a chunk's stop code."""

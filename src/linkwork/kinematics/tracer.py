@@ -111,6 +111,7 @@ def trace(
     settings = record(
         MarchSettings, drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=cos_turn,
         r_path=r_path, n_sigma=start.n_sigma, periodic=start.periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
+        weight=_step_weights(mech),
     )  # fmt: skip
     paper = steps is not None
     basis0 = start.basis  # read-only (the start's, shared): the marches get copies
@@ -194,6 +195,26 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
     # their twenty-odd fields on almost every call.
     key = ("path start", backend.compiled) if tol is DEFAULT else ("path start", backend.compiled, tol)
     return mech.derived(key, build)
+
+
+def _step_weights(mech: Mechanism) -> Array:
+    """Each unknown's weight in the step control's metric, once per mechanism: 1 for an angle, ``1 / L`` for a
+    length (a prismatic unknown), ``L`` the linkage's own length
+    (:func:`~linkwork.kinematics.normalization.length_scale`, the RMS distance of its hinge lines from their
+    centre: it scales with the linkage and does not move with it), so that the step sequence is the same in any
+    length unit and wherever the linkage stands. Read-only."""
+
+    def build() -> Array:
+        weight = np.ones(mech.n_unknowns)
+        prismatic = [k for k, j in enumerate(mech.first_joints) if mech.joint_types[j] != "R"]
+        if prismatic:
+            from linkwork.kinematics.normalization import length_scale
+
+            weight[prismatic] = 1.0 / length_scale(mech)
+        weight.flags.writeable = False
+        return weight
+
+    return mech.derived("step weights", build)
 
 
 def _periodic(mech: Mechanism) -> NDArray[np.bool_]:
