@@ -241,7 +241,7 @@ BAD_INPUT = {
     "unknown --set key": (lambda t: ["trace", "hedgepeth", "--set", "m=6"], '"m"'),
     "odd n": (lambda t: ["trace", "hedgepeth", "--set", "n=5"], "even"),
     "--until without =": (lambda t: ["trace", "hedgepeth", "--until", "A87"], "JOINT=VALUE"),
-    "--until unknown joint": (lambda t: ["trace", "hedgepeth", "--until", "Z=30"], "'Z'"),
+    "--until unknown joint": (lambda t: ["trace", "hedgepeth", "--until", "Z=30"], '--until "Z"'),
     "--until infinite value": (lambda t: ["trace", "hedgepeth", "--until", "A=inf"], "--until"),
     "negative --max-step": (lambda t: ["trace", "hedgepeth", "--max-step", "-1"], "--max-step"),
     "missing spec file": (lambda t: ["trace", str(t / "missing.toml")], "not found"),

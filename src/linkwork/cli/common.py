@@ -322,16 +322,29 @@ def parse_joint_value(text: str | None, flag: str, example: str) -> tuple[str, f
     except ValueError:
         value = float("nan")
     if not sep or not name.strip() or not math.isfinite(value):
-        raise fail(f"{flag} {show(text)}: expected JOINT=VALUE with VALUE in degrees, e.g. {example}")
+        raise fail(
+            f"{flag} {show(text)}: expected JOINT=VALUE with VALUE in degrees (a length for a prismatic joint), "
+            f"e.g. {example}"
+        )
     return name.strip(), value
 
 
-def until_in_api_units(mech: Mechanism, target: tuple[str, float] | None) -> tuple[str, float] | None:
-    """A parsed ``--until`` in the API's units: degrees become radians for a revolute joint; a length stays."""
+def joint_named(mech: Mechanism, name: str, flag: str) -> int:
+    """The index of the joint a flag names, or one line naming the flag and the joints there are."""
+    if name not in mech.joint_names:
+        raise fail(f"{flag} {show(name)}: unknown joint; expected one of {', '.join(mech.joint_names)}")
+    return mech.index(name)
+
+
+def until_in_api_units(
+    mech: Mechanism, target: tuple[str, float] | None, flag: str = "--until"
+) -> tuple[str, float] | None:
+    """A parsed ``--until`` (or ``flag``) in the API's units: degrees become radians for a revolute joint; a
+    length stays. An unknown joint is one line naming the flag."""
     if target is None:
         return None
     name, value = target
-    revolute = mech.joint_types[mech.index(name)] == "R"
+    revolute = mech.joint_types[joint_named(mech, name, flag)] == "R"
     return name, math.radians(value) if revolute else float(value)
 
 

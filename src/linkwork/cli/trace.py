@@ -14,6 +14,7 @@ from linkwork.cli.common import (
     check_range,
     fail,
     friendly_errors,
+    joint_named,
     parse_assignments,
     parse_couple,
     parse_joint_value,
@@ -170,8 +171,14 @@ def trace(
     if couple or fixed:
         mech = mech.with_couplings(parse_couple(couple), fixed or [])
     limits = _limits_in_api_units(mech, limits_file)
+    if drive is not None:
+        joint_named(mech, drive, "--drive")
+    if steps is not None and target is None:
+        raise fail(
+            f"--steps {steps}: paper mode's equal steps go to a target; expected --until JOINT=VALUE too"
+        )
     until_rad = until_in_api_units(mech, target)
-    deployed_rad = until_in_api_units(mech, _parse_deployed_at(deployed_at))
+    deployed_rad = until_in_api_units(mech, _parse_deployed_at(deployed_at), "--deployed-at")
 
     console.print(
         Text(mech.name, style="bold"),
