@@ -36,7 +36,7 @@ def test_an_unknown_joint_names_the_flag_and_the_joints(tmp_path: Path, name: st
     value = "ZZ=10" if flag != "--drive" else "ZZ"
     out = tmp_path / "out"
     line = error_line(["trace", name, flag, value, "--no-plots", "-o", str(out)])
-    assert line.startswith(f"error: {flag} \"ZZ\": unknown joint; expected one of ")
+    assert line.startswith(f'error: {flag} "ZZ": unknown joint; expected one of ')
     assert line.endswith(", ".join(joints))
     assert not out.exists()
 
