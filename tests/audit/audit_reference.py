@@ -447,64 +447,15 @@ class SliderCrank:
         return out
 
 
-class Watt:
-    """Watt II: four-bar A-B-C-D (ground pivots A, D), ternary rocker C-D-E, dyad E-F-G (G on ground).
+class _SixBar:
+    """A four-bar A-B-C-D (ground pivots A, D) whose link ``CARRIER`` also carries E, and a dyad E-F-G (G on
+    the ground): Watt II when the rocker carries E, Stephenson III when the coupler does.
 
-    Bodies: ground (A, D, G), crank (A, B), coupler (B, C), rocker (C, D, E), link5 (E, F), link6 (F, G).
+    Bodies: ground (A, D, G), crank (A, B), coupler (B, C), rocker (C, D), link5 (E, F), link6 (F, G); E on
+    ``CARRIER``. Solved by two circle intersections (every assembly).
     """
 
-    def __init__(self, name: str, pts: dict[str, tuple[float, float]], theta0: float) -> None:
-        self.pts = {k: P(*v) for k, v in pts.items()}
-        d = lambda u, v: float(np.linalg.norm(self.pts[u] - self.pts[v]))  # noqa: E731
-        self.len = {k: d(*k) for k in ["AB", "BC", "CD", "EF", "FG", "DE"]}
-        self.mech = Mech(
-            name,
-            [
-                dict(name="A", bodies=["ground", "crank"], point=list(self.pts["A"]), value=theta0),
-                dict(name="B", bodies=["crank", "coupler"], point=list(self.pts["B"])),
-                dict(name="C", bodies=["coupler", "rocker"], point=list(self.pts["C"])),
-                dict(name="D", bodies=["rocker", "ground"], point=list(self.pts["D"])),
-                dict(name="E", bodies=["rocker", "link5"], point=list(self.pts["E"])),
-                dict(name="F", bodies=["link5", "link6"], point=list(self.pts["F"])),
-                dict(name="G", bodies=["link6", "ground"], point=list(self.pts["G"])),
-            ],
-            planar=True,
-        )
-
-    def solve(self, drive: str, reading: float) -> list[dict[str, float]]:
-        assert drive == "A"
-        p = self.pts
-        gc = about_line(p["A"], Z, np.radians(reading - self.mech.joints[0]["value"]))
-        B1 = gc[:3, :3] @ p["B"] + gc[:3, 3]
-        out = []
-        for C1 in circles(B1, self.len["BC"], p["D"], self.len["CD"]):
-            if np.isnan(C1).any():
-                continue
-            C1 = np.array([*C1, 0.0])
-            grk = pose2(p["D"], p["C"], p["D"], C1)
-            E1 = grk[:3, :3] @ p["E"] + grk[:3, 3]
-            for F1 in circles(E1, self.len["EF"], p["G"], self.len["FG"]):
-                if np.isnan(F1).any():
-                    continue
-                F1 = np.array([*F1, 0.0])
-                g = dict(
-                    ground=np.eye(4),
-                    crank=gc,
-                    coupler=pose2(p["B"], p["C"], B1, C1),
-                    rocker=grk,
-                    link5=pose2(p["E"], p["F"], E1, F1),
-                    link6=pose2(p["G"], p["F"], p["G"], F1),
-                )
-                out.append(readings_from_poses(self.mech, g))
-        return out
-
-
-class Stephenson3:
-    """Stephenson III: four-bar A-B-C-D, ternary coupler B-C-E, dyad E-F-G with G on the ground.
-
-    Bodies: ground (A, D, G), crank (A, B), coupler (B, C, E), rocker (C, D), link5 (E, F), link6 (F, G).
-    The ternary links (ground, coupler) are not joined directly: Stephenson's chain.
-    """
+    CARRIER = ""
 
     def __init__(self, name: str, pts: dict[str, tuple[float, float]], theta0: float) -> None:
         self.pts = {k: P(*v) for k, v in pts.items()}
@@ -517,7 +468,7 @@ class Stephenson3:
                 dict(name="B", bodies=["crank", "coupler"], point=list(self.pts["B"])),
                 dict(name="C", bodies=["coupler", "rocker"], point=list(self.pts["C"])),
                 dict(name="D", bodies=["rocker", "ground"], point=list(self.pts["D"])),
-                dict(name="E", bodies=["coupler", "link5"], point=list(self.pts["E"])),
+                dict(name="E", bodies=[self.CARRIER, "link5"], point=list(self.pts["E"])),
                 dict(name="F", bodies=["link5", "link6"], point=list(self.pts["F"])),
                 dict(name="G", bodies=["link6", "ground"], point=list(self.pts["G"])),
             ],
@@ -534,8 +485,9 @@ class Stephenson3:
             if np.isnan(C1).any():
                 continue
             C1 = np.array([*C1, 0.0])
-            gcp = pose2(p["B"], p["C"], B1, C1)
-            E1 = gcp[:3, :3] @ p["E"] + gcp[:3, 3]
+            poses = dict(coupler=pose2(p["B"], p["C"], B1, C1), rocker=pose2(p["D"], p["C"], p["D"], C1))
+            carrier = poses[self.CARRIER]
+            E1 = carrier[:3, :3] @ p["E"] + carrier[:3, 3]
             for F1 in circles(E1, self.len["EF"], p["G"], self.len["FG"]):
                 if np.isnan(F1).any():
                     continue
@@ -543,13 +495,25 @@ class Stephenson3:
                 g = dict(
                     ground=np.eye(4),
                     crank=gc,
-                    coupler=gcp,
-                    rocker=pose2(p["D"], p["C"], p["D"], C1),
+                    **poses,
                     link5=pose2(p["E"], p["F"], E1, F1),
                     link6=pose2(p["G"], p["F"], p["G"], F1),
                 )
                 out.append(readings_from_poses(self.mech, g))
         return out
+
+
+class Watt(_SixBar):
+    """Watt II: the ternary rocker C-D-E carries the dyad E-F-G."""
+
+    CARRIER = "rocker"
+
+
+class Stephenson3(_SixBar):
+    """Stephenson III: the ternary coupler B-C-E carries the dyad E-F-G (the ternary links, ground and coupler,
+    are not joined directly: Stephenson's chain)."""
+
+    CARRIER = "coupler"
 
 
 def nearest(

@@ -578,8 +578,8 @@ class BranchMarcher:
     def _steps_onto_target(self, chunk: Chunk, left: int) -> float:
         """Paper mode, after a closed cycle of a drive turning towards its target: the equal drive step that lands
         on the target from the chunk's last row in the ``left`` steps the paper's count leaves (at least one). A
-        path closes by snapping its last row onto the start (a step shorter than the others), so the march's equal
-        steps, which land on the target only when it is on their grid, would otherwise step past it."""
+        paper path closes by landing on its start, whose row is then the start itself (the running sum's rounding
+        dropped): the steps after it are evened out again from there, so that the last lands on the target."""
         target = self.cfg.target
         if target is None:
             return chunk.h
