@@ -57,7 +57,7 @@ def _corrections(mech: Any, u0: Any, t: Any, corrector: Any, q: Any, res: Any, j
 def _tangents(jac: Any, t: Any, basis: Any, r_path: int, t_out: Any, sigma: Any, n: int) -> float:
     acc = 0.0
     for _ in range(n):
-        acc += kernels.tangent_and_test(jac, t, basis.copy(), r_path, t_out, sigma)
+        acc += kernels.tangent_and_test(jac, t, basis.copy(), r_path, t_out, sigma, np.ones(t.shape[0]))
     return acc
 
 
@@ -68,13 +68,14 @@ def _warm_tangents(jacs: Any, t0: Any, basis0: Any, r_path: int, sigma: Any, n: 
     E, m = jacs.shape[1], jacs.shape[2]
     t, t_out = t0.copy(), np.empty(m)
     svd = kernels.svd_work(E, m)
+    ones = np.ones(m)
     basis = basis0.copy()
     for i in range(n):
         k = i % jacs.shape[0]
         if k == 0:
             basis[:, :] = basis0
             t[:] = t0
-        acc += kernels.tangent_and_test_in(jacs[k], t, basis, r_path, t_out, sigma, svd)
+        acc += kernels.tangent_and_test_in(jacs[k], t, basis, r_path, t_out, sigma, svd, ones)
         t[:] = t_out
     return acc
 

@@ -1,6 +1,5 @@
-"""Failures the audit found in the tracer (kinematics/), as regression tests; the two not fixed yet are strict
-expected failures (each passes, and so fails the suite, once the tracer is fixed, when its mark should go). See
-changes/audit.md and CHANGELOG.md.
+"""Failures the audit found in the tracer (kinematics/), as regression tests (each was reproduced as the
+docstring's "Got:" says, and is fixed). See CHANGELOG.md.
 
 Each reference is the audit's own: the paper mode's promise of N equal drive steps, the law of cosines for a
 four-bar's extremes, and the same linkage written in another length unit.
@@ -65,21 +64,19 @@ def test_slider_crank_in_thousandths_closes_with_the_same_first_steps(tmp_path: 
     np.testing.assert_allclose(t1.angles[:100] * lengths, t1000.angles[:100], rtol=1e-12, atol=1e-12)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the corrector's closure tolerance is absolute (1e-12 in the length unit): in thousandths the "
-    "rounding floor of the residual is 1000 times higher, and near the slider's extreme the steps differ",
-)
 def test_slider_crank_steps_do_not_depend_on_the_length_unit(tmp_path: Path) -> None:
     """The offset slider-crank in units and in thousandths (every length x1000) closes in the same steps.
 
-    Got: 274 rows in units, 284 in thousandths (the same rows up to row 110, next to the slider's extreme)."""
+    Got: 274 rows in units, 284 in thousandths (the same rows up to row 110, next to the slider's extreme: the
+    new tangent was oriented against the old one in the plain metric, where the slider in thousandths outweighs
+    every angle, so the path seemed to turn back where the slider does and the step was halved)."""
     case = SliderCrank("offset-slider-crank", 1.0, 3.0, 0.4, 40.0)
     t1 = lw.trace(load(tmp_path, "sc1", case.mech.toml()), max_steps=600)
     t1000 = lw.trace(load(tmp_path, "sc1000", case.mech.toml(scale=1000.0)), max_steps=600)
     assert t1.branches[0].end_kind == lw.StopReason.CLOSED
     assert t1000.branches[0].end_kind == lw.StopReason.CLOSED
     assert len(t1.angles) == len(t1000.angles)
+    np.testing.assert_allclose(t1000.angles / [1.0, 1.0, 1.0, 1000.0], t1.angles, rtol=0.0, atol=1e-9)
 
 
 def test_small_closed_loop_is_recognised(tmp_path: Path) -> None:

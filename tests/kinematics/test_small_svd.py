@@ -103,8 +103,8 @@ def test_tangent_and_test_agree_with_the_lapack_kernel_along_a_path(E: int, m: i
     for jac in jacs:
         out_a, out_b = np.empty(m), np.empty(m)
         sig_a, sig_b = np.empty(n_sigma), np.empty(n_sigma)
-        tau_a = kernels.tangent_and_test_in(jac, t_a, basis_a, r, out_a, sig_a, svd)
-        tau_b = kernels.tangent_and_test_lapack(jac, t_b, basis_b, r, out_b, sig_b)
+        tau_a = kernels.tangent_and_test_in(jac, t_a, basis_a, r, out_a, sig_a, svd, np.ones(jac.shape[1]))
+        tau_b = kernels.tangent_and_test_lapack(jac, t_b, basis_b, r, out_b, sig_b, np.ones(jac.shape[1]))
         np.testing.assert_allclose(sig_a, sig_b, rtol=0, atol=1e-14 * sig_b[0])
         np.testing.assert_allclose(out_a, out_b, atol=1e-12)
         # the same range, the same orientation (each column's own sign is free: only det(basis) is kept)
@@ -128,8 +128,12 @@ def test_the_test_function_changes_sign_where_the_rank_drops() -> None:
     for s in np.linspace(-0.5, 0.5, 21) + 0.025:
         jac = Q1 @ np.diag([3.0, 2.5, 2.0, 1.5, 1.0, s]) @ Q2[:, :E].T
         out_a, out_b = np.empty(m), np.empty(m)
-        taus_a.append(kernels.tangent_and_test_in(jac, t_a, basis_a, E, out_a, np.empty(E), svd))
-        taus_b.append(kernels.tangent_and_test_lapack(jac, t_b, basis_b, E, out_b, np.empty(E)))
+        taus_a.append(
+            kernels.tangent_and_test_in(jac, t_a, basis_a, E, out_a, np.empty(E), svd, np.ones(jac.shape[1]))
+        )
+        taus_b.append(
+            kernels.tangent_and_test_lapack(jac, t_b, basis_b, E, out_b, np.empty(E), np.ones(jac.shape[1]))
+        )
         t_a, t_b = out_a, out_b
     assert np.count_nonzero(np.diff(np.sign(taus_a))) == 1
     np.testing.assert_allclose(taus_a, taus_b, rtol=1e-12)
@@ -142,7 +146,7 @@ def test_the_python_twin_of_the_tangent_kernel_agrees_with_the_compiled_one() ->
         outs = []
         for backend in (twin, compiled):
             basis, t, sig = np.ascontiguousarray(U[:, :5]), np.empty(6), np.empty(6)
-            tau = backend.tangent_and_test(jac, Vt[-1].copy(), basis, 5, t, sig)
+            tau = backend.tangent_and_test(jac, Vt[-1].copy(), basis, 5, t, sig, np.ones(jac.shape[1]))
             outs.append((tau, t, sig, basis))
         (tau_p, t_p, s_p, b_p), (tau_c, t_c, s_c, b_c) = outs
         assert tau_p == pytest.approx(tau_c, rel=1e-14)

@@ -14,6 +14,8 @@ P. Kumar, S. Pellegrino, "Computation of kinematic paths and bifurcation points"
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -92,19 +94,23 @@ def locate(
     r_path: int,
     tol: Tolerances,
     n_sigma: int,
+    weight: Array,
 ) -> tuple[Array, float]:
     """Locate the zero of the test function between path points ``a`` and ``b`` (Illinois regula falsi).
 
     Points are parametrised by ``h = t_a . (u - u_a)``. Each trial point is predicted by the cubic Hermite
     interpolant between the two bracketing points (with their tangents) and corrected in the hyperplane of its
     ``h``: the prediction error, fourth order in the bracket, stays far below the distance to the other branch
-    crossing there, so the trials stay on the branch being traced. Returns the point and the bracket width.
+    crossing there, so the trials stay on the branch being traced. ``weight`` is the step's metric (tangents are
+    oriented in it, :func:`~linkwork.kinematics.march.tangent_and_test`). Returns the point and the bracket width.
     """
 
     def evaluate_at(u: Array) -> tuple[float, Array]:
         _, _, jac = ws.evaluate(u)
         t = np.empty_like(t_a)
-        value = ws.kernels.tangent_and_test(jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma))
+        value = ws.kernels.tangent_and_test(
+            jac, t_a.copy(), basis_a.copy(), r_path, t, np.empty(n_sigma), weight
+        )
         return float(value), t
 
     f_lo, _ = evaluate_at(u_a)
@@ -229,49 +235,94 @@ def _sphere_tangents(ws: Workspace, u: Array, N: Array, radius: float, tol: Tole
 
 def polish(
     ws: Workspace, u: Array, tangents: Array, tol: Tolerances, radius: float = 2e-3
-) -> tuple[Array, float]:
-    """Refine a located simple bifurcation point as the intersection of its two branches.
+) -> tuple[Array, float, float]:
+    """Refine a located simple bifurcation point as the intersection of its two branches: ``(point, gap,
+    accuracy)``.
 
     Closing a loop at a double point is only as accurate as the square root of the residual. Here each branch
     is sampled instead at four regular points (signed distances ``-2r, -r, r, 2r`` along its tangent, corrected
     in the hyperplanes there, where the corrector converges quadratically), a cubic is fitted through them, and
-    the point nearest both cubics is returned with the distance between them (the intersection's accuracy).
+    the point nearest both cubics is taken (:func:`intersect_branches`). The cubics' own error, of order
+    ``r^4``, is far larger than the distance between them (which is round-off), so the intersection is taken at
+    ``r`` and at ``r / 2``: the second is returned, and its accuracy is the larger of the distance between the
+    two results (an ``r^4`` error falls sixteenfold when ``r`` halves, so that distance bounds the second's) and
+    the distance ``gap`` between its cubics, plus the bound on what its samples' round-off moves it. NaN gap and accuracy when the branches cannot be sampled.
+    """
+    coarse, gap, _ = intersect_branches(ws, u, tangents, tol, radius)
+    if not np.isfinite(gap):
+        return u, float("nan"), float("nan")
+    fine, fine_gap, noise = intersect_branches(ws, u, tangents, tol, 0.5 * radius)
+    if not np.isfinite(fine_gap):
+        return u, float("nan"), float("nan")
+    return fine, fine_gap, max(fine_gap, float(np.linalg.norm(fine - coarse))) + noise
+
+
+def intersect_branches(
+    ws: Workspace, u: Array, tangents: Array, tol: Tolerances, radius: float
+) -> tuple[Array, float, float]:
+    """The point nearest two cubics fitted to the two branches through ``u`` (each sampled at signed distances
+    ``-2r, -r, r, 2r`` along its tangent, corrected in the hyperplanes there): ``(point, gap, noise)``, ``gap``
+    the distance between the cubics there and ``noise`` a bound on how far the samples' own errors move it.
+
+    The samples are corrected to round-off (until the residual stops falling), not only below ``tol.exact``: a
+    residual ``e`` leaves a sample about ``e / sigma`` off its branch (:func:`_sample_error`), and a distance
+    ``r`` from a simple bifurcation point the smallest singular value ``sigma`` is itself of order ``r`` (the
+    parallelogram's crossing was 7.5e-11 rad off, stopping at 1e-12). A cubic through samples each off by at
+    most ``delta`` is off by at most ``sum_k |l_k(x)| delta`` at ``x`` (``l_k`` its Lagrange basis), and two
+    curves crossing at an angle ``theta`` that move by ``a`` and ``b`` move their crossing by at most
+    ``(a + b) / sin(theta)``.
     """
     if tangents.shape[0] != 2:
-        return u, float("nan")
+        return u, float("nan"), float("nan")
+    tol = replace(tol, exact=0.0)
     fits = []
     for t in tangents:
         t = t / np.linalg.norm(t)
-        params, points = [], []
+        params, points, errors = [], [], []
         for k in (-2.0, -1.0, 1.0, 2.0):
-            p, _, ok = correct_on_plane(ws, u + k * radius * t, t, tol)
+            p, r, ok = correct_on_plane(ws, u + k * radius * t, t, tol)
             if not ok:
-                return u, float("nan")
+                return u, float("nan"), float("nan")
             params.append(t @ (p - u))
             points.append(p)
+            errors.append(_sample_error(ws, p, t, r, tol))
         V = np.vander(np.array(params), 4)  # cubic through the four samples
-        fits.append((t, np.linalg.solve(V, np.array(points))))
+        fits.append((np.linalg.solve(V, np.array(points)), np.linalg.inv(V), np.array(errors)))
 
     def curve(i: int, x: float) -> Array:
-        return np.vander(np.array([x]), 4)[0] @ fits[i][1]
+        return np.vander(np.array([x]), 4)[0] @ fits[i][0]
+
+    def slope(i: int, x: float) -> Array:
+        return np.array([3.0 * x * x, 2.0 * x, 1.0, 0.0]) @ fits[i][0]
 
     # Nearest points of the two curves: Gauss-Newton on (x1, x2).
     x = np.zeros(2)
     for _ in range(30):
         d = curve(0, x[0]) - curve(1, x[1])
-        e = 1e-7
-        J = np.column_stack(
-            [
-                (curve(0, x[0] + e) - curve(0, x[0] - e)) / (2 * e),
-                -(curve(1, x[1] + e) - curve(1, x[1] - e)) / (2 * e),
-            ]
-        )
+        J = np.column_stack([slope(0, x[0]), -slope(1, x[1])])
         step = np.linalg.lstsq(J, -d, rcond=None)[0]
         x += step
         if np.linalg.norm(step) < 1e-15:
             break
     a, b = curve(0, x[0]), curve(1, x[1])
-    return 0.5 * (a + b), float(np.linalg.norm(a - b))
+    moved = sum(float(np.abs(np.vander(np.array([x[i]]), 4)[0] @ fits[i][1]) @ fits[i][2]) for i in range(2))
+    s0, s1 = slope(0, x[0]), slope(1, x[1])
+    cos = float(s0 @ s1) / float(np.linalg.norm(s0) * np.linalg.norm(s1))
+    sine = np.sqrt(max(1.0 - cos * cos, 0.0))
+    noise = moved / sine if sine > 0.0 else float("inf")
+    return 0.5 * (a + b), float(np.linalg.norm(a - b)), noise
+
+
+def _sample_error(ws: Workspace, p: Array, t: Array, r: float, tol: Tolerances) -> float:
+    """How far a point corrected in the hyperplane normal to ``t`` to residual ``r`` can be from where that
+    hyperplane meets the path: ``r / sigma``, ``sigma`` the smallest singular value the corrector keeps of the
+    Jacobian restricted to the hyperplane (the next Gauss-Newton step's bound)."""
+    _, _, jac = ws.evaluate(p)
+    n = t / np.linalg.norm(t)
+    Q, _ = np.linalg.qr(np.column_stack([n, np.eye(len(p))]))
+    s = np.linalg.svd(jac @ Q[:, 1:], compute_uv=False)
+    kept = s[s > tol.truncate * s[0]]
+    return float(r / kept[-1]) if len(kept) else float("inf")
 
 
 def locate_minimum(

@@ -100,9 +100,9 @@ def classify_point(
                 width = float(np.linalg.norm(moved[0] - u))
                 u, (tangents_u, method, rank, sigma) = moved
         if len(tangents_u) == 2:
-            polished, gap = polish(ws, u, tangents_u, tol)
+            polished, gap, accuracy = polish(ws, u, tangents_u, tol)
             if np.isfinite(gap) and gap < tol.polish_gap:
-                u, width = polished, gap
+                u, width = polished, accuracy
                 tangents_u, method, rank, sigma = branch_tangents(mech, ws, u, tol, rank_hint=cfg.r_path - 1)
     res_norm, _, _ = ws.evaluate(u)
     C = mech.coupling_matrix()

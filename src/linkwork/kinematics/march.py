@@ -45,7 +45,7 @@ CORRECTOR = ("tol", "exact", "roundoff", "truncate", "max_iter")
 """The members of :func:`correct`'s settings tuple."""
 MARCH_ARGUMENTS = {
     "mech": MECHANISM,
-    "start": ("u0", "t0", "u_home", "basis", "reach"),
+    "start": ("u0", "t0", "u_home", "basis", "reach", "before"),
     "steps": (
         "paper", "drive", "h0", "hmin", "hmax", "cos_turn", "target", "has_target", "advance", "stall_steps",
         "stall_length", "max_steps", "r_path", "detect", "check_closed",
@@ -257,33 +257,36 @@ def svd_work(E, m):
 
 
 @kernel()
-def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out):
+def tangent_and_test(jac, t_prev, basis, r_path, t_out, sigma_out, weight):
     """Oriented null vector, singular values and the signed test function at the current Jacobian.
 
-    ``basis (E, r_path)`` is the previous oriented range basis, updated in place. Returns the test value
+    ``basis (E, r_path)`` is the previous oriented range basis, updated in place; the tangent is oriented to
+    agree with ``t_prev`` in the step's metric (``weight``, :func:`weighted_norm`). Returns the test value
     (0 when the path is not of mobility one with rank ``r_path``). :func:`tangent_and_test_in` from a cold
     start, with work arrays of its own.
     """
     return tangent_and_test_in(
-        jac, t_prev, basis, r_path, t_out, sigma_out, svd_work(jac.shape[0], jac.shape[1])
+        jac, t_prev, basis, r_path, t_out, sigma_out, svd_work(jac.shape[0], jac.shape[1]), weight
     )
 
 
 @kernel()
-def tangent_and_test_in(jac, t_prev, basis, r_path, t_out, sigma_out, svd):
+def tangent_and_test_in(jac, t_prev, basis, r_path, t_out, sigma_out, svd, weight):
     """:func:`tangent_and_test` with the SVD's work arrays ``svd = (V, W, norms, order, G)`` given (see
     :func:`svd_work`); ``V`` holds the right singular vectors of the last call (the warm start of the next).
 
     The SVD ``J = W V^T`` (one-sided Jacobi, :func:`~linkwork.kinematics.small_svd.jacobi_svd`) gives the
     singular values (``W``'s column norms), the tangent (``V``'s column of the smallest, oriented so that
-    ``t . t_prev > 0``) and the range basis ``U_r`` (the largest ``r`` columns of ``W``, normalised, its
+    ``t . t_prev > 0`` in the step's metric, ``sum_a t_a t_prev_a weight_a^2``: in the plain metric a path
+    whose tangent is mostly a slider's, in a small length unit, would be oriented by the slider alone, and turn
+    back where the slider does) and the range basis ``U_r`` (the largest ``r`` columns of ``W``, normalised, its
     orientation kept continuous with ``basis``: ``det(basis^T U_r) > 0``). The test function
     ``det([U_r^T J; t^T])`` is then, since ``U_r^T J = S_r V_r^T``, the product of the ``r`` largest singular
     values times ``det([V_r^T; t^T]) = +-det V = +-1``: its sign from the orientations alone.
     """
     E, m = jac.shape
     if m > JACOBI_UNKNOWNS:
-        return tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out)
+        return tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out, weight)
     V, W, norms, order, G = svd
     perm = jacobi_svd(jac, V, W, norms, order)
     k = min(E, m)
@@ -292,7 +295,7 @@ def tangent_and_test_in(jac, t_prev, basis, r_path, t_out, sigma_out, svd):
     last = order[m - 1]
     dot = 0.0
     for a in range(m):
-        dot += V[a, last] * t_prev[a]
+        dot += V[a, last] * t_prev[a] * (weight[a] * weight[a])
     orient = -1.0 if dot < 0.0 else 1.0
     for a in range(m):
         t_out[a] = orient * V[a, last]
@@ -318,7 +321,7 @@ def tangent_and_test_in(jac, t_prev, basis, r_path, t_out, sigma_out, svd):
 
 
 @kernel()
-def tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out):
+def tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out, weight):
     """:func:`tangent_and_test` by LAPACK's SVD (``gesdd``) and two determinants: a Jacobian of more than
     :data:`JACOBI_UNKNOWNS` columns."""
     m = jac.shape[1]
@@ -329,7 +332,7 @@ def tangent_and_test_lapack(jac, t_prev, basis, r_path, t_out, sigma_out):
     dot = 0.0
     for a in range(m):
         t_out[a] = Vt[m - 1, a]
-        dot += t_out[a] * t_prev[a]
+        dot += t_out[a] * t_prev[a] * (weight[a] * weight[a])
     if dot < 0.0:
         for a in range(m):
             t_out[a] = -t_out[a]
@@ -517,7 +520,9 @@ def march(mech, start, steps, corrector, bounds, out):
 
     ``u_home`` is where the path began and ``reach = [far, longest, t_home...]`` how far the path has gone from it,
     its longest step and its tangent there (``2 + m`` zeros for a new path; updated in place), for closed-path
-    detection across several calls.
+    detection across several calls. ``before`` ``(2, m)`` is the row before ``u0`` and its tangent when the call
+    goes on with a path another call marched (NaN: none): paper mode's first step then extrapolates from it as
+    every later step does from its two last rows, so a path marched in several calls has the rows of one call.
 
     An adaptive step is rejected (and halved) when the corrected point advanced less than ``advance * h`` along
     the tangent (the corrector pulled it back); an adaptive march stops with ``NO_PROGRESS`` when its last
@@ -529,7 +534,7 @@ def march(mech, start, steps, corrector, bounds, out):
     otherwise adaptive arclength steps in ``[hmin, hmax]`` with the minimum-norm corrector. Returns
     ``(count, code, h)``: rows written, the stop code and the last step length.
     """
-    u0, t0, u_home, basis, reach = start
+    u0, t0, u_home, basis, reach, before = start
     (
         paper, drive, h0, hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length,
         max_steps, r_path, detect, check_closed,
@@ -556,7 +561,7 @@ def march(mech, start, steps, corrector, bounds, out):
     work = (q, res, jac, matrices, vectors, solve_work(m))  # every evaluation's work arrays, once per call
     r0 = evaluate_in(mech, u, work)
     svd = svd_work(E, m)  # the tangent's SVD work arrays; its right singular vectors carried from row to row
-    tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd)
+    tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd, weight)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
     if (
@@ -584,9 +589,12 @@ def march(mech, start, steps, corrector, bounds, out):
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
         if (
-            paper and count >= 2 and parts == 1
+            paper and parts == 1
         ):  # the last two points and their tangents predict better than the tangent alone
-            extrapolate(out[0][count - 2], out[1][count - 2], u, t, drive, u_try, 0.1 * abs(step))
+            if count >= 2:
+                extrapolate(out[0][count - 2], out[1][count - 2], u, t, drive, u_try, 0.1 * abs(step))
+            elif not np.isnan(before[0, 0]):  # the row before this call's start
+                extrapolate(before[0], before[1], u, t, drive, u_try, 0.1 * abs(step))
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
             ok, _, r = correct_across(mech, u_try, t, corrector, work, weight)
@@ -596,7 +604,7 @@ def march(mech, start, steps, corrector, bounds, out):
         easy = ok and correction(u, t, step, u_try, weight) <= 0.1 * abs(along)
         if ok:
             basis_try[:, :] = basis
-            tau_new = tangent_and_test_in(jac, t, basis_try, r_path, t_new, sig, svd)
+            tau_new = tangent_and_test_in(jac, t, basis_try, r_path, t_new, sig, svd, weight)
             turn, dist, ahead = step_geometry(u, t, u_try, t_new, weight, weighted)
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, along, cos_turn, advance)
@@ -647,7 +655,9 @@ def march(mech, start, steps, corrector, bounds, out):
             reach[0] = far
             align = 0.0
             for a in range(m):
-                align += t[a] * t_home[a]
+                align += t[a] * t_home[a] * (weight[a] * weight[a])
+            if weighted:  # the cosine in the step's metric
+                align /= weighted_norm(t, weight) * weighted_norm(t_home, weight)
             aligned = align > 2.0 * cos_turn * cos_turn - 1.0  # within two steps' largest turn of the start's
             if aligned and back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
                 close_path(u, u_home, periodic, count - 1, out_u, out_sigma, out_res, out_tau)

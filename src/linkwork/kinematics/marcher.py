@@ -207,10 +207,12 @@ class BranchMarcher:
         n: int,
         check_closed: bool,
         reach: Array,
+        before: Array | None = None,
     ) -> Chunk:
         """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place; ``reach
         = [far, longest, t_home...]``: how far the path has gone from ``u_home``, its longest step and its
-        tangent there, updated in place)."""
+        tangent there, updated in place; ``before``: the row before ``u`` and its tangent, ``(2, m)``, when the
+        call goes on with the path of the one before, so that the rows do not depend on where calls begin)."""
         cfg, tol, m = self.cfg, self.cfg.tol, len(u)
         out = Chunk(
             u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
@@ -235,10 +237,15 @@ class BranchMarcher:
             check_closed,
         )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
-            ws.kernel_arrays(), (u, t, u_home, basis, reach), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight),
+            ws.kernel_arrays(), (u, t, u_home, basis, reach, self._before(before, m)), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight),
             (out.u, out.t, out.sigma, out.res, out.tau, out.s),
         )  # fmt: skip
         return out
+
+    @staticmethod
+    def _before(before: Array | None, m: int) -> Array:
+        """``before`` as the march takes it: ``(2, m)``, NaN where there is no row before the start."""
+        return np.full((2, m), np.nan) if before is None else np.ascontiguousarray(before, dtype=float)
 
     # ---- one branch
     def run_branch(
@@ -301,6 +308,7 @@ class BranchMarcher:
         reach = np.zeros(2 + len(u0))
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
+        before: Array | None = None  # the row before u when the march goes on with the last call's path
         # A drive turning round towards its target: the step its current cycle began at, the fewest steps a cycle
         # took, and paper mode's count of equal steps to the target.
         cycle_from, fewest = 0, 0
@@ -317,7 +325,8 @@ class BranchMarcher:
                 self.interrupted = signum
                 return n_steps, StopReason.INTERRUPTED, interrupts.stop_text(signum), None, None
             basis_prev = basis.copy()
-            chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed, reach)
+            chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed, reach, before)
+            before = None
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
             if chunk.code == StopReason.CLOSED:
                 home.copy_to(chunk, chunk.count - 1)
@@ -414,6 +423,8 @@ class BranchMarcher:
             if self.budget <= 0:
                 return n_steps, StopReason.BUDGET, StopReason.BUDGET.text, None, None
             u, t, h0 = chunk.u[chunk.count - 1].copy(), chunk.t[chunk.count - 1].copy(), chunk.h
+            if chunk.count >= 2:  # the next call goes on with this path: its first step extrapolates as here
+                before = np.array([chunk.u[chunk.count - 2], chunk.t[chunk.count - 2]])
 
     def _land_on_limit(self, chunk: Chunk) -> tuple[int, str]:
         """Replace the chunk's last row (past a limit) by the point of the step where the joint is at its limit.
@@ -519,7 +530,9 @@ class BranchMarcher:
         r, _, jac = ws.evaluate(u_next)
         t_next, sigma = np.empty_like(tangent), np.empty(cfg.n_sigma)
         new_basis = basis_prev.copy()
-        tau = ws.kernels.tangent_and_test(jac, tangent.copy(), new_basis, cfg.r_path, t_next, sigma)
+        tau = ws.kernels.tangent_and_test(
+            jac, tangent.copy(), new_basis, cfg.r_path, t_next, sigma, self.weight
+        )
         basis[:, :] = new_basis
         across = Chunk(
             u=np.array([u_k, u_next]), t=np.array([tangent, t_next]),
@@ -766,7 +779,7 @@ class BranchMarcher:
         basis_a = self._basis_before(chunk.u[c - 2], chunk.t[c - 2], basis_prev)
         u_star, width = locate(
             self.ws, chunk.u[c - 2], chunk.t[c - 2], basis_a, chunk.u[c - 1], chunk.t[c - 1],
-            cfg.r_path, cfg.tol, cfg.n_sigma,
+            cfg.r_path, cfg.tol, cfg.n_sigma, self.weight,
         )  # fmt: skip
         known = self._match(u_star)
         if known is None:
@@ -851,7 +864,7 @@ class BranchMarcher:
         _, _, jac = self.ws.evaluate(u)
         basis = basis_prev.copy()
         self.ws.kernels.tangent_and_test(
-            jac, t.copy(), basis, self.cfg.r_path, np.empty_like(t), np.empty(min(jac.shape))
+            jac, t.copy(), basis, self.cfg.r_path, np.empty_like(t), np.empty(min(jac.shape)), self.weight
         )
         return basis
 
