@@ -308,6 +308,8 @@ def _search_chain(
             try:
                 pl = plan(chain, root, opts)
             except MechanizationError as exc:
+                if requested():  # a signal stopped the planning: no verdict on this root
+                    break
                 state.unusable(
                     f"root {root}, anchors {mode}: {exc}",
                     near_inside=isinstance(exc, NoPlan) and exc.near_inside,
