@@ -11,7 +11,11 @@ handler linkwork installs goes through it.
 :func:`held_signals` is the other half: while a long computation runs, the first SIGINT or SIGTERM is only
 recorded (:func:`requested`), and the computation, which looks at it between its steps (the tracer between two
 calls of its compiled march), ends there with what it computed, its end saying so; the command writes that and
-exits with :func:`exit_code` (130 or 143). A second signal raises :class:`Interrupted` at once.
+exits with :func:`exit_code` (130 or 143). A second signal raises :class:`Interrupted` at once. Every long
+command holds them this way: ``trace``, ``synth``, ``mechanize``, and the studies (``sweep``, ``robustness``,
+``search``) through their engine (:func:`linkwork.studies.engine.map_chunks`). A step that is kept only whole (one
+chunk of a study, one design's verification by tracing) runs under :func:`whole`: the tracer inside it does not see
+the request, and the loop around it stops after it.
 """
 
 from __future__ import annotations
@@ -134,16 +138,33 @@ _CURRENT: list[Hold] = []
 """The hold in force (at most one: a nested :func:`held_signals` shares the outer one)."""
 
 
+_WHOLE: list[int] = [0]
+"""How many :func:`whole` blocks are open (while any is, computations inside see no request)."""
+
+
 def requested() -> int:
-    """The SIGINT or SIGTERM received while :func:`held_signals` holds them (0: none, and always 0 outside it): a
-    computation that sees it ends at its next step, keeping what it computed."""
-    return _CURRENT[0].signum if _CURRENT else 0
+    """The SIGINT or SIGTERM received while :func:`held_signals` holds them (0: none, and always 0 outside it or
+    inside :func:`whole`): a computation that sees it ends at its next step, keeping what it computed."""
+    return _CURRENT[0].signum if _CURRENT and not _WHOLE[0] else 0
 
 
 def holding() -> bool:
-    """Whether :func:`held_signals` holds the signals now (a computation then returns to Python often enough to
-    look at :func:`requested`)."""
-    return bool(_CURRENT)
+    """Whether :func:`held_signals` holds the signals now, outside :func:`whole` (a computation then returns to
+    Python often enough to look at :func:`requested`)."""
+    return bool(_CURRENT) and not _WHOLE[0]
+
+
+@contextlib.contextmanager
+def whole() -> Iterator[None]:
+    """A step that is kept only whole: while the block runs, :func:`requested` is 0 for the computation inside
+    (a trace in it runs to its own end instead of stopping at the held signal), so the loop around it keeps the
+    step and stops after it. The hold still records a signal, and a second one still raises :class:`Interrupted`
+    at once."""
+    _WHOLE[0] += 1
+    try:
+        yield
+    finally:
+        _WHOLE[0] -= 1
 
 
 @contextlib.contextmanager

@@ -284,9 +284,10 @@ def test_equal_steps_several_turns_round_reach_the_target(tmp_path: Path) -> Non
 def test_a_signal_during_a_mechanization_is_one_line_and_keeps_the_chain(
     tmp_path: Path, sig: int, code: int
 ) -> None:
-    """A command that keeps nothing of the step it is in (here synth's mechanization, after the chain is written)
-    still stops with one line and 143 / 130, not SIGTERM's silent kill without cleanup; what was written before
-    (the chain) is kept, nothing is half-written, no staging folder is left."""
+    """A signal during synth's mechanization before any design has passed (the first passes after about twenty
+    seconds of the plain-Python kernels) stops with one line and 143 / 130, not SIGTERM's silent kill without
+    cleanup; what was written before (the chain) is kept, no mechanization is written, nothing is half-written,
+    no staging folder is left. (A design that passed is kept: tests/cli/test_long_command_stops.py.)"""
     out = tmp_path / "out"
     proc = start_linkwork(["synth", "wing/mechanize.toml", "--no-plots", "-o", str(out)])
     deadline = time.monotonic() + 120.0
@@ -299,7 +300,10 @@ def test_a_signal_during_a_mechanization_is_one_line_and_keeps_the_chain(
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == code, err
-    assert one_error_line(err) == f"error: interrupted ({signal.Signals(sig).name})"
+    assert one_error_line(err) == (
+        f"error: interrupted ({signal.Signals(sig).name}): no design had passed verification yet; nothing of the "
+        f"mechanization is written to {out}/"
+    )
     json.loads((out / "chain.json").read_text(encoding="utf-8"))
     assert not (out / "mechanization.json").exists()
     assert not list(tmp_path.glob(".linkwork-*"))

@@ -202,6 +202,48 @@ def test_without_a_status_a_signal_is_the_usual_interrupt() -> None:
         list(map_chunks(_chunk, [1, signal.SIGINT], [(i,) for i in range(4)], workers=0))
 
 
+def _traced_chunk(shared: list[int], index: int) -> int:
+    """A chunk that traces the four-bar round, sending this process a signal first when it is chunk
+    ``shared[0]``: the points traced."""
+    import linkwork as lw
+
+    if index == shared[0]:
+        os.kill(os.getpid(), shared[1])
+    return len(lw.trace(lw.load("four-bar")).angles)
+
+
+def test_a_chunk_in_hand_runs_whole() -> None:
+    """The engine holds signals with the one hold of every command (interrupts.held_signals), and runs a chunk
+    under interrupts.whole: the trace in the chunk the signal came in is not cut short (its points are those of
+    a trace with no signal), and the run stops after it."""
+    import linkwork as lw
+    from linkwork.studies.engine import RunStatus, map_chunks
+
+    points = len(lw.trace(lw.load("four-bar")).angles)
+    status = RunStatus()
+    done = list(
+        map_chunks(_traced_chunk, [1, signal.SIGTERM], [(i,) for i in range(4)], workers=0, status=status)
+    )
+    assert done == [points, points] and status.stopped == "interrupted (SIGTERM)" and status.code == 143
+
+
+def test_the_engine_shares_a_hold_its_caller_made() -> None:
+    """Inside a caller's hold the engine's hold is the same one: the signal is the caller's to see after the run
+    (as the CLI's), and the run still stops after the chunk in hand."""
+    from linkwork.interrupts import held_signals, requested
+    from linkwork.studies.engine import RunStatus, map_chunks
+
+    before = signal.getsignal(signal.SIGINT)
+    status = RunStatus()
+    with held_signals() as hold:
+        done = list(
+            map_chunks(_chunk, [1, signal.SIGINT], [(i,) for i in range(4)], workers=0, status=status)
+        )
+        assert requested() == signal.SIGINT  # still held: the caller decides what to do with it
+    assert done == [0, 1] and status.code == 130 and hold.signum == signal.SIGINT
+    assert signal.getsignal(signal.SIGINT) == before
+
+
 def _free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))

@@ -38,7 +38,8 @@ EXIT_CODES = (
     "Exit codes: 0 done as asked; 2 bad input (one line on stderr names the file, key or flag and what was "
     "expected); 3 the request could not be met (target not reached, no design or mechanism passes): one line "
     "says why, and everything computed so far is written; 130 / 143 interrupted (Ctrl-C / SIGTERM; trace, "
-    "robustness and sweep write what they computed); 141 the standard output closed by its reader (| head)."
+    "robustness, sweep and search write what they computed, synth the best chain and mechanize the best mechanism "
+    "found so far, marked incomplete); 141 the standard output closed by its reader (| head)."
 )
 
 

@@ -9,7 +9,7 @@ import typer
 from rich.text import Text
 
 from linkwork.cli import options as opt
-from linkwork.cli.common import check_range, check_workers, friendly_errors, progress_bar
+from linkwork.cli.common import check_range, check_workers, fail, friendly_errors, progress_bar
 from linkwork.cli.out_folder import file_label, out_help, run_folder
 from linkwork.outputs.staging import check_output_folder, console
 
@@ -41,7 +41,10 @@ def search(
 
     The default --out is out/NAME-search/, NAME the study file's name. Re-running on the same --out continues an interrupted search (its records are in --out/.linkwork-search/).
 
-    Exit codes: 0 some candidate passes; 2 bad input; 3 none passes (the closest is printed, outputs written).
+    Exit codes: 0 some candidate passes; 2 bad input; 3 none passes (the closest is printed, outputs written);
+    130 / 143 interrupted by Ctrl-C / SIGTERM (or 3, its Dask cluster lost): the candidates evaluated so far are
+    written (candidates.csv, ranked.csv, search.json saying "complete": false; no gallery), and the same command
+    continues the search; a second signal stops at once.
     """
     from linkwork.errors import RequestNotMetError
     from linkwork.outputs.search import (
@@ -50,6 +53,7 @@ def search(
         print_search_summary,
         write_search_outputs,
     )
+    from linkwork.studies.engine import RunStatus
     from linkwork.studies.search import closest, load_search, run_search
 
     check_workers(workers)
@@ -65,16 +69,32 @@ def search(
             console.print("the study changed since the records in --out were written: starting afresh")
         elif records.rows:
             console.print(f"resuming: {len(records.rows)} of {total} candidate(s) already done")
+        # SIGINT / SIGTERM are held while the candidates run (the engine's hold): the run ends after the batches
+        # in hand, whose rows are recorded whole, and what was evaluated is written below
+        status = RunStatus()
         with progress_bar("candidates", total) as report:
             report(len(records.rows), total)
             for rows in run_search(
-                search_study, skip=set(records.rows), scheduler=scheduler, workers=workers, progress=report
+                search_study,
+                skip=set(records.rows),
+                scheduler=scheduler,
+                workers=workers,
+                progress=report,
+                status=status,
             ):
                 records.add(rows)
         rows = list(records.rows.values())
-    summary = write_search_outputs(search_study, rows, out, gallery=gallery)
+    stopped = None if status.complete else status.stopped
+    summary = write_search_outputs(search_study, rows, out, gallery=gallery, stopped=stopped)
     print_search_summary(search_study, rows)
-    console.print(f"wrote {', '.join(n for n in OUTPUT_NAMES)} to {out}/")
+    written = [n for n in OUTPUT_NAMES if stopped is None or n not in ("gallery.html", "viewers")]
+    console.print(f"wrote {', '.join(written)} to {out}/")
+    if stopped is not None:
+        raise fail(
+            f"{stopped}: {len(rows)} of {total} candidate(s) evaluated are written to {out}/ (search.json says "
+            '"complete": false; no gallery); run the same command again to continue',
+            code=status.code,
+        )
     if summary["passing"] == 0:
         near = closest(rows)
         if near is None:

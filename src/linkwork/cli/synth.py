@@ -14,9 +14,10 @@ from typing import Annotated, Any
 import typer
 
 from linkwork.cli import mechanize_flags as mf
-from linkwork.cli.common import friendly_errors, progress_bar
+from linkwork.cli.common import fail, friendly_errors, progress_bar
 from linkwork.cli.out_folder import out_help, problem_label, run_folder
-from linkwork.errors import SpecError
+from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.interrupts import exit_code, held_signals
 from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
 
 
@@ -70,6 +71,12 @@ def synth(
     profiles goes to --out/problem/ (for `linkwork mechanize OUT`). With mechanization (the problem's
     `mechanize = true`, --mechanize or any mechanization flag) the chain's files are written first; if no
     mechanism passes they stay and the command exits with code 3 naming the closest design.
+
+    Ctrl-C or SIGTERM (exit 130 / 143) during the design search stops it after the design vector in hand: the
+    best chain joined so far is written (chain.json says "complete": false and why it "stopped") and not
+    mechanized; during the mechanization, the chain stays and the best mechanism that passed so far is written
+    (mechanization.json says "complete": false), or none when none had passed. A second signal stops at once,
+    writing nothing more.
     """
     from linkwork.io.problem import load_problem
     from linkwork.outputs.problem_copy import copy_problem
@@ -93,8 +100,16 @@ def synth(
         from linkwork.mechanization.mechanize import check_name_forms
 
         check_name_forms(options)
-    with progress_bar("[bold]synthesising[/]", None) as progress:
-        result = synthesize(spec, progress=progress, search=search, prune=not exhaustive)  # type: ignore[arg-type]
+    with held_signals() as hold, progress_bar("[bold]synthesising[/]", None) as progress:
+        try:
+            result = synthesize(spec, progress=progress, search=search, prune=not exhaustive)  # type: ignore[arg-type]
+        except RequestNotMetError:
+            if not hold.signum:
+                raise
+            raise fail(
+                f"{hold.stopped}: no design vector had been joined yet; nothing is written to {out}/",
+                code=exit_code(hold.signum),
+            ) from None
 
     plots = not no_plots
     if plots and not have_matplotlib():
@@ -109,16 +124,21 @@ def synth(
             written.append(write_synthesis_viewer(result, stage / "viewer.html"))
     print_synthesis_summary(result)
     console.print(f"wrote {len(written)} files to {out}/: " + ", ".join(path.name for path in written))
+    if hold.signum:
+        stats = result.stats
+        what = (
+            f"the best chain found so far (design {result.design}, joined E_max {result.joined_e_max:.4g}; "
+            f"{stats.designs_tried} of {stats.designs_tried + stats.not_searched} design vectors searched) is "
+            f'written to {out}/ (chain.json says "complete": false)'
+            if stats.stopped
+            else f"the search had ended; its chain is written to {out}/"
+        )
+        raise fail(
+            f"{hold.stopped}: {what}" + ("; not mechanized" if mechanizing else ""),
+            code=exit_code(hold.signum),
+        )
     if mechanizing:
         # the chain is on disk already: a mechanization that fails (exit 3) loses nothing of it
-        from linkwork.outputs.mechanization import mechanize_into, print_mechanization
+        from linkwork.cli.mechanize import mechanize_and_write
 
-        with (
-            staged_output(out, part="mechanize") as stage,
-            progress_bar("[bold]mechanizing[/]", None) as step,
-        ):
-            found, more = mechanize_into(
-                result, stage, options=options, plots=plots, progress=step, html=html
-            )
-        print_mechanization(found)
-        console.print(f"wrote {len(more)} files to {out}/: " + ", ".join(path.name for path in more))
+        mechanize_and_write(result, out, options, plots=plots, html=html)

@@ -141,7 +141,13 @@ SCHEMAS: dict[str, JsonSchema | CsvSchema | TomlSchema] = {
         "the chain.json that `linkwork synth` writes",
         Table(
             required={"design": TEXT, "joined": Table(required={"e_max": NUMBER})},
-            optional={"units": Nullable(_UNITS), "e_max": NUMBER, "e_mean": NUMBER},
+            optional={
+                "units": Nullable(_UNITS),
+                "e_max": NUMBER,
+                "e_mean": NUMBER,
+                "complete": BOOLEAN,
+                "stopped": Nullable(TEXT),
+            },
         ),
     ),
     "mechanization.json": JsonSchema(
@@ -153,7 +159,11 @@ SCHEMAS: dict[str, JsonSchema | CsvSchema | TomlSchema] = {
                 "drive": TEXT,
                 "profiles": ListOf(Table(required={"e_max": NUMBER})),
             },
-            optional={"verified": OneOf((BOOLEAN, Table()))},
+            optional={
+                "verified": OneOf((BOOLEAN, Table())),
+                "complete": BOOLEAN,
+                "stopped": Nullable(TEXT),
+            },
         ),
     ),
     "mechanism.toml": TomlSchema(

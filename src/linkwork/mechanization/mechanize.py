@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from linkwork.errors import SpecError
+from linkwork.interrupts import requested, stop_text, whole
 from linkwork.mechanization.assemble import BinaryLink, Design
 from linkwork.mechanization.chain import ShapeChain, build_chain
 from linkwork.mechanization.inside import verified
@@ -76,6 +77,10 @@ class Mechanization:
     recut
         When the mechanism follows the chain re-cut with monotonic C-segment piece counts
         (:mod:`linkwork.mechanization.recut`): the re-cut, with the synthesised segment matrix and joined errors.
+    stopped
+        Why the search stopped before its end (``"interrupted (SIGTERM)"``: a signal held by the command line,
+        :func:`linkwork.interrupts.held_signals`), so that ``design`` is the best of the designs that passed so
+        far; ``None`` when the search ran to its end.
     """
 
     design: Design
@@ -86,6 +91,12 @@ class Mechanization:
     ranked: tuple[RankedDesign, ...] = ()
     options: MechanizeOptions | None = None
     recut: Recut | None = None
+    stopped: str | None = None
+
+    @property
+    def complete(self) -> bool:
+        """Whether the search ran to its end (not stopped by a signal)."""
+        return self.stopped is None
 
 
 @dataclass
@@ -106,8 +117,8 @@ class _Search:
         return time.perf_counter() - self.started > self.options.time_limit
 
     def done(self) -> bool:
-        """Enough designs passed, or the time is up."""
-        return self.out_of_time() or len(self.passed) >= self.options.designs
+        """Enough designs passed, the time is up, or a signal asks the search to stop (it keeps what passed)."""
+        return self.out_of_time() or len(self.passed) >= self.options.designs or bool(requested())
 
     def unusable(self, line: str, *, near_inside: bool = False) -> None:
         """Record a plan or design that could not be traced (among the closest while nothing was traced; one
@@ -226,11 +237,14 @@ def mechanize(
         Called as ``progress(done, total)`` (:class:`linkwork.progress.Progress`) after every design traced (``total``: the most the search
         will trace).
 
+    A SIGINT or SIGTERM held by the command line (:func:`linkwork.interrupts.held_signals`) stops the search
+    after the design being traced: the best design passed so far is returned, its ``stopped`` saying why.
+
     Raises
     ------
     MechanizationError
-        When no design passes: the design that came closest (the most profiles reached) and what it violated,
-        and how many designs were tried.
+        When no design passes (or none had passed when a signal stopped the search): the design that came closest
+        (the most profiles reached) and what it violated, and how many designs were tried.
     """
     options = _options(result, options)
     chain, label = _chain(result, name)
@@ -254,6 +268,8 @@ def mechanize(
         try:
             found = _search_chain(cut, replace(options, time_limit=limit), label, progress)
         except MechanizationError as exc:
+            if requested():  # stopped by a signal before anything passed: the other cut is not tried
+                raise
             what = f"the re-cut chain ({recut.describe()})" if used else "the chain as synthesised"
             failures.append((what, str(exc).removeprefix("mechanize: ")))
             continue
@@ -292,6 +308,8 @@ def _search_chain(
             try:
                 pl = plan(chain, root, opts)
             except MechanizationError as exc:
+                if requested():  # a signal stopped the planning: no verdict on this root
+                    break
                 state.unusable(
                     f"root {root}, anchors {mode}: {exc}",
                     near_inside=isinstance(exc, NoPlan) and exc.near_inside,
@@ -358,10 +376,13 @@ def _outcome(state: _Search) -> Mechanization:
             seconds,
             ranked,
             state.options,
+            stopped=stop_text(requested()) if requested() else None,
         )
     lines = [line.removeprefix("mechanize: ") for _, line in state.closest]
     closest = " | ".join(f"({k}) {line}" for k, line in enumerate(lines, start=1)) if lines else "no design"
     timed_out = " (time limit reached)" if state.out_of_time() else ""
+    if requested():
+        timed_out = f" ({stop_text(requested())})"
     dof = state.options.dof
     raise MechanizationError(
         f"mechanize: no design passes after {state.attempts} traced{timed_out}"
@@ -515,7 +536,7 @@ def _search(chain: ShapeChain, pl: Plan, options: MechanizeOptions, label: str, 
             )
             return
         label_k = f"root {pl.root}, anchors {options.anchors}, design {attempt}"
-        check = verified(design, options)  # with the inside check on the traced poses
+        check = _verified(design, options)  # with the inside check on the traced poses
         state.traced(label_k, design, check)
         if check.defect == "order" and options.drive is None:
             design, check = _redrive(design, check, label_k, state)
@@ -591,11 +612,18 @@ def _redrive(design: Design, check: Verification, label: str, state: _Search) ->
         if state.done():
             break
         again = replace(design, drive=other)
-        verdict = verified(again, state.options)
+        verdict = _verified(again, state.options)
         state.traced(f"{label} re-driven from {other}", again, verdict)
         if verdict.passed:
             return again, verdict
     return design, check
+
+
+def _verified(design: Design, options: MechanizeOptions) -> Verification:
+    """:func:`~linkwork.mechanization.inside.verified`, run whole: a signal held meanwhile does not cut its traces
+    short (a verdict on part of the motion would be no verdict); the search stops after it."""
+    with whole():
+        return verified(design, options)
 
 
 def _fittable(design: Design, check: Verification) -> bool:
@@ -630,7 +658,7 @@ def _fitted(
     if broken is not None:
         state.rejected.append(f"{label} with its pivots fitted jointly: {broken}")
         return design, check
-    verdict = verified(fitted, options)
+    verdict = _verified(fitted, options)
     state.traced(f"{label} with its pivots fitted jointly", fitted, verdict)
     return (fitted, verdict) if verdict.passed else (design, check)
 

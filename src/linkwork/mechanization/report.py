@@ -20,7 +20,9 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
     """The ``mechanization.json`` contract: ``dof``, ``drive``, ``dyads`` and per profile ``drive_value``,
     ``angles`` {joint: degrees (lengths for prismatic joints)}, ``e_max`` beside ``joined_e_max``, and ``pivots``
     {link: [[x, y] anchor pivot, [x, y] moving pivot]} in that profile's pose; ``limits`` the link-length and
-    structural-error bounds used; angles in degrees."""
+    structural-error bounds used; angles in degrees. ``complete`` is false, and ``stopped`` says why
+    (``"interrupted (SIGTERM)"``), when a signal stopped the search: the design is then the best that passed
+    before it (``null`` when the search ran to its end)."""
     design, check = result.design, result.verification
     mech = design.mechanism()
     size = design.chain.size
@@ -47,6 +49,8 @@ def mechanization_dict(result: Mechanization) -> dict[str, Any]:
         )
     return {
         "name": design.name,
+        "complete": result.complete,
+        "stopped": result.stopped,
         "dof": check.dof,
         "rank": check.rank,
         "drive": design.drive,

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from linkwork.errors import LinkworkError, MechanizationError, SpecError
 from linkwork.geometry.se2 import relative
+from linkwork.interrupts import requested, stop_text
 from linkwork.mechanization import guidance, placement, sliders
 from linkwork.mechanization.assemble import BinaryLink
 from linkwork.mechanization.chain import ShapeChain, track, track_direction
@@ -53,6 +54,11 @@ class NoPlan(MechanizationError):
     def __init__(self, message: str, *, near_inside: bool = False) -> None:
         self.near_inside = near_inside
         super().__init__(message)
+
+
+class PlanStopped(MechanizationError):
+    """A SIGINT or SIGTERM held by the command line (:func:`linkwork.interrupts.held_signals`) stopped the
+    planning: ranking a body's candidates takes seconds, and a stop should not wait for every body of a plan."""
 
 
 @dataclass(frozen=True)
@@ -194,7 +200,15 @@ def body_candidates(
 
     With ``ground_region = "inside"`` a link is kept only when its pivots and the link lie inside every profile
     in its pose (:mod:`linkwork.mechanization.inside`); ``keep_outside`` keeps the others too, each with how it
-    leaves (``Candidate.leaves``), to say how close the search came."""
+    leaves (``Candidate.leaves``), to say how close the search came.
+
+    Raises
+    ------
+    PlanStopped
+        When a signal is held (:func:`linkwork.interrupts.requested`): the plan being made is given up.
+    """
+    if requested():
+        raise PlanStopped(f"mechanize: {stop_text(requested())} while ranking the links of body {body}")
     region = options.region_of(chain.targets, chain.size)
     out: list[Candidate] = []
     g_body = chain.body(body).displacements

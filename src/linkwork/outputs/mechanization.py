@@ -51,9 +51,19 @@ def mechanize_into(
     MechanizationError
         When no design passes (one line: the closest design and what it violated).
     """
-    from linkwork.mechanization import mechanize, write_mechanization
+    from linkwork.mechanization import mechanize
 
     found = mechanize(result, options or resolve_options(result.problem), progress=progress)
+    return found, write_mechanization_outputs(found, out_dir, plots=plots, html=html)
+
+
+def write_mechanization_outputs(
+    found: Mechanization, out_dir: Path, *, plots: bool = True, html: bool = False
+) -> list[Path]:
+    """Write a mechanization's ``mechanism.toml``, ``mechanization.json`` and figures into ``out_dir`` (and
+    ``mechanism.html`` with ``html`` and one DOF); returns their paths."""
+    from linkwork.mechanization import write_mechanization
+
     out_dir = Path(out_dir)
     written = write_mechanization(found, out_dir)
     if plots and have_matplotlib():
@@ -64,7 +74,7 @@ def mechanize_into(
         from linkwork.viz.mechanism_viewer import write_mechanism_viewer
 
         written.append(write_mechanism_viewer(found, out_dir / "mechanism.html"))
-    return found, written
+    return written
 
 
 def print_mechanization(found: Mechanization) -> None:
@@ -147,9 +157,11 @@ def print_mechanization(found: Mechanization) -> None:
                 r.design.drive,
             )
         console.print(ranking)
+    stopped = f"; the search was stopped early: {found.stopped}" if found.stopped else ""
     if not check.traced:
-        console.print(f"{check.reason} ({found.seconds:.1f} s)")
+        console.print(f"{check.reason} ({found.seconds:.1f} s{stopped})")
         return
     console.print(
-        f"verified: no circuit, branch or order defect ({found.attempts} designs traced, {found.seconds:.1f} s)"
+        f"verified: no circuit, branch or order defect ({found.attempts} designs traced, {found.seconds:.1f} s"
+        f"{stopped})"
     )

@@ -162,11 +162,20 @@ def columns(search: SearchStudy) -> list[str]:
 
 
 def write_search_outputs(
-    search: SearchStudy, rows: list[dict[str, Any]], out: Path, gallery: int = 12
+    search: SearchStudy,
+    rows: list[dict[str, Any]],
+    out: Path,
+    gallery: int = 12,
+    *,
+    stopped: str | None = None,
 ) -> dict[str, Any]:
     """Write candidates.csv / .parquet (every candidate in grid order), ranked.csv (the passing ones, best first,
     with ``rank``), search.json (the summary), and gallery.html with one viewer page per drawn candidate in
-    ``viewers/`` (the best ``gallery``, or the closest when none passes), all or nothing. Returns the summary."""
+    ``viewers/`` (the best ``gallery``, or the closest when none passes), all or nothing. Returns the summary.
+
+    A search ``stopped`` early (``"interrupted (SIGTERM)"``) writes the same files of the candidates evaluated so
+    far, search.json saying ``"complete": false`` and why it ``"stopped"``, without the gallery and its viewers
+    (they trace candidates again: a stop should not start more work)."""
     from linkwork.outputs.sweep import write_table
     from linkwork.studies.search import closest
 
@@ -179,6 +188,9 @@ def write_search_outputs(
     summary = {
         "name": search.study.name,
         "linkage": search.study.target,
+        "complete": stopped is None,
+        "stopped": stopped,
+        "candidates_asked": search.total,
         "candidates": len(rows),
         "passing": len(best),
         "failed_to_trace": sum(1 for r in rows if r["error"]),
@@ -207,8 +219,11 @@ def write_search_outputs(
         (stage / "search.json").write_text(
             json.dumps(_finite(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
-        drawn = best[:gallery] if best else sorted(rows, key=lambda r: (r["shortfall"], r["index"]))[:gallery]
-        _write_gallery(search, drawn, stage, none_pass=not best)
+        if stopped is None:
+            drawn = (
+                best[:gallery] if best else sorted(rows, key=lambda r: (r["shortfall"], r["index"]))[:gallery]
+            )
+            _write_gallery(search, drawn, stage, none_pass=not best)
     return summary
 
 

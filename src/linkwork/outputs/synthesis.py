@@ -139,10 +139,17 @@ def rerun_synthesis(folder: Path, spec: Problem) -> SynthesisResult:
 
 def _read_chain_json(chain_file: Path) -> tuple[str, float]:
     """``(design, joined E_max)`` of a ``chain.json``, read through its schema
-    (:data:`linkwork.io.readback.SCHEMAS`): anything else than the contract is a :class:`SpecError`."""
+    (:data:`linkwork.io.readback.SCHEMAS`): anything else than the contract, or the chain of a search that was
+    stopped early (``"complete": false``, which the seeded synthesis run again would not give), is a
+    :class:`SpecError`."""
     from linkwork.io.readback import read_chain
 
     saved = read_chain(chain_file)
+    if saved.get("complete") is False:
+        raise SpecError(
+            f"{chain_file}: is the chain of a design search stopped early ({saved.get('stopped') or 'interrupted'}"
+            '; "complete": false); run `linkwork synth` again to its end before mechanizing'
+        )
     return saved["design"], float(saved["joined"]["e_max"])
 
 
@@ -199,9 +206,17 @@ def _print_profiles_and_design(result: SynthesisResult) -> None:
         highlight=False,
     )
     stats = result.stats
-    if not problem.design:
+    if stats.stopped:
         console.print(
-            f"search: {stats.designs_tried} design vectors, {stats.designs_tried - len(stats.skipped) - stats.pruned} "
+            f"search stopped early ({stats.stopped}): {stats.designs_tried} of "
+            f"{stats.designs_tried + stats.not_searched} design vectors searched, {stats.not_joined} of them not "
+            "joined; the design is the best joined so far",
+            highlight=False,
+        )
+    if not problem.design:
+        joined = stats.designs_tried - len(stats.skipped) - stats.pruned - stats.not_joined
+        console.print(
+            f"search: {stats.designs_tried} design vectors, {joined} "
             f"joined, {stats.pruned} pruned (their lower bound on E_max exceeds the best), "
             f"{len(stats.skipped)} skipped (cannot be joined); ranked by {stats.rank_by}"
             + ("" if stats.e_max_tolerance is None else f" (E_max tolerance {stats.e_max_tolerance:g})"),

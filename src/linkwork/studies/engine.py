@@ -27,11 +27,10 @@ import uuid
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import CancelledError
 from dataclasses import dataclass
-from types import FrameType
 from typing import Any, TypeVar
 
 from linkwork.errors import LinkworkError, RequestNotMetError, SpecError
-from linkwork.interrupts import EXIT_SIGINT, EXIT_SIGTERM, Interrupted, when_safe
+from linkwork.interrupts import Interrupted, exit_code, held_signals, requested, stop_text, whole
 from linkwork.progress import Progress
 
 T = TypeVar("T")
@@ -164,35 +163,16 @@ def quiet_dask(restore: bool = True) -> Iterator[None]:
                 log.setLevel(level)
 
 
-@contextlib.contextmanager
-def caught_signals(state: RunStatus) -> Iterator[None]:
-    """While the block runs, the first SIGINT or SIGTERM is recorded in ``state.signal`` (the run then stops
-    after the chunks in hand and keeps them); a second one raises :class:`Interrupted` at once. Only in the
-    main thread; elsewhere nothing changes."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def record(signum: int, frame: FrameType | None) -> None:
-        if state.signal:
-            raise Interrupted(signum)
-        state.signal = signum
-
-    before = {sig: signal.signal(sig, when_safe(record)) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in before.items():
-            signal.signal(sig, handler)
-
-
 class _Stop(Exception):
     """The run stops early: a signal was received, or the cluster is gone (the message says which)."""
 
 
 def _check_signal(state: RunStatus) -> None:
+    """Stop the run at a held SIGINT or SIGTERM (:func:`linkwork.interrupts.held_signals`, the run's own or its
+    caller's), recording it in ``state.signal``."""
+    state.signal = state.signal or requested()
     if state.signal:
-        raise _Stop(f"interrupted ({signal.Signals(state.signal).name})")
+        raise _Stop(stop_text(state.signal))
 
 
 @contextlib.contextmanager
@@ -310,13 +290,16 @@ def map_chunks(
     address = scheduler_address(scheduler)
     state = status if status is not None else RunStatus()
     state.total = len(chunks)
-    guard = caught_signals(state) if status is not None else contextlib.nullcontext()
+    # with a status, the first SIGINT or SIGTERM is held (the one hold of every command) and the run stops after
+    # the chunks in hand; a chunk computed here runs whole (a trace in it is not cut short by the signal)
+    guard = held_signals() if status is not None else contextlib.nullcontext()
     try:
         with guard, quiet_dask(restore=status is None):
             if client is None and address is None and (workers == 0 or len(chunks) <= 1):
                 for chunk in chunks:
                     _check_signal(state)
-                    result = func(shared, *chunk)
+                    with whole():
+                        result = func(shared, *chunk)
                     state.done += 1
                     if progress is not None:
                         progress(state.done, state.total)
@@ -333,10 +316,15 @@ def map_chunks(
             raise RequestNotMetError("lost the Dask cluster: the work in hand was cancelled") from None
         status.stop("lost the Dask cluster; the work in hand was cancelled", 3)
     except _Stop as exc:
+        if status is None and state.signal:
+            # a caller's hold, and no status to say so: the usual interrupt
+            if state.signal == signal.SIGINT:
+                raise KeyboardInterrupt from None
+            raise Interrupted(state.signal, again=False) from None
         if status is None:
             raise RequestNotMetError(str(exc)) from None
         if state.signal:
-            status.stop(str(exc), EXIT_SIGTERM if state.signal == signal.SIGTERM else EXIT_SIGINT)
+            status.stop(str(exc), exit_code(state.signal))
         else:
             status.stop(str(exc), 3)
 

@@ -21,7 +21,7 @@ import numpy as np
 from linkwork.errors import LinkworkError, SpecError
 from linkwork.io.toml_reader import TomlReader
 from linkwork.progress import Progress
-from linkwork.studies.engine import default_workers, map_chunks
+from linkwork.studies.engine import RunStatus, default_workers, map_chunks
 from linkwork.studies.study_file import Study
 
 if TYPE_CHECKING:
@@ -336,9 +336,11 @@ def run_search(
     workers: int | None = None,
     client: Any = None,
     progress: Progress | None = None,
+    status: RunStatus | None = None,
 ) -> Iterator[list[Row]]:
     """Yield the rows of every candidate not in ``skip``, batch by batch in grid order (the Dask engine,
-    :func:`~linkwork.studies.engine.map_chunks`)."""
+    :func:`~linkwork.studies.engine.map_chunks`). With ``status``, SIGINT and SIGTERM (held while the run lasts)
+    or a lost cluster end the run after the batches finished so far, each one whole; ``status`` says why."""
     todo = [i for i in range(search.total) if i not in (skip or set())]
     in_process = workers == 0 and client is None and scheduler is None
     # In this process a batch of one costs nothing and records every candidate as soon as it is done.
@@ -352,7 +354,14 @@ def run_search(
             progress(already + min(finished * size, len(todo)), search.total)
 
     yield from map_chunks(
-        candidate_batch, search, chunks, scheduler=scheduler, workers=workers, client=client, progress=counted
+        candidate_batch,
+        search,
+        chunks,
+        scheduler=scheduler,
+        workers=workers,
+        client=client,
+        progress=counted,
+        status=status,
     )
 
 

@@ -294,7 +294,7 @@ class SearchStats:
         segmentation points).
     designs
         Every design vector tried: the joined ones best first (in the order of ``rank_by``), then the skipped
-        ones, then the pruned ones.
+        ones, then the pruned ones, then those a signal left unjoined.
     starts
         Initial segment matrices per design vector.
     iterations
@@ -315,6 +315,13 @@ class SearchStats:
         Number of design vectors not joined because their lower bound could not beat the best.
     rank_by, e_max_tolerance
         The ranking of the design vectors (see :class:`~linkwork.synthesis.problem.Problem`).
+    stopped
+        Why the search stopped before its end (``"interrupted (SIGTERM)"``, a signal held by the command line),
+        so that the design chosen is the best of those joined before it; ``None`` when it ran to its end.
+    not_searched
+        Design vectors whose segment matrix was never searched (after a signal).
+    not_joined
+        Design vectors searched but not joined (after a signal: the joining stops once one design is joined).
     """
 
     search: str
@@ -330,11 +337,18 @@ class SearchStats:
     pruned: int = 0
     rank_by: str = "error"
     e_max_tolerance: float | None = None
+    stopped: str | None = None
+    not_searched: int = 0
+    not_joined: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return {
             "search": self.search,
+            "complete": self.stopped is None,
+            "stopped": self.stopped,
+            "not_searched": self.not_searched,
+            "not_joined": self.not_joined,
             "designs": [d.to_dict() for d in self.designs],
             "designs_tried": self.designs_tried,
             "skipped": [{"design": d, "reason": r} for d, r in self.skipped],
@@ -400,8 +414,12 @@ class SynthesisResult:
     history: tuple[tuple[float, ...], ...] = field(default=())
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``chain.json`` contract: lengths as given, angles in degrees."""
+        """The ``chain.json`` contract: lengths as given, angles in degrees; ``complete`` false and ``stopped``
+        the reason (``"interrupted (SIGTERM)"``) when a signal stopped the design search (the chain is then the
+        best found before it), ``null`` otherwise."""
         return {
+            "complete": self.stats.stopped is None,
+            "stopped": self.stats.stopped,
             "kind": self.problem.kind,
             "piece_length": float(self.problem.piece_length),
             "min_pieces": int(self.problem.min_pieces),

@@ -9,11 +9,13 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
 
 from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.interrupts import requested, stop_text
 from linkwork.progress import Progress
 from linkwork.synthesis.compound import merge_joints
 from linkwork.synthesis.problem import Problem
@@ -78,18 +80,24 @@ def _join_pruned(
     fitter: SegmentFitter,
     prune: bool,
     tick: Callable[[], None],
-) -> tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign]]:
+) -> tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign], list[SegmentedDesign]]:
     """Join the designs in the order of their lower bounds; skip those whose bound cannot beat the best.
 
     A design is left unjoined ("pruned") only when its bound exceeds the best joined ``E_max`` so far and, for
-    ``rank_by = "joints"``, also ``e_max_tolerance``: it can then neither rank first nor be acceptable.
+    ``rank_by = "joints"``, also ``e_max_tolerance``: it can then neither rank first nor be acceptable. A signal
+    held by the command line (:func:`linkwork.interrupts.requested`) stops the joining once one design is
+    joined; the designs left are returned last (``(joined, skipped, pruned, not joined)``).
     """
     joined: list[JoinedDesign] = []
     skipped: list[SkippedDesign] = []
     pruned: list[SegmentedDesign] = []
+    left: list[SegmentedDesign] = []
     best = math.inf
     tol = -math.inf if problem.rank_by == "error" else float(problem.e_max_tolerance or 0.0)
     for seg in sorted(segmented, key=lambda d: (d.bound, d.design)):
+        if joined and requested():  # stopped: the best joined so far is the result
+            left.append(seg)
+            continue
         if prune and seg.bound > best and seg.bound > tol:
             pruned.append(seg)
         else:
@@ -100,7 +108,7 @@ def _join_pruned(
                 joined.append(outcome)
                 best = min(best, outcome.joined_e_max)
         tick()
-    return joined, skipped, pruned
+    return joined, skipped, pruned, left
 
 
 def synthesize(
@@ -132,14 +140,18 @@ def synthesize(
     SynthesisResult
         The design vector ranked first (``problem.rank_by``; by default the lowest ``E_max`` after joining),
         its segments, the joined chain on every profile and, when ``merge_below > 0``, the compound segments.
+        A SIGINT or SIGTERM held by the command line (:func:`linkwork.interrupts.held_signals`) stops the search
+        after the design vector in hand: the designs searched so far are joined in the order of their bounds
+        until one joins, and the result is the best of those joined, ``stats.stopped`` saying why.
 
     Raises
     ------
     SpecError
         For an invalid problem (unknown design letters, too few pieces for the segments, ...).
     RequestNotMetError
-        When no design vector can be joined (each closed or fixed-end chain misses its constraint); a design
-        that cannot be joined is otherwise skipped and listed in ``stats.skipped``.
+        When no design vector can be joined (each closed or fixed-end chain misses its constraint), or none
+        searched before a signal stopped the search; a design that cannot be joined is otherwise skipped and
+        listed in ``stats.skipped``.
 
     References
     ----------
@@ -154,18 +166,27 @@ def synthesize(
     designs = _designs_to_try(problem, [t.pieces for t in targets])
     fitter = SegmentFitter(targets)
     tick = _ticker(progress, len(designs) * (problem.starts + 1))
-    segmented = [
-        segment_design(problem, design, targets, fitter, search=search, on_start_done=tick)
-        for design in designs
-    ]
-    joined, skipped, pruned = _join_pruned(problem, segmented, targets, fitter, prune, tick)
+    segmented: list[SegmentedDesign] = []
+    for design in designs:
+        if requested():  # a signal held by the command line: the designs searched so far are kept
+            break
+        segmented.append(segment_design(problem, design, targets, fitter, search=search, on_start_done=tick))
+    joined, skipped, pruned, left = _join_pruned(problem, segmented, targets, fitter, prune, tick)
+    signum = requested()
+    stopped = stop_text(signum) if signum and (left or len(segmented) < len(designs)) else None
     if not joined:
+        if stopped:
+            raise RequestNotMetError(
+                f"{stopped} before any design vector was joined ({len(segmented)} of {len(designs)} searched)"
+            )
         reasons = "; ".join(s.reason for s in skipped[:3]) + ("; ..." if len(skipped) > 3 else "")
         raise RequestNotMetError(f"no design vector of the {len(designs)} tried could be joined: {reasons}")
     ranked = _ranked(joined, problem)
     compound = _compound(problem, targets, ranked[0])
     seconds = time.perf_counter() - t0
-    stats = _search_stats(problem, search, segmented, fitter, (ranked, skipped, pruned), seconds)
+    stats = _search_stats(problem, search, segmented, fitter, (ranked, skipped, pruned, left), seconds)
+    if stopped:
+        stats = replace(stats, stopped=stopped, not_searched=len(designs) - len(segmented))
     return _result(problem, targets, ranked[0], compound, stats)
 
 
@@ -247,15 +268,15 @@ def _search_stats(
     search: str,
     segmented: list[SegmentedDesign],
     fitter: SegmentFitter,
-    outcomes: tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign]],
+    outcomes: tuple[list[JoinedDesign], list[SkippedDesign], list[SegmentedDesign], list[SegmentedDesign]],
     seconds: float,
 ) -> SearchStats:
     """The search's statistics and its table of design vectors: ``outcomes`` are the joined designs in rank
-    order, the skipped and the pruned ones."""
-    ranked, skipped, pruned = outcomes
+    order, the skipped and the pruned ones, and those a signal left unjoined."""
+    ranked, skipped, pruned, left = outcomes
     scores = [_score(c.segmented, c, problem) for c in ranked]
     scores += [_score(s.segmented, None, problem) for s in skipped]
-    scores += [_score(p, None, problem) for p in pruned]
+    scores += [_score(p, None, problem) for p in pruned + left]
     return SearchStats(
         search=search,
         designs=tuple(scores),
@@ -268,6 +289,7 @@ def _search_stats(
         designs_tried=len(segmented),
         skipped=tuple((s.design, s.reason) for s in skipped),
         pruned=len(pruned),
+        not_joined=len(left),
         rank_by=problem.rank_by,
         e_max_tolerance=problem.e_max_tolerance,
     )
