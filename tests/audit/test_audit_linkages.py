@@ -221,3 +221,36 @@ def test_located_crossings_are_within_their_stated_accuracy(
         assert err_deg * RAD <= bif.bracket < 1e-8, (
             f"off by {err_deg * RAD:.2e} rad, stated {bif.bracket:.2e}"
         )
+
+
+@pytest.mark.parametrize("scale", [1e-5, 1e-3, 1.0, 1e3])
+def test_accuracy_does_not_depend_on_the_length_unit(tmp_path: Path, scale: float) -> None:
+    """A crank-rocker of 4 units and the same written 1000 times larger or up to 100,000 times smaller (a
+    millimetre mechanism in metres, a MEMS one): every row on the closed form to the same round-off.
+
+    Was: the corrector stopped at a residual of 1e-12 in the length unit, a billionth of a 1-mm loop: 1.2e-8 deg
+    off the closed form at 1e-3, 8.4e-7 deg at 1e-5 (1.1e-13 at 1)."""
+    case = FourBar("crank-rocker", *(x * scale for x in FOUR_BARS["crank-rocker"][:4]), 35.0)
+    trace = lw.trace(load(tmp_path, "cr", case.mech.toml()))
+    angle, sigma = check_planar(case, trace, "A")
+    assert angle < 1e-12  # degrees
+    assert sigma < 1e-13
+    assert trace.branches[0].end_kind == lw.StopReason.CLOSED
+
+
+@pytest.mark.parametrize("scale", [1e-5, 1e-3, 1.0, 1e3])
+def test_a_slider_crank_driven_by_its_slider_folds_at_its_extremes_in_any_unit(
+    tmp_path: Path, scale: float
+) -> None:
+    """The offset slider-crank driven by its slider turns back at the slider's extremes,
+    sqrt((l +- r)^2 - e^2): both folds found, to 2e-13 of the slider's travel, whatever the length unit.
+
+    Was: x1000, one fold, 2e-5 off (the tangent oriented in the plain metric flipped beyond the slider's
+    extreme while the fold was bisected); x0.001, both folds, 6.7e-10 off."""
+    r, l, e = 1.0 * scale, 3.0 * scale, 0.4 * scale
+    case = SliderCrank("offset-slider-crank", r, l, e, 40.0)
+    trace = lw.trace(load(tmp_path, "sc", case.mech.toml()), drive="D")
+    assert trace.branches[0].end_kind == lw.StopReason.CLOSED
+    extremes = sorted([np.sqrt((l + r) ** 2 - e**2), np.sqrt((l - r) ** 2 - e**2)])
+    found = sorted(f.value for f in trace.folds)
+    np.testing.assert_allclose(found, extremes, rtol=0.0, atol=2e-13 * 2 * r)

@@ -142,26 +142,39 @@ def _onto_node(
 
 
 def locate_fold(
-    ws: Workspace, u_a: Array, t_a: Array, u_b: Array, t_b: Array, drive: int, tol: Tolerances
+    ws: Workspace,
+    u_a: Array,
+    t_a: Array,
+    u_b: Array,
+    t_b: Array,
+    drive: int,
+    tol: Tolerances,
+    weight: Array | None = None,
 ) -> Array:
     """The fold of the drive between path points ``a`` and ``b``: where the tangent's drive component vanishes.
 
-    Bisection on ``h = t_a . (u - u_a)``; each trial point is predicted by the cubic Hermite curve through the two
-    points and corrected in the hyperplane of its ``h`` (as :func:`linkwork.kinematics.bifurcation.locate`).
+    Bisection on ``h``, the distance along ``t_a`` in the step's metric (``weight``, each unknown's weight: 1 for
+    an angle, ``1 / L`` for a length; None: all 1), to ``tol.locate`` in that metric; each trial point is
+    predicted by the cubic Hermite curve through the two points and corrected in the hyperplane of its ``h``
+    (as :func:`linkwork.kinematics.bifurcation.locate`), and its tangent oriented along ``t_a`` in that metric,
+    so that the fold found does not depend on the length unit (in the plain metric a slider in a small unit
+    outweighs every angle, and its tangent flipped on the far side of the slider's extreme).
     """
+    w2 = np.ones_like(t_a) if weight is None else np.asarray(weight) ** 2
+    axis = w2 * t_a / np.sqrt(float(t_a @ (w2 * t_a)))
     sign_a = np.sign(t_a[drive])
-    lo, hi = (0.0, u_a, t_a), (float(t_a @ (u_b - u_a)), u_b, t_b)
+    lo, hi = (0.0, u_a, t_a), (float(axis @ (u_b - u_a)), u_b, t_b)
     best = u_a
     for _ in range(100):
         if abs(hi[0] - lo[0]) < tol.locate:
             break
         x = 0.5 * (lo[0] + hi[0])
-        u_x, _, ok = correct_on_plane(ws, hermite(x, lo, hi, t_a), t_a, tol)
+        u_x, _, ok = correct_on_plane(ws, hermite(x, lo, hi, axis), axis, tol)
         if not ok:
             break
         _, _, jac = ws.evaluate(u_x)
         t_x = np.linalg.svd(jac)[2][-1]
-        t_x = t_x if t_x @ t_a > 0 else -t_x
+        t_x = t_x if t_x @ (w2 * t_a) > 0 else -t_x
         best = u_x
         if np.sign(t_x[drive]) == sign_a:
             lo = (x, u_x, t_x)

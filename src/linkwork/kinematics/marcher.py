@@ -754,7 +754,8 @@ class BranchMarcher:
         constant (its tangent component only noise) has no folds.
         """
         d = self.cfg.drive
-        td = chunk.t[: chunk.count, d]
+        tw = chunk.t[: chunk.count] * self.weight  # the tangents in the step's metric (scale-free)
+        td = tw[:, d] / np.linalg.norm(tw, axis=1)
         turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
         if len(turned) == 0:
             return
@@ -762,9 +763,10 @@ class BranchMarcher:
         joint = self.cfg.drive_joint if self.cfg.drive_joint >= 0 else self.first_joint[d]
         for k in turned[moving[turned]]:
             u_a, u_b = chunk.u[k], chunk.u[k + 1]
-            u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol)
+            u_f = locate_fold(self.ws, u_a, chunk.t[k], u_b, chunk.t[k + 1], d, self.cfg.tol, self.weight)
             beyond = np.sign(td[k]) * (u_f[d] - np.array([u_a[d], u_b[d]]))
-            noise = 1e-13 * max(1.0, abs(float(u_f[d])))
+            w = float(self.weight[d])  # round-off of the drive's value, in its own unit
+            noise = 1e-13 * max(1.0, abs(float(u_f[d])) * w) / w
             if beyond.min() < -noise or beyond.max() <= noise:
                 continue  # the drive does not turn back here
             angles = self.mech.angles_from_q(self.mech.q_from_u(u_f))

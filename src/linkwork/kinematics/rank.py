@@ -26,7 +26,9 @@ class Tolerances:
         Raised above ``exact`` (``--closure-tol``, play in the hinges), the corrector accepts a least-squares
         closure: Gauss-Newton iterated until its step stops reducing the residual, with a residual below this.
     exact
-        A residual below this is closed whatever ``closure`` says (the round-off level of one loop).
+        A residual below this is closed whatever ``closure`` says (the round-off level of one loop of unit size;
+        the tracer scales it by the linkage's own length ``L`` when ``L < 1``, since the residual's translation
+        part is a length).
     roundoff
         A residual that stalls (falls by less than half in an iteration) below ``roundoff * max(closure, exact)``
         is accepted: the round-off floor of very long loops.
