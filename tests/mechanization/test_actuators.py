@@ -113,14 +113,14 @@ def _grubler(spec: dict) -> int:
 
 @pytest.fixture(scope="module")
 def prismatic(tmp_path_factory: pytest.TempPathFactory) -> tuple[Mechanization, dict, dict, Path]:
-    found = mechanize(_known_chain(), MechanizeOptions(actuator="prismatic", designs=1, time_limit=15.0))
+    found = mechanize(_known_chain(), MechanizeOptions(actuator="prismatic", designs=1, time_limit=120.0))
     folder = tmp_path_factory.mktemp("prismatic")
     return (found, *_written(found, folder), folder)
 
 
 @pytest.fixture(scope="module")
 def two_dof(tmp_path_factory: pytest.TempPathFactory) -> tuple[Mechanization, dict, dict, Path]:
-    found = mechanize(_known_chain(), MechanizeOptions(dof=2, designs=1, time_limit=15.0))
+    found = mechanize(_known_chain(), MechanizeOptions(dof=2, designs=1, time_limit=120.0))
     folder = tmp_path_factory.mktemp("two_dof")
     return (found, *_written(found, folder), folder)
 
@@ -237,7 +237,7 @@ def _joined_e_max(result: SynthesisResult) -> np.ndarray:
 def test_wing_with_a_linear_actuator_traces_through_every_profile(
     wing: SynthesisResult, tmp_path: Path
 ) -> None:
-    found = mechanize(wing, MechanizeOptions(actuator="prismatic", designs=1, time_limit=15.0))
+    found = mechanize(wing, MechanizeOptions(actuator="prismatic", designs=1, time_limit=120.0))
     report, spec = _written(found, tmp_path)
     joints = {j["name"]: j for j in spec["mechanism"]["joints"]}
     drive = report["drive"]
@@ -260,7 +260,7 @@ def test_wing_with_a_linear_actuator_traces_through_every_profile(
 
 
 def test_wing_with_two_actuators_closes_every_profile(wing: SynthesisResult, tmp_path: Path) -> None:
-    found = mechanize(wing, MechanizeOptions(dof=2, designs=1, time_limit=15.0))
+    found = mechanize(wing, MechanizeOptions(dof=2, designs=1, time_limit=120.0))
     report, _ = _written(found, tmp_path)
     mech = load_spec(tmp_path / "mechanism.toml").mechanism
     dof, rank = _dof_from_rank(tmp_path)
