@@ -1,0 +1,78 @@
+"""The checks :func:`linkwork.trace` makes of its arguments before any work, each failure one
+:class:`~linkwork.errors.SpecError` naming the argument and what it expects.
+
+The command line checks its flags in its own layer (``cli.options``); a script or a notebook calls ``lw.trace``
+directly, and a NaN, ``None``, a string or a zero step given there must not reach the compiled march (a NaN
+``max_step`` looped there for ever, a zero one traced nothing for the whole budget) or surface as numpy's or
+numba's internal errors.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from numbers import Integral, Real
+from typing import Any
+
+from linkwork.errors import SpecError
+
+__all__ = ["check_trace_arguments"]
+
+
+def _real(name: str, value: Any, unit: str, *, positive: bool = False, finite: bool = True) -> float:
+    """``value`` as a float, or a SpecError naming ``name``: a real number (not a bool), finite unless
+    ``finite`` is False (then not NaN), above zero when ``positive``."""
+    what = ("a positive " if positive else "a ") + ("finite number" if finite else "number")
+    expected = f"expected {what}{f' ({unit})' if unit else ''}"
+    if isinstance(value, bool) or not isinstance(value, Real):
+        raise SpecError(f"{name}={value!r}: {expected}")
+    x = float(value)
+    if math.isnan(x) or (finite and math.isinf(x)) or (positive and not x > 0.0):
+        raise SpecError(f"{name}={value!r}: {expected}")
+    return x
+
+
+def _count(name: str, value: Any, low: int) -> int:
+    """``value`` as an int of at least ``low``, or a SpecError naming ``name`` (a whole number, not a float)."""
+    if isinstance(value, bool) or not isinstance(value, Integral) or int(value) < low:
+        raise SpecError(f"{name}={value!r}: expected a whole number >= {low}")
+    return int(value)
+
+
+def check_trace_arguments(
+    until: Any,
+    steps: Any,
+    max_step: Any,
+    min_step: Any,
+    max_turn: Any,
+    max_steps: Any,
+    limits: Any,
+    closure_tol: Any,
+) -> None:
+    """Refuse, with one :class:`SpecError` naming the argument, any of :func:`linkwork.trace`'s settings that is
+    not what it documents: ``until`` a ``(joint, value)`` pair with a finite value; ``steps`` and ``max_steps``
+    whole numbers >= 1; ``max_step``, ``min_step`` (radians) and ``closure_tol`` positive finite numbers,
+    ``max_turn`` one in ``(0, pi]``; ``limits`` a mapping of joint names to ``(low, high)`` numbers (not NaN; an
+    end may be infinite)."""
+    if until is not None:
+        if isinstance(until, str | bytes) or not hasattr(until, "__len__") or len(until) != 2:
+            raise SpecError(f"until={until!r}: expected (joint, value)")
+        _real("until", until[1], "radians, or a length for a prismatic joint")
+    if steps is not None:
+        _count("steps", steps, 1)
+    _real("max_step", max_step, "radians", positive=True)
+    _real("min_step", min_step, "radians", positive=True)
+    turn = _real("max_turn", max_turn, "radians", positive=True)
+    if turn > math.pi:
+        raise SpecError(f"max_turn={max_turn!r}: expected a positive finite number up to pi (radians)")
+    _count("max_steps", max_steps, 1)
+    if closure_tol is not None:
+        _real("closure_tol", closure_tol, "", positive=True)
+    if limits is not None:
+        if not isinstance(limits, Mapping):
+            raise SpecError(f"limits={limits!r}: expected a mapping {{joint: (low, high)}}")
+        for joint, ends in limits.items():
+            if isinstance(ends, str | bytes) or not hasattr(ends, "__len__") or len(ends) != 2:
+                raise SpecError(f"limits[{joint!r}]={ends!r}: expected (low, high)")
+            for end in ends:
+                _real(f"limits[{joint!r}]", end, "radians, or lengths for a prismatic joint", finite=False)
