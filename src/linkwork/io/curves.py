@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
+from linkwork.messages import escape_line
 
 Points = NDArray[np.float64]
 
@@ -181,7 +182,7 @@ def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points
     SpecError
         Naming ``source``, what is wrong (1-based point numbers) and what was expected.
     """
-    where = str(source) if source is not None else None
+    where = escape_line(str(source)) if source is not None else None
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         if pts.size == 0:
@@ -293,14 +294,14 @@ def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
     if count < max(2, order) and len(entity.fit_points) < 2:
         raise SpecError(
             f"the SPLINE has {count} control points for degree {order - 1}; expected at least {max(2, order)}",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     spline = entity.construction_tool()
     control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
     if not np.all(np.isfinite(control)) or np.abs(control).max() > MAX_COORDINATE:
         raise SpecError(
             f"the SPLINE has a control point that is not finite or beyond +-{MAX_COORDINATE:g}",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     absolute = tolerance * bounding_size(control)
     points = []
@@ -308,7 +309,8 @@ def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
         points.append((v.x, v.y))
         if len(points) > MAX_FLATTENED_POINTS:
             raise SpecError(
-                f"the SPLINE flattens into more than {MAX_FLATTENED_POINTS} points", source=str(path)
+                f"the SPLINE flattens into more than {MAX_FLATTENED_POINTS} points",
+                source=escape_line(str(path)),
             )
     return np.array(points, dtype=float)
 

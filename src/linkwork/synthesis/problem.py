@@ -12,8 +12,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
+from linkwork.limits import MAX_SEED
 from linkwork.messages import show
-from linkwork.names import MAX_NAME_CHARS
+from linkwork.names import MAX_NAME_CHARS, name_problem
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
 RankBy = Literal["error", "joints"]
@@ -184,6 +185,8 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
         return [("merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {shown}")]
     if not _whole(p.seed, 0):
         return [("seed", f"expected a whole number >= 0, got {show(p.seed)}")]
+    if p.seed > MAX_SEED:  # the bound of every seed (limits.SEED), the largest whole number TOML holds
+        return [("seed", f"expected a whole number <= {MAX_SEED}, got {show(p.seed)}")]
     return _ranking_rules(p) or _name_rules(p) or _profile_rules(p)
 
 
@@ -266,13 +269,8 @@ def _name_rules(p: Problem) -> list[tuple[str, str]]:
     for index, name in enumerate(p.names):
         if len(name) > MAX_NAME_CHARS:
             return [(f"names[{index}]", f"expected at most {MAX_NAME_CHARS} characters, got {len(name)}")]
-        if any(ord(ch) < 32 or ord(ch) == 127 or ch in "\u2028\u2029" for ch in name):
-            return [
-                (
-                    f"names[{index}]",
-                    f"expected a name without line breaks or control characters, got {show(name)}",
-                )
-            ]
+        if name_problem(name) is not None:
+            return [(f"names[{index}]", f"expected {name_problem(name)}, got {show(name)}")]
     first: dict[str, int] = {}
     for index, name in enumerate(p.names):
         earlier = first.setdefault(name, index)
