@@ -15,6 +15,7 @@ import io
 import re
 from pathlib import Path
 
+import ezdxf
 import numpy as np
 import pytest
 from fuzzkit import FUZZ, one_line_error
@@ -288,3 +289,62 @@ def test_problem_values_are_quoted_as_written(tmp_path: Path, line: str, fragmen
     )
     message = one_line_error(lambda: load_problem(file), (SpecError,))
     assert message is not None and fragment in message, message
+
+
+# ------------------------------------------------------------------------------------------ DXF profiles
+
+
+def _distance_to_polyline(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
+    """The distance of each point to a dense polyline (its pieces)."""
+    a, b = polyline[:-1], polyline[1:]
+    d = b - a
+    t = np.clip(np.einsum("pkj,kj->pk", points[:, None, :] - a[None], d) / np.einsum("kj,kj->k", d, d), 0, 1)
+    nearest = a[None] + t[..., None] * d[None]
+    return np.min(np.linalg.norm(points[:, None, :] - nearest, axis=2), axis=1)
+
+
+@pytest.mark.parametrize("entity", ["LWPOLYLINE", "POLYLINE"])
+@pytest.mark.parametrize("normal", [(0.0, 0.0, 1.0), (0.0, 0.0, -1.0), (0.0, 0.0, -2.5)])
+def test_a_mirrored_dxf_polyline_is_read_where_cad_draws_it(
+    tmp_path: Path, entity: str, normal: tuple
+) -> None:
+    """A polyline mirrored in CAD is written with the extrusion (0, 0, -1): its vertices are in an object
+    coordinate system whose x is the world's -x, and its arcs turn the other way. linkwork read the raw numbers:
+    the profile came out mirrored, silently. Checked against ezdxf's own path of the entity in world
+    coordinates (``ezdxf.path.make_path``, flattened densely)."""
+    from ezdxf import path as dxf_path
+
+    document = ezdxf.new("R2010")
+    space = document.modelspace()
+    vertices = [(0.0, 0.0, 0.4), (1.0, 0.0, 0.0), (2.0, 0.5, -0.3), (3.0, 0.2, 0.0)]
+    attributes = {"extrusion": normal}
+    if entity == "LWPOLYLINE":
+        drawn = space.add_lwpolyline(vertices, format="xyb", dxfattribs=attributes)
+    else:
+        drawn = space.add_polyline2d([v[:2] for v in vertices], dxfattribs=attributes)
+        for vertex, (_, _, bulge) in zip(drawn.vertices, vertices, strict=True):
+            vertex.dxf.bulge = bulge
+    file = tmp_path / "mirrored.dxf"
+    document.saveas(str(file))
+    corners = np.array([(v.x, v.y) for v in drawn.ocs().points_to_wcs([(x, y, 0.0) for x, y, _ in vertices])])
+    reference = np.array([(p.x, p.y) for p in dxf_path.make_path(drawn).flattening(distance=1e-7)])
+    points = load_profile(file)
+    for corner in corners:  # every vertex where ezdxf puts it in world coordinates, to rounding
+        assert np.min(np.linalg.norm(points - corner, axis=1)) <= 1e-12
+    # ezdxf's path draws the arcs as cubic Bezier curves (within about 3e-4 of the radius); a mirrored or
+    # turned-over arc is 0.1 away
+    size = float(np.hypot(*np.ptp(reference, axis=0)))
+    assert _distance_to_polyline(points, reference).max() <= 1e-3 * size
+
+
+def test_a_dxf_polyline_outside_the_xy_plane_is_refused(tmp_path: Path) -> None:
+    document = ezdxf.new("R2010")
+    document.modelspace().add_lwpolyline(
+        [(0, 0), (1, 0), (2, 0.5)], dxfattribs={"extrusion": (1.0, 0.0, 0.0)}
+    )
+    file = tmp_path / "side.dxf"
+    document.saveas(str(file))
+    message = one_line_error(lambda: load_profile(file), (SpecError,))
+    assert message is not None and message.startswith(
+        f"{file}: the LWPOLYLINE lies in a plane with normal (1, 0, 0)"
+    )

@@ -17,6 +17,7 @@ vertex of the flattened polyline lies on the true curve (to rounding). The check
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -307,7 +308,34 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
             for v in entity.vertices
         ]
         closed = bool(entity.is_closed)
+    if kind == "LWPOLYLINE" or entity.is_2d_polyline:
+        vertices = _ocs_to_xy(vertices, entity, path)
     return bulge_polyline(vertices, closed, tolerance)
+
+
+def _ocs_to_xy(
+    vertices: list[tuple[float, float, float]], entity: Any, path: Path
+) -> list[tuple[float, float, float]]:
+    """The ``(x, y, bulge)`` of a 2-D polyline's vertices in the drawing's x and y (world coordinates).
+
+    A 2-D polyline is written in its object coordinate system (DXF's "arbitrary axis algorithm" on its
+    extrusion vector): a polyline mirrored in CAD has the extrusion ``(0, 0, -1)``, whose x axis is the world's
+    ``-x``, and its arcs turn the other way seen from ``+z`` (the bulges change sign). Read as they were, its
+    points came out mirrored. A polyline in a plane that is not parallel to the world's x-y plane is refused.
+    """
+    nx, ny, nz = (float(c) for c in entity.dxf.get("extrusion", (0.0, 0.0, 1.0)))
+    size = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if not (math.isfinite(size) and size > 0.0) or abs(nx) > 1e-12 * size or abs(ny) > 1e-12 * size:
+        raise SpecError(
+            f"the {entity.dxftype()} lies in a plane with normal ({nx:g}, {ny:g}, {nz:g}); expected a profile "
+            "drawn in the x-y plane (normal (0, 0, 1), or (0, 0, -1) when mirrored)",
+            source=escape_line(str(path)),
+        )
+    if nz > 0.0:
+        return vertices
+    return [
+        (0.0 - x, y, -bulge) for x, y, bulge in vertices
+    ]  # the arbitrary axis x for -z is -x (0 - x: no -0.0)
 
 
 def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:

@@ -243,6 +243,15 @@ def _design_rules(p: Problem) -> list[tuple[str, str]]:
     if wrong:
         letters = show(", ".join(wrong))[1:-1]
         return [("design", f"expected {expected}, got {show(p.design)} (letters {letters} are not M or C)")]
+    most = MAX_PIECES // 2
+    if len(design) > most:  # every segment takes at least 2 of a profile's at most MAX_PIECES pieces
+        return [
+            (
+                "design",
+                f"has {len(design)} segments; expected at most {most} (each segment takes at least 2 of a "
+                f"profile's at most {MAX_PIECES} pieces), got {show(p.design)}",
+            )
+        ]
     if p.segments is not None and p.segments != len(design):
         return [
             (

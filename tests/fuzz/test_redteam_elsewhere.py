@@ -1,0 +1,147 @@
+"""Hostile inputs whose failure lies outside the red team's layers (session 13): each is a strict xfail naming the
+layer that owns the fix, so that the test passes the day it is fixed and CI says so.
+
+- ``lw.trace`` with NaN, infinity, ``None``, a string or a wrong shape for a setting (kinematics, the lead): an
+  internal ``ValueError``/``TypeError``/``IndexError`` ("cannot convert float NaN to integer", "unsupported operand
+  type(s) for /: 'NoneType' and 'float'"), a ``RuntimeWarning``, or a trace run with a step of 0 or -1 degrees,
+  instead of one :class:`~linkwork.errors.SpecError` naming the argument.
+- ``lw.trace(mech, max_step=nan)`` never returns (kinematics, the lead): run in a child process with a deadline.
+- ``--set KEY=1 --set KEY=2``: the last is kept silently (cli, interrupts), where ``--until`` given twice is refused.
+- a study whose ``trace.until`` names a joint the linkage does not have runs every grid point and exits 3
+  ("every grid point failed") instead of exit 2 before any work (studies.sweep, the lead).
+- a problem whose profiles are too short for its segments: the line names ``min_pieces`` but not the problem
+  file (synthesis.synthesize, the lead).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from fuzzkit import run_cli
+
+import linkwork as lw
+from linkwork.io.profiles import save_profile
+
+
+@pytest.fixture(scope="module")
+def bennett() -> lw.Mechanism:
+    return lw.load("bennett")
+
+
+TRACE_ARGUMENTS: dict[str, dict[str, Any]] = {
+    "until-nan": {"until": ("A", math.nan), "steps": 10},
+    "until-inf": {"until": ("A", math.inf), "steps": 10},
+    "until-None": {"until": ("A", None), "steps": 10},
+    "until-one-item": {"until": ("A",), "steps": 10},
+    "until-array": {"until": ("A", np.array([1.0])), "steps": 10},
+    "steps-nan": {"until": ("A", 1.0), "steps": math.nan},
+    "max_step-None": {"max_step": None, "max_steps": 20},
+    "max_step-str": {"max_step": "0.1", "max_steps": 20},
+    "max_step-zero": {"max_step": 0.0, "max_steps": 20},
+    "max_step-negative": {"max_step": -1.0, "max_steps": 20},
+    "max_steps-float": {"max_steps": 20.5},
+    "max_steps-None": {"max_steps": None},
+    "max_steps-inf": {"max_steps": math.inf},
+    "limits-None": {"limits": {"A": None}, "max_steps": 20},
+    "limits-list": {"limits": [("A", (0.0, 1.0))], "max_steps": 20},
+    "limits-three": {"limits": {"A": (0.0, 1.0, 2.0)}, "max_steps": 20},
+}
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="kinematics.tracer (the lead): lw.trace does not check its settings; an internal error, a warning or "
+    "a trace with a zero or negative step instead of one SpecError naming the argument",
+)
+@pytest.mark.parametrize("arguments", list(TRACE_ARGUMENTS.values()), ids=list(TRACE_ARGUMENTS))
+def test_trace_settings_that_are_not_numbers_are_one_spec_error(
+    bennett: lw.Mechanism, arguments: dict[str, Any]
+) -> None:
+    import warnings
+
+    name = next(iter(arguments))  # the argument each case makes hostile comes first
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(lw.SpecError) as info:
+            lw.trace(bennett, **arguments)
+    assert name in str(info.value)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="kinematics (the lead): lw.trace(mech, max_step=nan) loops for ever in the compiled march (killed "
+    "after 30 s here; after 400 s by hand)",
+)
+def test_a_nan_step_is_refused_not_a_hang() -> None:
+    script = textwrap.dedent(
+        """
+        import math, linkwork as lw
+        try:
+            lw.trace(lw.load("bennett"), max_step=math.nan, max_steps=20)
+        except lw.SpecError as exc:
+            print("refused:", exc)
+        """
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=30, check=False
+        )
+    except subprocess.TimeoutExpired:
+        pytest.fail("lw.trace(max_step=nan) did not return within 30 s")
+    assert done.stdout.startswith("refused:"), done.stdout + done.stderr
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="cli.common.parse_assignments (interrupts owns cli/): a repeated --set key keeps the last value "
+    "silently, where a repeated --until is refused",
+)
+def test_a_set_key_given_twice_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    run = run_cli(["show", "bennett", "--set", "alpha1=45", "--set", "alpha1=60"], home=tmp_path)
+    assert run.code == 2
+    assert "alpha1" in run.stderr and "twice" in run.stderr
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="studies.sweep (the lead): trace.until naming an unknown joint is found by each grid point's trace, "
+    "exit 3 after the work, not exit 2 before it",
+)
+def test_a_study_until_an_unknown_joint_is_bad_input(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    Path("study.toml").write_text(
+        'linkage = "bennett"\n[trace]\nuntil = "Q=90"\nsteps = 5\n[grid]\nalpha1 = [30, 40]\n',
+        encoding="utf-8",
+    )
+    run = run_cli(["sweep", "study.toml", "-o", "out", "--workers", "0", "--no-plots"], home=tmp_path)
+    assert run.code == 2, run
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="synthesis.synthesize / segment_matrix.check_feasible (the lead): the SpecError carries no source, "
+    "so the line does not name the problem file",
+)
+def test_an_infeasible_problem_names_its_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    t = np.linspace(0.0, 1.0, 30)
+    save_profile(tmp_path / "a.csv", np.column_stack([t, 0.2 * t**2]))
+    save_profile(tmp_path / "b.csv", np.column_stack([1.2 * t, 0.3 * t**2]))
+    Path("problem.toml").write_text(
+        'profiles = ["a.csv", "b.csv"]\npiece_length = 0.1\ndesign = "MC"\nmin_pieces = 1000\n',
+        encoding="utf-8",
+    )
+    run = run_cli(["synth", "problem.toml", "-o", "out", "--no-plots"], home=tmp_path)
+    assert run.code == 2
+    assert run.stderr.startswith("error: problem.toml: min_pieces: "), run.stderr
