@@ -145,3 +145,43 @@ def test_an_infeasible_problem_names_its_file(tmp_path: Path, monkeypatch: pytes
     run = run_cli(["synth", "problem.toml", "-o", "out", "--no-plots"], home=tmp_path)
     assert run.code == 2
     assert run.stderr.startswith("error: problem.toml: min_pieces: "), run.stderr
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="cli (interrupts): --out '' is Path('') == Path('.'): an unset shell variable (-o \"$OUT\") writes "
+    "the run into the working folder instead of being refused",
+)
+def test_an_empty_out_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "notes.txt").write_text("the user's\n", encoding="utf-8")
+    run = run_cli(["trace", "bennett", "--out", "", "--no-plots", "--max-steps", "10"], home=None)
+    assert run.code == 2, run
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="mechanization.options (the lead): a problem file's dof, ground_region box and polygon are not held "
+    "to the bounds of their flags and of every other length (--dof <= 20, |x| <= 1e12, a simple polygon)",
+)
+@pytest.mark.parametrize(
+    "line",
+    [
+        "dof = 1000000000000",
+        "ground_region = [-1e300, -1e300, 1e300, 1e300]",
+        "ground_region = [[0, 0], [1, 1], [1, 0], [0, 1]]",  # a bow tie: which side is inside?
+    ],
+)
+def test_problem_mechanization_keys_have_the_bounds_of_their_flags(tmp_path: Path, line: str) -> None:
+    from linkwork.io.problem import load_problem
+
+    t = np.linspace(0.0, 1.0, 30)
+    save_profile(tmp_path / "a.csv", np.column_stack([t, 0.2 * t**2]))
+    save_profile(tmp_path / "b.csv", np.column_stack([1.2 * t, 0.3 * t**2]))
+    file = tmp_path / "problem.toml"
+    file.write_text(
+        f'profiles = ["a.csv", "b.csv"]\npiece_length = 0.1\ndesign = "MC"\n{line}\n', encoding="utf-8"
+    )
+    with pytest.raises(lw.SpecError):
+        load_problem(file)

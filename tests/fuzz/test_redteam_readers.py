@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import re
 from pathlib import Path
 
@@ -348,3 +349,40 @@ def test_a_dxf_polyline_outside_the_xy_plane_is_refused(tmp_path: Path) -> None:
     assert message is not None and message.startswith(
         f"{file}: the LWPOLYLINE lies in a plane with normal (1, 0, 0)"
     )
+
+
+# ------------------------------------------------------------------------------------- the Python API
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".dat", ".svg", ".dxf"])
+@pytest.mark.parametrize(
+    "points",
+    [[[0.0, 0.0], [1.0, math.nan]], [[0.0, 0.0], [1.0, math.inf]], [[0, 0, 0], [1, 1, 1]], [[0.0, 0.0]], []],
+    ids=["nan", "inf", "three-columns", "one-point", "empty"],
+)
+def test_save_profile_writes_only_what_load_profile_reads(tmp_path: Path, suffix: str, points: list) -> None:
+    """save_profile wrote ``nan`` into a CSV, Selig or DXF file (the reader then refused its own file), dropped a
+    third column into a DXF silently, and failed on an empty SVG with numpy's "zero-size array"."""
+    file = tmp_path / f"profile{suffix}"
+    message = one_line_error(lambda: save_profile(file, points), (SpecError,))
+    assert message is not None and message.startswith(str(file))
+    assert not file.exists()
+
+
+@pytest.mark.parametrize(
+    "profiles",
+    [
+        None,
+        (p for p in ()),
+        ([[0, 0], [1]], [[0, 0], [1, 1]]),
+        (np.array([[0, "a"], [1, 1]], dtype=object), [[0, 0], [1, 1]]),
+    ],
+    ids=["None", "generator", "ragged", "text"],
+)
+def test_a_problem_built_in_a_script_from_odd_profiles_is_one_spec_error(profiles: object) -> None:
+    """numpy's ValueError ("inhomogeneous shape"), TypeError ("object of type 'NoneType' has no len()",
+    "ufunc 'isfinite' not supported") came out of Problem(...) instead of the SpecError of its rules."""
+    from linkwork.synthesis import Problem
+
+    message = one_line_error(lambda: Problem(profiles=profiles, piece_length=0.2, design="MC"), (SpecError,))  # type: ignore[arg-type]
+    assert message is not None and message.startswith("profiles")

@@ -47,6 +47,7 @@ from linkwork.io.drawing import LENGTH_UNITS, new_dxf, svg_d, svg_document, svg_
 from linkwork.io.outlines import final_chain, write_outline_dxf, write_outline_svg
 from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
 from linkwork.io.toml_reader import check_input_file, escape_line
+from linkwork.io.writer import require_finite
 
 __all__ = [
     "COINCIDENT",
@@ -432,7 +433,7 @@ def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> P
     >>> save_profile(folder / "line.csv", [[0.0, 0.0], [1.0, 0.5]])
     >>> load_profile(folder / "line.csv").tolist()
     [[0.0, 0.0], [1.0, 0.5]]
-    >>> save_profile(folder / "dot.csv", [[0.0, 0.0]])
+    >>> _ = (folder / "dot.csv").write_text("x,y\\n0,0\\n")
     >>> load_profile(folder / "dot.csv")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -461,9 +462,20 @@ def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> P
 
 
 def save_profile(path: str | Path, points: ArrayLike) -> None:
-    """Write a profile in the format its suffix names (the inverse of :func:`load_profile`)."""
+    """Write a profile in the format its suffix names (the inverse of :func:`load_profile`).
+
+    Only what :func:`load_profile` reads back is written: a polyline of shape ``(N, 2)``, ``N >= 2``, every
+    coordinate finite (:func:`linkwork.io.writer.require_finite`). A NaN used to be written as ``nan`` into a
+    CSV, Selig or DXF file, and a third column dropped silently."""
     path = Path(path)
-    _format_for(path).write(path, np.asarray(points, dtype=float))
+    fmt = _format_for(path)
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 2:
+        raise SpecError(
+            f"expected a profile of shape (N, 2) with N >= 2 to write, got shape {pts.shape}",
+            source=escape_line(str(path)),
+        )
+    fmt.write(path, require_finite(pts, f"{escape_line(str(path))}: the profile's points"))
 
 
 # --------------------------------------------------------------------------------------------- helpers

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
 from linkwork.limits import MAX_SEED
-from linkwork.messages import show
+from linkwork.messages import escape_line, show
 from linkwork.names import MAX_NAME_CHARS, name_problem
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
@@ -115,7 +115,9 @@ class Problem:
         """Check every rule of a problem; a broken one is a :class:`SpecError` naming the problem file's key
         with the same words as the file reader."""
         for key, message in _broken_rules(self):
-            raise SpecError(message, source=None if self.source is None else str(self.source), key=key)
+            raise SpecError(
+                message, source=None if self.source is None else escape_line(str(self.source)), key=key
+            )
 
     @property
     def count(self) -> int:
@@ -148,6 +150,10 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
     p = problem
     if p.kind not in KINDS:
         return [("type", f'expected one of "open", "closed", "fixed-end", got {show(p.kind)}')]
+    if not isinstance(p.profiles, tuple | list):  # a generator has no length; None is no profile
+        return [
+            ("profiles", f"expected a tuple of polylines of shape (N, 2), got {type(p.profiles).__name__}")
+        ]
     if len(p.profiles) < 2:
         return [("profiles", f"lists {len(p.profiles)} profile(s); expected at least 2 profiles")]
     if not (_real(p.piece_length) and math.isfinite(p.piece_length) and p.piece_length > 0):
@@ -298,8 +304,11 @@ def _profile_rules(p: Problem) -> list[tuple[str, str]]:
     """Each profile a finite ``(N, 2)`` polyline, short enough in pieces for :data:`MAX_PIECES`."""
     length = 0.0
     for index, profile in enumerate(p.profiles):
-        points = np.asarray(profile)
         key = f"profiles[{index}]"
+        try:  # rows of unequal length, text, None: numpy's own error would not name the profile
+            points = np.asarray(profile, dtype=float)
+        except (TypeError, ValueError):
+            return [(key, "expected a polyline of shape (N, 2) with N >= 2 of numbers")]
         if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 2:
             return [(key, f"expected a polyline of shape (N, 2) with N >= 2, got shape {points.shape}")]
         if not np.all(np.isfinite(points)):
