@@ -185,3 +185,17 @@ def test_problem_mechanization_keys_have_the_bounds_of_their_flags(tmp_path: Pat
     )
     with pytest.raises(lw.SpecError):
         load_problem(file)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="cli/export (interrupts): --set with a trace folder (not a built-in) is ignored silently, where "
+    "`trace SPEC.toml --set` is refused",
+)
+def test_export_with_set_on_a_trace_folder_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert run_cli(["trace", "four-bar", "-o", "tr", "--no-plots", "--max-steps", "20"], home=None).code == 0
+    run = run_cli(["export", "dxf", "tr", "-o", "x.dxf", "--set", "crank=5"], home=tmp_path)
+    assert run.code == 2 and "--set" in run.stderr

@@ -82,3 +82,18 @@ def test_a_trace_whose_out_is_the_folder_of_its_spec(home: Path) -> None:
     assert run.code == 2
     assert '"mechanism.toml" exists and was not written by linkwork' in run.stderr
     assert tree(home) == before
+
+
+def test_a_subnormal_scale_is_refused_not_written_with_three_digits(home: Path, traced: Path) -> None:
+    """--scale 1e-320 is positive, so it passed the flag's bound, and wrote subnormal coordinates: a float
+    there keeps two or three significant digits, and every facet of the STL was degenerate."""
+    run = run_cli(["export", "stl", str(traced), "-o", "tiny.stl", "--scale", "1e-320"], home=home)
+    assert run.code == 2 and "expected a size of at least" in run.stderr
+    assert not (home / "tiny.stl").exists()
+    small = run_cli(["export", "stl", str(traced), "-o", "small.stl", "--scale", "1e-280"], home=None)
+    assert small.code == 0, small
+    vertices = [
+        line.split()[1:] for line in (home / "small.stl").read_text().splitlines() if "vertex" in line
+    ]
+    finite = [abs(float(v)) for row in vertices for v in row if float(v) != 0.0]
+    assert min(finite) > 2.2250738585072014e-308  # normal floats: every digit kept
