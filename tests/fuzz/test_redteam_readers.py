@@ -386,3 +386,28 @@ def test_a_problem_built_in_a_script_from_odd_profiles_is_one_spec_error(profile
 
     message = one_line_error(lambda: Problem(profiles=profiles, piece_length=0.2, design="MC"), (SpecError,))  # type: ignore[arg-type]
     assert message is not None and message.startswith("profiles")
+
+
+def test_a_selig_file_in_millimetres_is_read_not_taken_for_lednicer(tmp_path: Path) -> None:
+    """A Selig airfoil in millimetres starts at its trailing edge, ``100 20``: two whole numbers above 1.5,
+    which the reader took for a Lednicer point-count line and refused. Checked against numpy.loadtxt."""
+    file = tmp_path / "wing-mm.dat"
+    file.write_text("wing in mm\n100 20\n50 30\n0 0\n50 -10\n100 0\n", encoding="utf-8")
+    np.testing.assert_array_equal(load_profile(file), np.loadtxt(file, skiprows=1))
+    lednicer = tmp_path / "lednicer.dat"  # the real layout: counts, a blank line, upper then lower surface
+    lednicer.write_text(
+        "NACA 0012\n3.       3.\n\n0 0\n0.5 0.06\n1 0\n\n0 0\n0.5 -0.06\n1 0\n", encoding="utf-8"
+    )
+    message = one_line_error(lambda: load_profile(lednicer), (SpecError,))
+    assert message is not None and "line 2: looks like a Lednicer point-count line" in message
+
+
+def test_a_coupling_naming_a_joint_twice_is_refused_as_the_flag_is(tmp_path: Path) -> None:
+    """``--couple A=A`` is refused ("names a joint twice"); ``couple = [["A", "A"]]`` in a file was read."""
+    file = _spec_with(tmp_path, "joint", "A")
+    file.write_text(
+        file.read_text(encoding="utf-8").replace("planar = true", 'planar = true\ncouple = [["A", "A"]]'),
+        encoding="utf-8",
+    )
+    message = one_line_error(lambda: load_spec(file), (SpecError,))
+    assert message is not None and "mechanism.couple[0]: names a joint twice" in message

@@ -155,11 +155,15 @@ def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 
     The points run from the trailing edge over the upper surface to the leading edge and back along the lower
     surface. A file without the name line is accepted. Lednicer files (upper and lower surfaces listed
-    separately after a line of point counts) are recognised and refused. ``tolerance`` is unused.
+    separately after a line of point counts) are recognised and refused: their first line of numbers is two
+    whole numbers above 1.5 lying beyond every point of the curve (``61. 61.`` before a chord from 0 to 1); a
+    Selig file in millimetres, whose first point ``100 20`` is its trailing edge, is read. ``tolerance`` is
+    unused.
     """
     path = Path(path)
     source = escape_line(str(path))
     rows: list[tuple[float, float]] = []
+    first = (0, "")
     for index, (number, line) in enumerate(_read_lines(path)):
         cells = line.replace(",", " ").split()
         values = [_csv_number(cell) for cell in cells]
@@ -167,14 +171,18 @@ def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
             continue  # the airfoil's name
         if len(values) != 2 or values[0] is None or values[1] is None:
             raise SpecError(f"line {number}: expected two numbers 'x y', got {_quoted(line)}", source=source)
-        x, y = float(values[0]), float(values[1])
-        if not rows and x > 1.5 and y > 1.5 and x.is_integer() and y.is_integer():
+        if not rows:
+            first = (number, line)
+        rows.append((float(values[0]), float(values[1])))
+    if rows:
+        x, y = rows[0]
+        counts = x > 1.5 and y > 1.5 and x.is_integer() and y.is_integer()
+        if counts and (len(rows) == 1 or x > max(p[0] for p in rows[1:])):
             raise SpecError(
-                f"line {number}: looks like a Lednicer point-count line {_quoted(line)}; expected Selig format "
-                "(one list from the trailing edge over the upper surface and back along the lower)",
+                f"line {first[0]}: looks like a Lednicer point-count line {_quoted(first[1])}; expected Selig "
+                "format (one list from the trailing edge over the upper surface and back along the lower)",
                 source=source,
             )
-        rows.append((x, y))
     return np.array(rows, dtype=float).reshape(-1, 2)
 
 

@@ -144,6 +144,8 @@ class SpecReader(TomlReader):
             if len(group) < 2:
                 raise self.error(key, f"expected at least two joints to couple, got {_show(group)}")
             members = [joint(item, _key(key, i)) for i, item in enumerate(group)]
+            if len(set(members)) != len(members):  # the words of --couple A=A
+                raise self.error(key, f"names a joint twice; expected distinct joints, got {_show(group)}")
             kinds = {types[names.index(m)] for m in members}
             if len(kinds) > 1:
                 raise self.error(key, f"cannot couple revolute and prismatic joints: {_show(group)}")
