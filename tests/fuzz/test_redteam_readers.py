@@ -411,3 +411,11 @@ def test_a_coupling_naming_a_joint_twice_is_refused_as_the_flag_is(tmp_path: Pat
     )
     message = one_line_error(lambda: load_spec(file), (SpecError,))
     assert message is not None and "mechanism.couple[0]: names a joint twice" in message
+
+
+def test_a_profile_saved_as_dxf_declares_no_unit(tmp_path: Path) -> None:
+    """save_profile wrote ezdxf's default header, ``$INSUNITS`` 6: a unitless profile declared in metres to
+    every CAD program that opens it. Read back by ezdxf."""
+    file = tmp_path / "profile.dxf"
+    save_profile(file, [[0.0, 0.0], [1.0, 0.5], [2.0, 0.0]])
+    assert ezdxf.readfile(str(file)).header["$INSUNITS"] == 0

@@ -349,12 +349,11 @@ def _ocs_to_xy(
 
 def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:
     """Write a profile as a DXF drawing with one LWPOLYLINE (flagged closed, without the repeated point, when
-    the profile returns to its first point)."""
-    import ezdxf
-
+    the profile returns to its first point), unitless (``$INSUNITS`` 0: a profile carries no unit; ezdxf's own
+    default header said metres)."""
     pts = np.asarray(points, dtype=float)
     closed = is_closed(pts)
-    document = ezdxf.new("R2010")
+    document = new_dxf(None)
     document.modelspace().add_lwpolyline(pts[:-1] if closed else pts, format="xy", close=closed)
     document.saveas(str(path))
 
