@@ -199,3 +199,15 @@ def test_export_with_set_on_a_trace_folder_is_refused(
     assert run_cli(["trace", "four-bar", "-o", "tr", "--no-plots", "--max-steps", "20"], home=None).code == 0
     run = run_cli(["export", "dxf", "tr", "-o", "x.dxf", "--set", "crank=5"], home=tmp_path)
     assert run.code == 2 and "--set" in run.stderr
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="kinematics.chains / linkages (the lead): the assembly's closure tolerance is absolute (1e-12 length "
+    "units), so a built-in at a scale its own bounds allow (bennett scale=1e5, bound 1e6) is refused as not "
+    "closing (misfit 2.2e-11, rounding of a 1e5-sized loop), exit 2",
+)
+def test_a_bennett_linkage_at_a_large_allowed_scale_moves_as_at_scale_one() -> None:
+    reference = lw.trace(lw.load("bennett"), until=("A", math.radians(120)), steps=20)
+    large = lw.trace(lw.load("bennett", scale=1e5), until=("A", math.radians(120)), steps=20)
+    np.testing.assert_allclose(large.angles, reference.angles, rtol=0, atol=1e-9)
