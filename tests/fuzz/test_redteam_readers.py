@@ -14,6 +14,7 @@ import csv
 import io
 import math
 import re
+import time
 from pathlib import Path
 
 import ezdxf
@@ -419,3 +420,74 @@ def test_a_profile_saved_as_dxf_declares_no_unit(tmp_path: Path) -> None:
     file = tmp_path / "profile.dxf"
     save_profile(file, [[0.0, 0.0], [1.0, 0.5], [2.0, 0.0]])
     assert ezdxf.readfile(str(file)).header["$INSUNITS"] == 0
+
+
+# --------------------------------------------------------------------------------- self-crossing, bounded
+
+
+def _crosses_brute_force(points: np.ndarray) -> bool:
+    """Whether two non-adjacent pieces of an open polyline in general position cross (every pair tested, the
+    orientation test written out: the reference the sweep is checked against)."""
+
+    def orient(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> float:
+        return float((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
+
+    n = len(points) - 1
+    for i in range(n):
+        for j in range(i + 2, n):
+            a, b, c, d = points[i], points[i + 1], points[j], points[j + 1]
+            if orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0:
+                return True
+    return False
+
+
+@FUZZ
+@given(
+    coordinates=st.lists(
+        st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)), min_size=3, max_size=12, unique=True
+    ),
+    transpose=st.booleans(),
+)
+def test_the_self_crossing_check_agrees_with_every_pair_tested(
+    coordinates: list[tuple[float, float]], transpose: bool
+) -> None:
+    """The sweep now runs along x or y, whichever has fewer candidate pairs; either way it finds a crossing
+    exactly when testing every pair does (random points: general position, open curves)."""
+    from linkwork.io.curves import find_self_crossing
+
+    points = np.array(coordinates)[:, ::-1] if transpose else np.array(coordinates)
+    if np.min(np.hypot(*np.diff(points, axis=0).T)) < 1e-6:
+        return  # repeated points are refused before the crossing check
+    closeness = np.abs(np.diff(points, axis=0)).min()
+    if closeness < 1e-9:
+        return  # nearly axis-parallel pieces: within the check's tolerance, not general position
+    assert (find_self_crossing(points) is not None) == _crosses_brute_force(points)
+
+
+@pytest.mark.parametrize("along", ["x", "y"])
+def test_a_serpentine_profile_of_200000_points_is_checked_in_seconds(tmp_path: Path, along: str) -> None:
+    """A zigzag across the whole width (hatching, a serpentine) overlapped every other piece along x: the
+    crossing check was quadratic, 20 s for 10,000 points and hours for the 200,000 a profile may have."""
+    n = 200_000
+    across = (np.arange(n) % 2).astype(float)
+    up = np.arange(n) * 1e-3
+    points = np.column_stack([across, up] if along == "x" else [up, across])
+    file = tmp_path / "serpentine.csv"
+    file.write_text("x,y\n" + "\n".join(f"{x:.3f},{y:.3f}" for x, y in points) + "\n", encoding="utf-8")
+    start = time.perf_counter()
+    np.testing.assert_array_equal(load_profile(file), np.loadtxt(file, delimiter=",", skiprows=1))
+    assert time.perf_counter() - start < 60.0  # about 3 s on a loaded 2-core machine
+
+
+def test_a_tangle_beyond_the_budget_is_refused_at_once(tmp_path: Path) -> None:
+    """Long pieces side by side along both x and y: both sweeps are quadratic, so the check is refused with its
+    budget stated (it would have run for minutes to hours) rather than started."""
+    n = 20_000
+    k = np.arange(n)
+    points = np.column_stack([(k % 2) + 1e-4 * k, (k % 2) * 1.0 + 2e-4 * k])
+    file = tmp_path / "tangle.csv"
+    file.write_text("x,y\n" + "\n".join(f"{x:.17g},{y:.17g}" for x, y in points) + "\n", encoding="utf-8")
+    start = time.perf_counter()
+    message = one_line_error(lambda: load_profile(file), (SpecError,))
+    assert time.perf_counter() - start < 30.0
+    assert message is not None and "pairs of pieces; expected at most" in message
