@@ -49,12 +49,24 @@ def show_path(path: Any) -> str:
     return '"' + escape_line(text).replace('"', '\\"') + '"'
 
 
-_CONTROL = re.compile(r"[\x00-\x1f\x7f\u0085\u2028\u2029]")
+#: Characters never printed as they are: C0 and C1 control characters (C1 holds ``\x9b``, the one-byte CSI
+#: that some terminals read as the start of an escape sequence, and ``\x85``, a line break), the line and
+#: paragraph separators, and the bidirectional embeddings, overrides and isolates (U+202A-U+202E,
+#: U+2066-U+2069), which reorder the rest of a line on screen ("Trojan Source", CVE-2021-42574), so that a
+#: message would not read as what it says.
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
 
 
 def escape_line(text: str) -> str:
-    """``text`` with line breaks and other control characters written as escapes (``\\n``, ``\\x1b``)."""
-    return _CONTROL.sub(lambda m: repr(m.group(0))[1:-1], text)
+    """``text`` with line breaks, other control characters and bidirectional controls written as escapes
+    (``\\n``, ``\\x1b``, ``\\u202e``), so that it prints as one line that reads in the order it is stored."""
+    return _CONTROL.sub(_escape, text)
+
+
+def _escape(match: re.Match[str]) -> str:
+    char = match.group(0)
+    shown = repr(char)[1:-1]
+    return shown if shown != char else f"\\u{ord(char):04x}"
 
 
 def closest(word: str, choices: Sequence[str], cutoff: float = 0.6) -> str | None:

@@ -33,12 +33,14 @@ __all__ = [
     "FORMULA_START",
     "MAX_NAME_CHARS",
     "MJCF_RESERVED",
+    "NAME_RULE",
     "NameMap",
     "csv_columns",
     "describe",
     "dxf_layers",
     "html_text",
     "mathtext",
+    "name_problem",
     "stl_names",
     "xml_attribute",
     "xml_names",
@@ -57,6 +59,27 @@ a CSV column name starting with one is written with :data:`COLUMN_PREFIX`."""
 
 MJCF_RESERVED = frozenset({"world"})
 """Body names MuJoCo reserves (the world body)."""
+
+NAME_RULE = "a name without line breaks or control characters"
+"""What a name a user writes in a file must be (the words of every reader's message): see :func:`name_problem`."""
+
+#: Characters no name may hold: C0 and C1 control characters (line breaks, escape sequences, ``\x9b`` the
+#: one-byte CSI), the line and paragraph separators, and the bidirectional embeddings, overrides and isolates
+#: (U+202A-U+202E, U+2066-U+2069) that reorder what follows them on screen ("Trojan Source",
+#: CVE-2021-42574): a name is printed in tables and error lines, and written in CSV headers and drawings, where
+#: any of these would break a line or make it read as something else. (The same characters that
+#: :func:`linkwork.messages.escape_line` escapes; a tab is refused unless a reader allows it.)
+_UNSAFE_IN_NAME = re.compile("[\x00-\x08\x0a-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
+
+
+def name_problem(name: str, *, tab: bool = False) -> str | None:
+    """Why ``name`` cannot be a name a user writes in a file (a linkage, joint, body, point, profile or study
+    name), or ``None`` when it can: it holds a character of :data:`_UNSAFE_IN_NAME` (a tab only when ``tab``
+    is false). The message is :data:`NAME_RULE`; the caller adds the key and the value."""
+    if _UNSAFE_IN_NAME.search(name) or (not tab and "\t" in name):
+        return NAME_RULE
+    return None
+
 
 _XML_FORBIDDEN = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
 _DXF_FORBIDDEN = re.compile('[<>/\\\\":;?*|=,`\x00-\x1f\x7f\ud800-\udfff]')
@@ -112,7 +135,13 @@ def describe(*maps: NameMap) -> str | None:
 
 def _show(text: str) -> str:
     shown = text if len(text) <= 40 else text[:37] + "..."
-    escaped = re.sub(r"[\x00-\x1f\x7f\u0085\u2028\u2029]", lambda m: repr(m.group(0))[1:-1], shown)
+    escaped = re.sub(
+        r"[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]",
+        lambda m: (
+            f"\\u{ord(m.group(0)):04x}" if repr(m.group(0))[1:-1] == m.group(0) else repr(m.group(0))[1:-1]
+        ),
+        shown,
+    )
     return '"' + escaped.replace('"', '\\"') + '"'
 
 

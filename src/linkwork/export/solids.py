@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from linkwork.errors import SpecError
 from linkwork.io.writer import require_finite
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.names import NameMap, stl_names, xml_attribute
@@ -24,10 +25,15 @@ def parts(mech: Mechanism, angles: ArrayLike, scale: float = 1.0) -> list[Mesh]:
     """Every body's solid, then a pin on every joint, at the joint values ``angles`` (radians), scaled."""
     T = np.diag([scale, scale, scale, 1.0])
     meshes = [mesh.transformed(T) for mesh in posed_meshes(mech, angles)]
+    what = f"--scale {scale:g}: the solids' coordinates (the mechanism's lengths times it)"
     for mesh in meshes:
-        require_finite(
-            mesh.vertices, f"--scale {scale:g}: the solids' coordinates (the mechanism's lengths times it)"
-        )
+        require_finite(mesh.vertices, what)
+    size = max((float(np.max(np.abs(m.vertices))) for m in meshes if m.vertices.size), default=0.0)
+    # Below this a float has lost digits to underflow (subnormal numbers): --scale 1e-320 wrote vertices
+    # with two or three significant digits, every facet degenerate.
+    smallest = float(np.finfo(float).tiny / np.finfo(float).eps)
+    if 0.0 < size < smallest:
+        raise SpecError(f"{what}: the largest is {size:.3g}; expected a size of at least {smallest:.3g}")
     return meshes
 
 

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
+from linkwork.messages import escape_line
 
 Points = NDArray[np.float64]
 
@@ -33,6 +34,11 @@ MAX_COORDINATE = 1e12
 
 MAX_FLATTENED_POINTS = 200_000
 """The most points curved geometry (arcs, bulges, Bézier curves, splines) may be flattened into."""
+
+MAX_CROSSING_PAIRS = 50_000_000
+"""The most pairs of pieces the self-crossing check of a profile tests (about a minute on one core): a curve
+folding back and forth across its whole width in both x and y needs more, and is refused rather than checked
+for hours."""
 
 MAX_BULGE = 1e6
 """The largest DXF bulge (tan of a quarter of the arc's included angle) accepted."""
@@ -100,22 +106,33 @@ def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
     pairs = [(i, i + 1) for i in range(n_pieces - 1)]
     if closed and n_pieces > 2:
         pairs.append((0, n_pieces - 1))
-    for i, j in pairs:
-        cross = direction[i, 0] * direction[j, 1] - direction[i, 1] * direction[j, 0]
-        dot = direction[i] @ direction[j]
-        if abs(cross) <= length_tol * max(piece_length[i], piece_length[j]) and dot < 0.0:
-            return (i, j)
+    for p, q in pairs:
+        cross = direction[p, 0] * direction[q, 1] - direction[p, 1] * direction[q, 0]
+        dot = direction[p] @ direction[q]
+        if abs(cross) <= length_tol * max(piece_length[p], piece_length[q]) and dot < 0.0:
+            return (p, q)
 
     lo = np.minimum(a, b) - length_tol
     hi = np.maximum(a, b) + length_tol
 
-    # Sweep along x: after sorting pieces by their left end, piece k can only meet the pieces that start
-    # before it ends, a contiguous run found by searchsorted; the run is short for any curve but a tangle.
-    order = np.argsort(lo[:, 0], kind="stable")
-    run_end = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
-    counts = np.maximum(run_end - np.arange(n_pieces) - 1, 0)
-    offsets = np.cumsum(counts) - counts
+    # Sweep along x or y: after sorting pieces by their low end on that axis, piece k can only meet the pieces
+    # that start before it ends, a contiguous run found by searchsorted; the run is short for any curve but a
+    # tangle. The axis is the one with fewer candidate pairs: a zigzag of pieces across the whole width (a
+    # serpentine, hatching) overlaps every other piece along x, so the x sweep alone was quadratic (10,000
+    # points took 20 s, the 200,000 a profile may have, hours).
+    order, counts = _sweep(lo, hi, 0)
     total = int(counts.sum())
+    if total > n_pieces:
+        order_y, counts_y = _sweep(lo, hi, 1)
+        if int(counts_y.sum()) < total:
+            order, counts, total = order_y, counts_y, int(counts_y.sum())
+    if total > MAX_CROSSING_PAIRS:
+        raise SpecError(
+            f"the curve's {n_pieces} pieces lie so close together along x and y that checking it for "
+            f"self-crossings means {total} pairs of pieces; expected at most {MAX_CROSSING_PAIRS} (fewer points, "
+            "or a curve that does not fold back and forth across its whole width)"
+        )
+    offsets = np.cumsum(counts) - counts
     batch = 1_000_000
     for first in range(0, total, batch):
         flat = np.arange(first, min(first + batch, total))
@@ -131,6 +148,14 @@ def find_self_crossing(points: ArrayLike) -> tuple[int, int] | None:
             pick = np.lexsort((j[hit], i[hit]))[0]
             return (int(i[hit][pick]), int(j[hit][pick]))
     return None
+
+
+def _sweep(lo: Points, hi: Points, axis: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The pieces in order of their low end along ``axis``, and for each how many later pieces start before it
+    ends there (the candidates it is tested against)."""
+    order = np.argsort(lo[:, axis], kind="stable")
+    run_end = np.searchsorted(lo[order, axis], hi[order, axis], side="right")
+    return order, np.maximum(run_end - np.arange(len(order)) - 1, 0)
 
 
 def _pieces_meet(a: Points, b: Points, c: Points, d: Points, length_tol: float) -> NDArray[np.bool_]:
@@ -181,7 +206,7 @@ def check_profile(points: ArrayLike, source: str | Path | None = None) -> Points
     SpecError
         Naming ``source``, what is wrong (1-based point numbers) and what was expected.
     """
-    where = str(source) if source is not None else None
+    where = escape_line(str(source)) if source is not None else None
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         if pts.size == 0:
@@ -293,14 +318,14 @@ def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
     if count < max(2, order) and len(entity.fit_points) < 2:
         raise SpecError(
             f"the SPLINE has {count} control points for degree {order - 1}; expected at least {max(2, order)}",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     spline = entity.construction_tool()
     control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
     if not np.all(np.isfinite(control)) or np.abs(control).max() > MAX_COORDINATE:
         raise SpecError(
             f"the SPLINE has a control point that is not finite or beyond +-{MAX_COORDINATE:g}",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     absolute = tolerance * bounding_size(control)
     points = []
@@ -308,7 +333,8 @@ def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
         points.append((v.x, v.y))
         if len(points) > MAX_FLATTENED_POINTS:
             raise SpecError(
-                f"the SPLINE flattens into more than {MAX_FLATTENED_POINTS} points", source=str(path)
+                f"the SPLINE flattens into more than {MAX_FLATTENED_POINTS} points",
+                source=escape_line(str(path)),
             )
     return np.array(points, dtype=float)
 

@@ -96,7 +96,10 @@ def _settings(reader: TomlReader, table: dict[str, Any]) -> dict[str, Any]:
         raise reader.error(
             "merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {show(merge_below)}"
         )
-    settings["merge_below"] = math.radians(merge_below) if math.isfinite(merge_below) else math.inf
+    try:  # nan stays nan, so the rule's message quotes what the file says
+        settings["merge_below"] = math.radians(merge_below)
+    except OverflowError:  # a whole number beyond a float
+        settings["merge_below"] = math.inf
     settings["seed"] = _whole(reader, table, "seed", 0, "a whole number >= 0")
     settings["mechanize"] = reader.boolean(table, "mechanize", "", default=False)
     if "description" in table and not isinstance(table["description"], str):

@@ -17,6 +17,8 @@ vertex of the flattened polyline lies on the true curve (to rounding). The check
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,6 +47,7 @@ from linkwork.io.drawing import LENGTH_UNITS, new_dxf, svg_d, svg_document, svg_
 from linkwork.io.outlines import final_chain, write_outline_dxf, write_outline_svg
 from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
 from linkwork.io.toml_reader import check_input_file, escape_line
+from linkwork.io.writer import require_finite
 
 __all__ = [
     "COINCIDENT",
@@ -85,33 +88,55 @@ _CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier
 def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> Points:
     """Read a profile from a CSV file of ``x,y`` rows.
 
-    A header row is optional; when present it must name an ``x`` and a ``y`` column (any order, any other
-    columns ignored). Without a header the first two columns are x and y. Blank lines and lines starting with
-    ``#`` are skipped. ``tolerance`` is unused (the points are taken as they are).
+    A header row is optional; when present it must name an ``x`` and a ``y`` column once each (any order, any
+    other columns ignored). Without a header the first two columns are x and y. Every row has as many cells as
+    the header (or, without one, as the first row): a row with more is refused rather than read wrong, since a
+    thousands separator (``1,000.5``) or a decimal comma splits a number into two cells. Numbers are written
+    as CSV files write them (:func:`_csv_number`). Blank lines and lines starting with ``#`` are skipped.
+    ``tolerance`` is unused (the points are taken as they are).
     """
     path = Path(path)
+    source = escape_line(str(path))
     lines = _read_lines(path)
     x_col, y_col = 0, 1
     rows: list[tuple[float, float]] = []
-    header_seen = False
+    width: tuple[int, int] | None = None  # the cells of every row, and the line that set it
     for number, line in lines:
         cells = [cell.strip() for cell in line.split(",")]
-        if not rows and not header_seen and not _is_number(cells[0]):
+        if width is None and _csv_number(cells[0]) is None:
             names = [cell.lower() for cell in cells]
             if "x" not in names or "y" not in names:
                 raise SpecError(
-                    f"line {number}: header {line!r} names no x and y columns; expected e.g. 'x,y'",
-                    source=str(path),
+                    f"line {number}: header {_quoted(line)} names no x and y columns; expected e.g. 'x,y'",
+                    source=source,
                 )
+            for column in ("x", "y"):
+                if names.count(column) > 1:
+                    raise SpecError(
+                        f"line {number}: header {_quoted(line)} names column {column} {names.count(column)} times; "
+                        "expected one x and one y column",
+                        source=source,
+                    )
             x_col, y_col = names.index("x"), names.index("y")
-            header_seen = True
+            width = (len(cells), number)
             continue
-        try:
-            rows.append((float(cells[x_col]), float(cells[y_col])))
-        except (ValueError, IndexError):
+        if width is None:
+            width = (len(cells), number)
+        if len(cells) != width[0] and len(cells) > max(x_col, y_col):
             raise SpecError(
-                f"line {number}: expected numbers in columns x and y, got {line!r}", source=str(path)
-            ) from None
+                f"line {number}: {_cells(len(cells))} in {_quoted(line)}, but line {width[1]} has {width[0]}; "
+                "expected the same number of cells on every line (a thousands separator or a decimal comma "
+                "splits a number into two cells)",
+                source=source,
+            )
+        x, y = (
+            (_csv_number(cells[x_col]), _csv_number(cells[y_col])) if len(cells) == width[0] else (None, None)
+        )
+        if x is None or y is None:
+            raise SpecError(
+                f"line {number}: expected numbers in columns x and y, got {_quoted(line)}", source=source
+            )
+        rows.append((x, y))
     return np.array(rows, dtype=float).reshape(-1, 2)
 
 
@@ -130,25 +155,34 @@ def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
 
     The points run from the trailing edge over the upper surface to the leading edge and back along the lower
     surface. A file without the name line is accepted. Lednicer files (upper and lower surfaces listed
-    separately after a line of point counts) are recognised and refused. ``tolerance`` is unused.
+    separately after a line of point counts) are recognised and refused: their first line of numbers is two
+    whole numbers above 1.5 lying beyond every point of the curve (``61. 61.`` before a chord from 0 to 1); a
+    Selig file in millimetres, whose first point ``100 20`` is its trailing edge, is read. ``tolerance`` is
+    unused.
     """
     path = Path(path)
+    source = escape_line(str(path))
     rows: list[tuple[float, float]] = []
+    first = (0, "")
     for index, (number, line) in enumerate(_read_lines(path)):
         cells = line.replace(",", " ").split()
-        values = [_to_float(cell) for cell in cells]
+        values = [_csv_number(cell) for cell in cells]
         if index == 0 and (len(values) != 2 or None in values):
             continue  # the airfoil's name
         if len(values) != 2 or values[0] is None or values[1] is None:
-            raise SpecError(f"line {number}: expected two numbers 'x y', got {line!r}", source=str(path))
-        x, y = float(values[0]), float(values[1])
-        if not rows and x > 1.5 and y > 1.5 and x.is_integer() and y.is_integer():
+            raise SpecError(f"line {number}: expected two numbers 'x y', got {_quoted(line)}", source=source)
+        if not rows:
+            first = (number, line)
+        rows.append((float(values[0]), float(values[1])))
+    if rows:
+        x, y = rows[0]
+        counts = x > 1.5 and y > 1.5 and x.is_integer() and y.is_integer()
+        if counts and (len(rows) == 1 or x > max(p[0] for p in rows[1:])):
             raise SpecError(
-                f"line {number}: looks like a Lednicer point-count line {line!r}; expected Selig format "
-                "(one list from the trailing edge over the upper surface and back along the lower)",
-                source=str(path),
+                f"line {first[0]}: looks like a Lednicer point-count line {_quoted(first[1])}; expected Selig "
+                "format (one list from the trailing edge over the upper surface and back along the lower)",
+                source=source,
             )
-        rows.append((x, y))
     return np.array(rows, dtype=float).reshape(-1, 2)
 
 
@@ -180,14 +214,15 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
         document = svg_lib.SVG.parse(str(path), reify=True)
     except Exception as exc:  # svgelements raises bare parser errors of several kinds
         raise SpecError(
-            f"not a readable SVG drawing ({exc}); expected an SVG file", source=str(path)
+            f"not a readable SVG drawing ({escape_line(str(exc))[:200]}); expected an SVG file",
+            source=escape_line(str(path)),
         ) from None
     shapes = [element for element in document.elements() if isinstance(element, svg_lib.Shape)]
     shapes = [shape for shape in shapes if len(svg_lib.Path(shape)) > 0]
     if len(shapes) != 1:
         raise SpecError(
             f"found {len(shapes)} shapes; expected exactly one path (or polyline, polygon, line)",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     outline = svg_lib.Path(shapes[0])
     user_units = ~svg_lib.Matrix(document.viewbox_transform) if document.viewbox_transform else None
@@ -198,10 +233,13 @@ def read_profile_svg(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     moves = sum(isinstance(segment, svg_lib.Move) for segment in outline.segments())
     if moves > 1:
         raise SpecError(
-            f"the path has {moves} parts (M commands); expected one continuous curve", source=str(path)
+            f"the path has {moves} parts (M commands); expected one continuous curve",
+            source=escape_line(str(path)),
         )
     if not segments:
-        raise SpecError("the shape has no points; expected a curve of at least 2 points", source=str(path))
+        raise SpecError(
+            "the shape has no points; expected a curve of at least 2 points", source=escape_line(str(path))
+        )
     defining: list[tuple[float, float]] = []
     for segment in segments:
         anchors = (segment.start, segment.end, *(getattr(segment, name, None) for name in _CONTROLS))
@@ -252,13 +290,14 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
         document = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as exc:
         raise SpecError(
-            f"not a readable DXF drawing ({exc}); expected a DXF file", source=str(path)
+            f"not a readable DXF drawing ({escape_line(str(exc))[:200]}); expected a DXF file",
+            source=escape_line(str(path)),
         ) from None
     entities = list(document.modelspace().query("LWPOLYLINE POLYLINE SPLINE"))
     if len(entities) != 1:
         raise SpecError(
             f"found {len(entities)} LWPOLYLINE/POLYLINE/SPLINE entities in model space; expected exactly one",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     entity = entities[0]
     kind = entity.dxftype()
@@ -270,24 +309,51 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     else:
         if not entity.is_2d_polyline and not entity.is_3d_polyline:
             raise SpecError(
-                f"the POLYLINE is a {entity.get_mode()}; expected a 2-D or 3-D polyline", source=str(path)
+                f"the POLYLINE is a {entity.get_mode()}; expected a 2-D or 3-D polyline",
+                source=escape_line(str(path)),
             )
         vertices = [
             (float(v.dxf.location.x), float(v.dxf.location.y), float(v.dxf.get("bulge", 0.0)))
             for v in entity.vertices
         ]
         closed = bool(entity.is_closed)
+    if kind == "LWPOLYLINE" or entity.is_2d_polyline:
+        vertices = _ocs_to_xy(vertices, entity, path)
     return bulge_polyline(vertices, closed, tolerance)
+
+
+def _ocs_to_xy(
+    vertices: list[tuple[float, float, float]], entity: Any, path: Path
+) -> list[tuple[float, float, float]]:
+    """The ``(x, y, bulge)`` of a 2-D polyline's vertices in the drawing's x and y (world coordinates).
+
+    A 2-D polyline is written in its object coordinate system (DXF's "arbitrary axis algorithm" on its
+    extrusion vector): a polyline mirrored in CAD has the extrusion ``(0, 0, -1)``, whose x axis is the world's
+    ``-x``, and its arcs turn the other way seen from ``+z`` (the bulges change sign). Read as they were, its
+    points came out mirrored. A polyline in a plane that is not parallel to the world's x-y plane is refused.
+    """
+    nx, ny, nz = (float(c) for c in entity.dxf.get("extrusion", (0.0, 0.0, 1.0)))
+    size = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if not (math.isfinite(size) and size > 0.0) or abs(nx) > 1e-12 * size or abs(ny) > 1e-12 * size:
+        raise SpecError(
+            f"the {entity.dxftype()} lies in a plane with normal ({nx:g}, {ny:g}, {nz:g}); expected a profile "
+            "drawn in the x-y plane (normal (0, 0, 1), or (0, 0, -1) when mirrored)",
+            source=escape_line(str(path)),
+        )
+    if nz > 0.0:
+        return vertices
+    return [
+        (0.0 - x, y, -bulge) for x, y, bulge in vertices
+    ]  # the arbitrary axis x for -z is -x (0 - x: no -0.0)
 
 
 def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:
     """Write a profile as a DXF drawing with one LWPOLYLINE (flagged closed, without the repeated point, when
-    the profile returns to its first point)."""
-    import ezdxf
-
+    the profile returns to its first point), unitless (``$INSUNITS`` 0: a profile carries no unit; ezdxf's own
+    default header said metres)."""
     pts = np.asarray(points, dtype=float)
     closed = is_closed(pts)
-    document = ezdxf.new("R2010")
+    document = new_dxf(None)
     document.modelspace().add_lwpolyline(pts[:-1] if closed else pts, format="xy", close=closed)
     document.saveas(str(path))
 
@@ -341,7 +407,9 @@ def _format_for(path: Path) -> ProfileFormat:
     if fmt is None:
         known = ", ".join(sorted(FORMATS))
         got = f"suffix {path.suffix!r}" if path.suffix else "no suffix"
-        raise SpecError(f"unknown profile format ({got}); expected one of {known}", source=str(path))
+        raise SpecError(
+            f"unknown profile format ({got}); expected one of {known}", source=escape_line(str(path))
+        )
     return fmt
 
 
@@ -372,7 +440,7 @@ def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> P
     >>> save_profile(folder / "line.csv", [[0.0, 0.0], [1.0, 0.5]])
     >>> load_profile(folder / "line.csv").tolist()
     [[0.0, 0.0], [1.0, 0.5]]
-    >>> save_profile(folder / "dot.csv", [[0.0, 0.0]])
+    >>> _ = (folder / "dot.csv").write_text("x,y\\n0,0\\n")
     >>> load_profile(folder / "dot.csv")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -384,26 +452,37 @@ def load_profile(path: str | Path, *, tolerance: float = FLATTEN_TOLERANCE) -> P
     if path.stat().st_size > MAX_PROFILE_BYTES:
         raise SpecError(
             f"is {path.stat().st_size} bytes, larger than the limit of {MAX_PROFILE_BYTES}; expected a profile",
-            source=str(path),
+            source=escape_line(str(path)),
         )
     try:
         points = fmt.read(path, tolerance)
     except SpecError as exc:
         if exc.source is None:
-            raise SpecError(str(exc), source=str(path), key=exc.key) from None
+            raise SpecError(exc.detail, source=escape_line(str(path)), key=exc.key) from None
         raise
     except Exception as exc:  # a hostile file can make a third-party parser fail in many ways
         raise SpecError(
             f"could not be read as a {fmt.name} curve ({type(exc).__name__}: {escape_line(str(exc))[:200]})",
-            source=str(path),
+            source=escape_line(str(path)),
         ) from None
     return check_profile(points, source=path)
 
 
 def save_profile(path: str | Path, points: ArrayLike) -> None:
-    """Write a profile in the format its suffix names (the inverse of :func:`load_profile`)."""
+    """Write a profile in the format its suffix names (the inverse of :func:`load_profile`).
+
+    Only what :func:`load_profile` reads back is written: a polyline of shape ``(N, 2)``, ``N >= 2``, every
+    coordinate finite (:func:`linkwork.io.writer.require_finite`). A NaN used to be written as ``nan`` into a
+    CSV, Selig or DXF file, and a third column dropped silently."""
     path = Path(path)
-    _format_for(path).write(path, np.asarray(points, dtype=float))
+    fmt = _format_for(path)
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 2:
+        raise SpecError(
+            f"expected a profile of shape (N, 2) with N >= 2 to write, got shape {pts.shape}",
+            source=escape_line(str(path)),
+        )
+    fmt.write(path, require_finite(pts, f"{escape_line(str(path))}: the profile's points"))
 
 
 # --------------------------------------------------------------------------------------------- helpers
@@ -416,30 +495,49 @@ def _check_readable(path: Path) -> None:
             pass
     except OSError as exc:
         raise SpecError(
-            f"cannot be read ({exc.strerror}); expected a readable file", source=str(path)
+            f"cannot be read ({exc.strerror}); expected a readable file", source=escape_line(str(path))
         ) from None
 
 
 def _read_lines(path: Path) -> list[tuple[int, str]]:
-    """Numbered (1-based), stripped, non-blank lines that are not ``#`` comments."""
+    """Numbered (1-based), stripped, non-blank lines that are not ``#`` comments.
+
+    Lines end at ``\\n``, ``\\r\\n`` or ``\\r`` only, as in a text editor and Python's ``csv`` module (not at
+    every character :meth:`str.splitlines` takes for a break: a form feed or ``\\x85`` inside a comment would
+    start a data line, and every later line number would be wrong)."""
     _check_readable(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = path.read_bytes().decode("utf-8-sig")
     except UnicodeDecodeError:
-        raise SpecError("is not a UTF-8 text file; expected text", source=str(path)) from None
+        raise SpecError("is not a UTF-8 text file; expected text", source=escape_line(str(path))) from None
     return [
         (number, line.strip())
-        for number, line in enumerate(text.splitlines(), start=1)
+        for number, line in enumerate(_LINE_END.split(text), start=1)
         if line.strip() and not line.lstrip().startswith("#")
     ]
 
 
-def _to_float(text: str) -> float | None:
-    try:
-        return float(text)
-    except ValueError:
-        return None
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+#: A number as a CSV or Selig file writes it: ASCII digits, an optional sign, decimal point and exponent, or
+#: nan / inf (refused later as not finite, with the point named). Python's ``float`` would also take
+#: ``1_000`` (a typo for 1.000 in some locales), Arabic-Indic and full-width digits, which no spreadsheet or
+#: other reader of the file takes for the same number.
+_NUMBER = re.compile(
+    r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:nan|inf|infinity)", re.I
+)
 
 
-def _is_number(text: str) -> bool:
-    return _to_float(text) is not None
+def _quoted(line: str) -> str:
+    """A line of a profile file as a message quotes it: Python's ``repr`` (control characters escaped), cut after
+    60 characters (a line can be megabytes long)."""
+    return repr(line if len(line) <= 60 else line[:57] + "...")
+
+
+def _cells(count: int) -> str:
+    return f"{count} cell" if count == 1 else f"{count} cells"
+
+
+def _csv_number(text: str) -> float | None:
+    """The number ``text`` writes (see :data:`_NUMBER`), or ``None``."""
+    return float(text) if _NUMBER.fullmatch(text) else None

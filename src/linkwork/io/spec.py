@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -66,10 +65,11 @@ from linkwork.io.spec_reader import POINT_KEYS as POINT_KEYS
 from linkwork.io.spec_reader import ROD_KEYS as ROD_KEYS
 from linkwork.io.spec_reader import Couplings as Couplings
 from linkwork.io.spec_writer import dump_spec
-from linkwork.io.toml_reader import MAX_NAME_CHARS, read_toml, show
+from linkwork.io.toml_reader import MAX_NAME_CHARS, escape_line, read_toml, show
 from linkwork.kinematics.chains import Assembly
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.normalization import near_mobility
+from linkwork.names import name_problem
 
 __all__ = ["CONVENTIONS", "LoadedSpec", "dump_spec", "load_spec", "resolve_spec"]
 
@@ -138,10 +138,8 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
     reader = SpecReader(source)
     reader.check_keys(table, "", TOP_KEYS)
     name = reader.string(table, "name", "", default=path.stem, limit=MAX_NAME_CHARS)
-    if re.search(r"[\x00-\x08\x0a-\x1f\x7f\u2028\u2029]", name):  # a tab is fine (and valid XML)
-        raise reader.error(
-            "name", f"expected a name without line breaks or control characters, got {show(name)}"
-        )
+    if name_problem(name, tab=True) is not None:  # a tab is fine (and valid XML)
+        raise reader.error("name", f"expected {name_problem(name, tab=True)}, got {show(name)}")
     reader.string(table, "description", "", default="")  # free text for the reader
     unit = reader.choice(table, "angles", "", ANGLE_UNITS, default="deg")
     reader.degrees = unit == "deg"
@@ -162,12 +160,12 @@ def load_spec(path: str | Path, *, closure_tol: float = 1e-12) -> LoadedSpec:
             mech, couplings = read_mechanism_table(reader, table["mechanism"], name, meta)
             assembly = None
     except AssemblyError as exc:
-        raise AssemblyError(f"{source}: {exc}", residual=exc.residual) from None
+        raise AssemblyError(f"{reader.source}: {exc}", residual=exc.residual) from None
     couple, fixed = couplings
     if couple or fixed:
         mech = mech.with_couplings(couple, fixed)
     if assembly is None:
-        _check_not_near_mobile(mech, source, closure_tol)
+        _check_not_near_mobile(mech, reader.source, closure_tol)
     if "points" in table:
         mech = replace(mech, meta={**mech.meta, "points": read_points_table(reader, table["points"], mech)})
     return LoadedSpec(mechanism=mech, assembly=assembly, source=path)
@@ -221,7 +219,7 @@ def resolve_spec(
             given = ", ".join(sorted(params))
             raise SpecError(
                 f"--set applies to built-in linkages only (got {given}); edit the file instead",
-                source=str(path),
+                source=escape_line(str(path)),
                 key="--set",
             )
         return load_spec(path, closure_tol=closure_tol)

@@ -19,6 +19,7 @@ from linkwork.geometry.names import default_joint_name
 from linkwork.io.toml_reader import MAX_NAME_CHARS, TomlReader, closest, key_path, show
 from linkwork.kinematics.chains import Assembly, from_dh, from_rods
 from linkwork.kinematics.mechanism import Array, Mechanism
+from linkwork.names import name_problem
 
 CONVENTIONS = ("dh", "hinge-lines", "rods")
 """The values of ``loop.convention``."""
@@ -65,8 +66,10 @@ _ELSEWHERE = {
     "angles": "the top level",
 }
 
-#: Joint names end up in CSV headers and in flags such as ``--until A=30`` and ``--couple A=C``.
-_JOINT_NAME = re.compile(r"[^\s=,\"'\x00-\x1f\x7f]+")
+#: Joint names end up in CSV headers and in flags such as ``--until A=30`` and ``--couple A=C``: no spaces,
+#: quotes, ``=`` or ``,``, and none of the characters the name policy refuses in every name
+#: (:func:`linkwork.names.name_problem`: control characters, bidirectional controls).
+_JOINT_NAME = re.compile(r"[^\s=,\"'\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]+")
 
 _show = show
 _closest = closest
@@ -123,7 +126,7 @@ class SpecReader(TomlReader):
             if value not in names:
                 close = _closest(value, names)
                 hint = f'did you mean "{close}"? ' if close else ""
-                raise self.error(key, f'unknown joint "{value}"; {hint}joints are {known}')
+                raise self.error(key, f"unknown joint {_show(value)}; {hint}joints are {known}")
             return value
 
         couple_key = _key(path, "couple")
@@ -141,6 +144,8 @@ class SpecReader(TomlReader):
             if len(group) < 2:
                 raise self.error(key, f"expected at least two joints to couple, got {_show(group)}")
             members = [joint(item, _key(key, i)) for i, item in enumerate(group)]
+            if len(set(members)) != len(members):  # the words of --couple A=A
+                raise self.error(key, f"names a joint twice; expected distinct joints, got {_show(group)}")
             kinds = {types[names.index(m)] for m in members}
             if len(kinds) > 1:
                 raise self.error(key, f"cannot couple revolute and prismatic joints: {_show(group)}")
@@ -251,9 +256,21 @@ def read_mechanism_table(
                 _key(here, "bodies"),
                 f'expected the two bodies it joins, e.g. ["ground", "crank"], got {_show(bodies)}',
             )
+        for b, body in enumerate(bodies):
+            if len(body) > MAX_NAME_CHARS:
+                raise reader.error(
+                    _key(_key(here, "bodies"), b),
+                    f"expected a body name of at most {MAX_NAME_CHARS} characters, got {len(body)}: {_show(body)}",
+                )
+            if name_problem(body, tab=True) is not None:
+                raise reader.error(
+                    _key(_key(here, "bodies"), b),
+                    f"expected {name_problem(body, tab=True)}, got {_show(body)}",
+                )
         if bodies[0] == bodies[1]:
             raise reader.error(
-                _key(here, "bodies"), f'expected two different bodies, got "{bodies[0]}" joined to itself'
+                _key(here, "bodies"),
+                f"expected two different bodies, got {_show(bodies[0])} joined to itself",
             )
         point, direction = _joint_line(reader, joint, here, kind, planar)
         value_ = reader.number(joint, "value", here, default=0.0, angle=kind == "R")
@@ -295,7 +312,7 @@ def read_points_table(reader: SpecReader, value: Any, mech: Mechanism) -> list[d
     for i, entry in enumerate(value):
         here = _key("points", i)
         entry = reader.table(entry, here, POINT_KEYS)
-        name = reader.string(entry, "name", here, default=f"P{i + 1}")
+        name = reader.string(entry, "name", here, default=f"P{i + 1}", limit=MAX_NAME_CHARS)
         if name in taken or not _JOINT_NAME.fullmatch(name):
             raise reader.error(_key(here, "name"), f"expected a new name without spaces, got {_show(name)}")
         taken.add(name)

@@ -87,21 +87,28 @@ def read_toml(path: Path, what: str) -> dict[str, Any]:
     """
     expected = f"expected {what}"
     check_input_file(path, what)
+    source = escape_line(str(path))
     try:
         if path.stat().st_size > MAX_FILE_BYTES:
             raise SpecError(
                 f"is {path.stat().st_size} bytes, larger than the limit of {MAX_FILE_BYTES}; {expected}",
-                source=str(path),
+                source=source,
             )
-        text = path.read_bytes().decode("utf-8")
-    except UnicodeDecodeError:
-        raise SpecError(f"not a UTF-8 text file; {expected}", source=str(path)) from None
+        # "utf-8-sig": a byte-order mark (Notepad writes one) is not part of the text; as U+FEFF it would be an
+        # "invalid statement" at line 1, column 1, which names nothing the user can see in the file.
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = exc.object[: exc.start].count(b"\n") + 1
+        raise SpecError(
+            f"not a UTF-8 text file (byte {exc.object[exc.start]:#04x} at line {line}); {expected}",
+            source=source,
+        ) from None
     except OSError as exc:
-        raise SpecError(f"cannot be read ({exc.strerror}); {expected}", source=str(path)) from None
+        raise SpecError(f"cannot be read ({exc.strerror}); {expected}", source=source) from None
     try:
         return tomllib.loads(text)
     except RecursionError:
-        raise SpecError(f"invalid TOML: nested too deeply; {expected}", source=str(path)) from None
+        raise SpecError(f"invalid TOML: nested too deeply; {expected}", source=source) from None
     except tomllib.TOMLDecodeError as exc:
         message = str(exc)
         match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)
@@ -111,7 +118,7 @@ def read_toml(path: Path, what: str) -> dict[str, Any]:
         else:
             where = f"line {text.count(chr(10)) + 1} (end of file)"
             message = message.replace(" (at end of document)", "")
-        raise SpecError(f"invalid TOML: {escape_line(message)}", source=str(path), key=where) from None
+        raise SpecError(f"invalid TOML: {escape_line(message)}", source=source, key=where) from None
 
 
 class TomlReader:
@@ -123,7 +130,7 @@ class TomlReader:
     Attributes
     ----------
     source
-        The file being read, first in every message.
+        The file being read, first in every message (control characters escaped).
     degrees
         Whether angles in the file are degrees (converted to radians by :meth:`number` with ``angle=True``).
     elsewhere
@@ -131,7 +138,7 @@ class TomlReader:
     """
 
     def __init__(self, source: str, elsewhere: Mapping[str, str] | None = None) -> None:
-        self.source = source
+        self.source = escape_line(source)  # a file name may hold a line break: the message stays one line
         self.degrees = True
         self.elsewhere = dict(elsewhere or {})
 

@@ -334,7 +334,17 @@ def _check_output_file(file: Path, flag: str) -> None:
         raise SpecError(f"{flag} {_shown(file)}: is a folder; expected a file name to write")
     if file.name == MANIFEST:
         raise SpecError(f"{flag} {_shown(file)}: is linkwork's manifest; choose another file name")
-    if _exists(file) and file.name not in Manifest.read(file.absolute().parent).owned():
+    manifest = Manifest.read(file.absolute().parent) if _exists(file) else Manifest()
+    runs = sorted(part for part, names in manifest.parts.items() if file.name in names)
+    if runs and file.name not in manifest.files:
+        # An entry of a run's results (a trace folder's mechanism.toml, path.csv): other commands read it back
+        # from the folder (export reads the very folder it writes into), so a single file written over it would
+        # break that result, not replace an earlier export.
+        raise SpecError(
+            f"{flag} {_shown(file)}: is one of the results of a linkwork run in that folder ({runs[0]}, listed in "
+            f"{MANIFEST}), which other commands read back; choose another file name"
+        )
+    if _exists(file) and file.name not in manifest.owned():
         raise SpecError(
             f"{flag} {_shown(file)}: exists and was not written by linkwork; move it away or choose another "
             f"file (linkwork never overwrites what it did not write; what it wrote is listed in {MANIFEST} beside it)"

@@ -30,6 +30,7 @@ from linkwork import limits
 from linkwork.errors import SpecError
 from linkwork.io.toml_reader import MAX_NAME_CHARS, TomlReader, read_toml, show
 from linkwork.limits import Limit
+from linkwork.names import name_problem
 from linkwork.synthesis.problem import MAX_AUTO_SEGMENTS, MAX_PIECES, MAX_STARTS
 
 SYNTHESIS_KEYS = ("piece_length", "segments", "design", "min_pieces", "starts", "merge_below")
@@ -325,9 +326,11 @@ def load_study(path: str | Path) -> Study:
     reader.check_keys(table, "", TOP_KEYS)
     given = [k for k in ("linkage", "spec", "problem") if k in table]
     if len(given) != 1:
-        raise SpecError("give exactly one of linkage, spec or problem", source=source)
+        raise SpecError("give exactly one of linkage, spec or problem", source=reader.source)
     target = reader.string(table, given[0], "", default=None, limit=4096)
     name = reader.string(table, "name", "", default=path.stem, limit=MAX_NAME_CHARS)
+    if name_problem(name, tab=True) is not None:
+        raise reader.error("name", f"expected {name_problem(name, tab=True)}, got {show(name)}")
     if "description" in table and not isinstance(table["description"], str):
         raise reader.error("description", f"expected a string, got {show(table['description'])}")
     budget = (

@@ -12,8 +12,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from linkwork.errors import SpecError
-from linkwork.messages import show
-from linkwork.names import MAX_NAME_CHARS
+from linkwork.limits import MAX_SEED
+from linkwork.messages import escape_line, show
+from linkwork.names import MAX_NAME_CHARS, name_problem
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
 RankBy = Literal["error", "joints"]
@@ -114,7 +115,9 @@ class Problem:
         """Check every rule of a problem; a broken one is a :class:`SpecError` naming the problem file's key
         with the same words as the file reader."""
         for key, message in _broken_rules(self):
-            raise SpecError(message, source=None if self.source is None else str(self.source), key=key)
+            raise SpecError(
+                message, source=None if self.source is None else escape_line(str(self.source)), key=key
+            )
 
     @property
     def count(self) -> int:
@@ -147,6 +150,10 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
     p = problem
     if p.kind not in KINDS:
         return [("type", f'expected one of "open", "closed", "fixed-end", got {show(p.kind)}')]
+    if not isinstance(p.profiles, tuple | list):  # a generator has no length; None is no profile
+        return [
+            ("profiles", f"expected a tuple of polylines of shape (N, 2), got {type(p.profiles).__name__}")
+        ]
     if len(p.profiles) < 2:
         return [("profiles", f"lists {len(p.profiles)} profile(s); expected at least 2 profiles")]
     if not (_real(p.piece_length) and math.isfinite(p.piece_length) and p.piece_length > 0):
@@ -184,6 +191,8 @@ def _broken_rules(problem: Problem) -> list[tuple[str, str]]:
         return [("merge_below", f"expected an angle in degrees, 0 <= merge_below < 180, got {shown}")]
     if not _whole(p.seed, 0):
         return [("seed", f"expected a whole number >= 0, got {show(p.seed)}")]
+    if p.seed > MAX_SEED:  # the bound of every seed (limits.SEED), the largest whole number TOML holds
+        return [("seed", f"expected a whole number <= {MAX_SEED}, got {show(p.seed)}")]
     return _ranking_rules(p) or _name_rules(p) or _profile_rules(p)
 
 
@@ -240,6 +249,15 @@ def _design_rules(p: Problem) -> list[tuple[str, str]]:
     if wrong:
         letters = show(", ".join(wrong))[1:-1]
         return [("design", f"expected {expected}, got {show(p.design)} (letters {letters} are not M or C)")]
+    most = MAX_PIECES // 2
+    if len(design) > most:  # every segment takes at least 2 of a profile's at most MAX_PIECES pieces
+        return [
+            (
+                "design",
+                f"has {len(design)} segments; expected at most {most} (each segment takes at least 2 of a "
+                f"profile's at most {MAX_PIECES} pieces), got {show(p.design)}",
+            )
+        ]
     if p.segments is not None and p.segments != len(design):
         return [
             (
@@ -266,13 +284,8 @@ def _name_rules(p: Problem) -> list[tuple[str, str]]:
     for index, name in enumerate(p.names):
         if len(name) > MAX_NAME_CHARS:
             return [(f"names[{index}]", f"expected at most {MAX_NAME_CHARS} characters, got {len(name)}")]
-        if any(ord(ch) < 32 or ord(ch) == 127 or ch in "\u2028\u2029" for ch in name):
-            return [
-                (
-                    f"names[{index}]",
-                    f"expected a name without line breaks or control characters, got {show(name)}",
-                )
-            ]
+        if name_problem(name) is not None:
+            return [(f"names[{index}]", f"expected {name_problem(name)}, got {show(name)}")]
     first: dict[str, int] = {}
     for index, name in enumerate(p.names):
         earlier = first.setdefault(name, index)
@@ -291,8 +304,11 @@ def _profile_rules(p: Problem) -> list[tuple[str, str]]:
     """Each profile a finite ``(N, 2)`` polyline, short enough in pieces for :data:`MAX_PIECES`."""
     length = 0.0
     for index, profile in enumerate(p.profiles):
-        points = np.asarray(profile)
         key = f"profiles[{index}]"
+        try:  # rows of unequal length, text, None: numpy's own error would not name the profile
+            points = np.asarray(profile, dtype=float)
+        except (TypeError, ValueError):
+            return [(key, "expected a polyline of shape (N, 2) with N >= 2 of numbers")]
         if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 2:
             return [(key, f"expected a polyline of shape (N, 2) with N >= 2, got shape {points.shape}")]
         if not np.all(np.isfinite(points)):
