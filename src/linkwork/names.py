@@ -27,6 +27,7 @@ import html
 import re
 from collections.abc import Collection, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 __all__ = [
     "COLUMN_PREFIX",
@@ -35,6 +36,7 @@ __all__ = [
     "MJCF_RESERVED",
     "NAME_RULE",
     "NameMap",
+    "csv_cell",
     "csv_columns",
     "describe",
     "dxf_layers",
@@ -56,6 +58,19 @@ COLUMN_PREFIX = "joint:"
 FORMULA_START = frozenset("=+-@\t\r")
 """Characters that make a spreadsheet read a cell as a formula when it starts with one (``=HYPERLINK(...)``):
 a CSV column name starting with one is written with :data:`COLUMN_PREFIX`."""
+
+
+T = TypeVar("T")
+
+
+def csv_cell(value: T) -> T | str:
+    """A CSV cell a spreadsheet shows as written: text starting with a :data:`FORMULA_START` character gets a
+    leading apostrophe (``'=HYPERLINK(...)``), the mark spreadsheets read as "text follows"; anything else (a
+    number) is returned as it is."""
+    if isinstance(value, str) and value[:1] in FORMULA_START:
+        return "'" + value
+    return value
+
 
 MJCF_RESERVED = frozenset({"world"})
 """Body names MuJoCo reserves (the world body)."""

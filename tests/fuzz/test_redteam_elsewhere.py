@@ -1,16 +1,16 @@
-"""Hostile inputs whose failure lies outside the red team's layers (session 13): each is a strict xfail naming the
-layer that owns the fix, so that the test passes the day it is fixed and CI says so.
+"""Hostile inputs whose failure lay outside the red team's layers (session 13), fixed in the layer that owns each
+(they were strict xfails; each docstring or comment says what happened before):
 
-- ``lw.trace`` with NaN, infinity, ``None``, a string or a wrong shape for a setting (kinematics, the lead): an
-  internal ``ValueError``/``TypeError``/``IndexError`` ("cannot convert float NaN to integer", "unsupported operand
-  type(s) for /: 'NoneType' and 'float'"), a ``RuntimeWarning``, or a trace run with a step of 0 or -1 degrees,
-  instead of one :class:`~linkwork.errors.SpecError` naming the argument.
-- ``lw.trace(mech, max_step=nan)`` never returns (kinematics, the lead): run in a child process with a deadline.
-- ``--set KEY=1 --set KEY=2``: the last is kept silently (cli, interrupts), where ``--until`` given twice is refused.
-- a study whose ``trace.until`` names a joint the linkage does not have runs every grid point and exits 3
-  ("every grid point failed") instead of exit 2 before any work (studies.sweep, the lead).
-- a problem whose profiles are too short for its segments: the line names ``min_pieces`` but not the problem
-  file (synthesis.synthesize, the lead).
+- ``lw.trace`` with NaN, infinity, ``None``, a string, a bool or a wrong shape for a setting gave an internal
+  ``ValueError``/``TypeError``/``IndexError``, a ``RuntimeWarning``, or a trace with a step of 0 or -1; now one
+  :class:`~linkwork.errors.SpecError` naming the argument (``kinematics.trace_arguments``).
+- ``lw.trace(mech, max_step=nan)`` never returned (run here in a child process with a deadline).
+- ``--set KEY=1 --set KEY=2`` kept the last silently; ``--out ''`` wrote into the working folder.
+- a study whose ``trace.until`` names a joint the linkage does not have ran every grid point, then exit 3.
+- an infeasible problem's line did not name the problem file; a problem's ``dof`` and ``ground_region`` were not
+  bounded like their flags; profile names went raw into CSV cells (a formula in a spreadsheet).
+- ``export dxf TRACE --set`` ignored ``--set``; ``mechanize --problem`` said the designs differed when only E_max
+  did; a Bennett linkage at scale 1e5 (its bound 1e6) was refused as not closing (an absolute tolerance).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ TRACE_ARGUMENTS: dict[str, dict[str, Any]] = {
     "until-None": {"until": ("A", None), "steps": 10},
     "until-one-item": {"until": ("A",), "steps": 10},
     "until-array": {"until": ("A", np.array([1.0])), "steps": 10},
-    "steps-nan": {"until": ("A", 1.0), "steps": math.nan},
+    "steps-nan": {"steps": math.nan, "until": ("A", 1.0)},
     "max_step-None": {"max_step": None, "max_steps": 20},
     "max_step-str": {"max_step": "0.1", "max_steps": 20},
     "max_step-zero": {"max_step": 0.0, "max_steps": 20},
@@ -56,11 +56,6 @@ TRACE_ARGUMENTS: dict[str, dict[str, Any]] = {
 }
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="kinematics.tracer (the lead): lw.trace does not check its settings; an internal error, a warning or "
-    "a trace with a zero or negative step instead of one SpecError naming the argument",
-)
 @pytest.mark.parametrize("arguments", list(TRACE_ARGUMENTS.values()), ids=list(TRACE_ARGUMENTS))
 def test_trace_settings_that_are_not_numbers_are_one_spec_error(
     bennett: lw.Mechanism, arguments: dict[str, Any]
@@ -75,11 +70,6 @@ def test_trace_settings_that_are_not_numbers_are_one_spec_error(
     assert name in str(info.value)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="kinematics (the lead): lw.trace(mech, max_step=nan) loops for ever in the compiled march (killed "
-    "after 30 s here; after 400 s by hand)",
-)
 def test_a_nan_step_is_refused_not_a_hang() -> None:
     script = textwrap.dedent(
         """
@@ -100,11 +90,6 @@ def test_a_nan_step_is_refused_not_a_hang() -> None:
     assert done.stdout.startswith("refused:"), done.stdout + done.stderr
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="cli.common.parse_assignments (interrupts owns cli/): a repeated --set key keeps the last value "
-    "silently, where a repeated --until is refused",
-)
 def test_a_set_key_given_twice_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     run = run_cli(["show", "bennett", "--set", "alpha1=45", "--set", "alpha1=60"], home=tmp_path)
@@ -112,11 +97,6 @@ def test_a_set_key_given_twice_is_refused(tmp_path: Path, monkeypatch: pytest.Mo
     assert "alpha1" in run.stderr and "twice" in run.stderr
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="studies.sweep (the lead): trace.until naming an unknown joint is found by each grid point's trace, "
-    "exit 3 after the work, not exit 2 before it",
-)
 def test_a_study_until_an_unknown_joint_is_bad_input(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     Path("study.toml").write_text(
@@ -128,11 +108,6 @@ def test_a_study_until_an_unknown_joint_is_bad_input(tmp_path: Path, monkeypatch
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="synthesis.synthesize / segment_matrix.check_feasible (the lead): the SpecError carries no source, "
-    "so the line does not name the problem file",
-)
 def test_an_infeasible_problem_names_its_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     t = np.linspace(0.0, 1.0, 30)
@@ -147,11 +122,6 @@ def test_an_infeasible_problem_names_its_file(tmp_path: Path, monkeypatch: pytes
     assert run.stderr.startswith("error: problem.toml: min_pieces: "), run.stderr
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="cli (interrupts): --out '' is Path('') == Path('.'): an unset shell variable (-o \"$OUT\") writes "
-    "the run into the working folder instead of being refused",
-)
 def test_an_empty_out_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     (tmp_path / "notes.txt").write_text("the user's\n", encoding="utf-8")
@@ -160,11 +130,6 @@ def test_an_empty_out_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="mechanization.options (the lead): a problem file's dof, ground_region box and polygon are not held "
-    "to the bounds of their flags and of every other length (--dof <= 20, |x| <= 1e12, a simple polygon)",
-)
 @pytest.mark.parametrize(
     "line",
     [
@@ -187,11 +152,6 @@ def test_problem_mechanization_keys_have_the_bounds_of_their_flags(tmp_path: Pat
         load_problem(file)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="cli/export (interrupts): --set with a trace folder (not a built-in) is ignored silently, where "
-    "`trace SPEC.toml --set` is refused",
-)
 def test_export_with_set_on_a_trace_folder_is_refused(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -201,24 +161,12 @@ def test_export_with_set_on_a_trace_folder_is_refused(
     assert run.code == 2 and "--set" in run.stderr
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="kinematics.chains / linkages (the lead): the assembly's closure tolerance is absolute (1e-12 length "
-    "units), so a built-in at a scale its own bounds allow (bennett scale=1e5, bound 1e6) is refused as not "
-    "closing (misfit 2.2e-11, rounding of a 1e5-sized loop), exit 2",
-)
 def test_a_bennett_linkage_at_a_large_allowed_scale_moves_as_at_scale_one() -> None:
     reference = lw.trace(lw.load("bennett"), until=("A", math.radians(120)), steps=20)
     large = lw.trace(lw.load("bennett", scale=1e5), until=("A", math.radians(120)), steps=20)
     np.testing.assert_allclose(large.angles, reference.angles, rtol=0, atol=1e-9)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="synthesis.result.write_target_profiles_csv (the lead): profile names are written raw into the "
-    "profile column of target_profiles.csv; a name starting with = + - @ runs as a formula in a spreadsheet "
-    "(the name policy guards CSV headers, names.FORMULA_START, not cells)",
-)
 def test_profile_names_in_target_profiles_csv_never_start_a_formula(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -239,12 +187,6 @@ def test_profile_names_in_target_profiles_csv_never_start_a_formula(
     assert cells and not any(cell[:1] in "=+-@\t\r" for cell in cells)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="outputs.synthesis.rerun_synthesis (interrupts owns outputs/): when --problem gives the same design "
-    "but another E_max (here 2 of the chain's 3 profiles), the line reads 'the chain (design \"MC\") is not what "
-    "two.toml gives now (design MC)': the difference it found, E_max or the profiles, is not said",
-)
 def test_mechanize_with_another_problem_says_what_differs(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -26,7 +26,7 @@ from linkwork.cli import (
     synth,
     trace,
 )
-from linkwork.cli.common import check_flags, fail, repeated_option
+from linkwork.cli.common import check_flags, fail, option_misuse
 from linkwork.interrupts import Interrupted, exit_code, install_safe_interrupt
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -58,13 +58,11 @@ class OneLineErrors(help.Group):
     ) -> Any:
         check_flags(self)  # every numeric flag's bounds (cli/options.py), checked before any work starts
         given = list(sys.argv[1:] if args is None else args)
-        twice = repeated_option(self, given)
-        if twice is not None:
+        misuse = option_misuse(self, given)
+        if misuse is not None:
             if not standalone_mode:
-                raise click_exceptions.UsageError(
-                    f"{twice} given twice; expected it once (it takes one value)"
-                )
-            fail(f"{twice} given twice; expected it once (it takes one value)", code=2)
+                raise click_exceptions.UsageError(misuse)
+            fail(misuse, code=2)
             sys.exit(2)
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, False, windows_expand_args, **extra)

@@ -135,7 +135,8 @@ def os_error_line(exc: OSError) -> tuple[str, int]:
 
 
 def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
-    """Parse ``KEY=VALUE`` pairs of a repeated flag; values become int, float or str (never evaluated)."""
+    """Parse ``KEY=VALUE`` pairs of a repeated flag; values become int, float or str (never evaluated). A key
+    given twice is refused."""
     out: dict[str, Any] = {}
     for item in items or []:
         key, sep, raw = item.partition("=")
@@ -149,6 +150,8 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
                 value = float(raw)
             except ValueError:
                 value = raw
+        if key.strip() in out:  # the last would win silently: refused, as a repeated --until is
+            raise fail(f"{flag} {show(key.strip())} given twice ({show(item)}); expected each key once")
         out[key.strip()] = value
     return out
 
@@ -226,11 +229,12 @@ def _checked_callback(flag: str, limit: Limit | None, then: Callable[..., Any] |
     return check
 
 
-def repeated_option(group: Any, args: Sequence[str]) -> str | None:
-    """The first option of the command ``args`` call in ``group`` (the built app) that takes one value and is
-    given twice (``--until A=80 --until A=90``, ``-o a --out b``), or ``None``. Click keeps the last silently, so
-    a slip in a long command line would run with a value the user did not mean; repeatable options (``--set``)
-    and on/off flags are not counted."""
+def option_misuse(group: Any, args: Sequence[str]) -> str | None:
+    """What is wrong with the options of the command ``args`` call in ``group`` (the built app), as the words of
+    an ``error:`` line, or ``None``: an option that takes one value given twice (``--until A=80 --until A=90``,
+    ``-o a --out b``: click keeps the last silently, so a slip in a long command line would run with a value the
+    user did not mean; repeatable options such as ``--set`` and on/off flags are not counted), or any option given
+    an empty value (``-o "$OUT"`` with ``OUT`` unset: click reads ``--out ''`` as the working folder)."""
     command, rest = group, list(args)
     while getattr(command, "commands", None) is not None:
         if not rest or rest[0].startswith("-") or rest[0] not in command.commands:
@@ -252,11 +256,18 @@ def repeated_option(group: Any, args: Sequence[str]) -> str | None:
         if param is None:
             i += 1
             continue
+        flag = str(max(param.opts, key=len))
         if not param.multiple:
             if param.name in seen:
-                return str(max(param.opts, key=len))
+                return f"{flag} given twice; expected it once (it takes one value)"
             seen.add(param.name)
         attached = "=" in token if long_form else len(token) > 2
+        if attached:
+            value: str | None = token.partition("=")[2] if long_form else token[2:]
+        else:
+            value = rest[i + 1] if i + 1 < len(rest) else None
+        if value is not None and not value.strip():
+            return f"{flag} {show(value)}: expected a value (an empty one is not the working folder or a default)"
         i += 1 if attached else 2
     return None
 

@@ -128,6 +128,8 @@ def dxf(
     if units is not None and units not in LENGTH_UNITS:
         raise SpecError(f"--units: expected one of {', '.join(LENGTH_UNITS)}, got {show(units)}")
     if (path / "path.csv").is_file():
+        if set_:
+            raise SpecError("--set applies to built-in linkages only, not to a trace folder", key="--set")
         folder = read_trace_folder(path)
         mech, angles = folder.mechanism, folder.point(branch, point)
     else:

@@ -171,6 +171,14 @@ def _check_output_folder(out: Path, names: Iterable[str], flag: str) -> None:
     if _exists(out) and not out.is_dir():
         raise SpecError(f"{flag} {_shown(out)}: is a file; expected a folder to write into")
     if not out.is_dir():
+        for parent in out.absolute().parents:  # the nearest existing folder on the way must be a folder
+            if _exists(parent):
+                if not parent.is_dir():
+                    raise SpecError(
+                        f"{flag} {_shown(out)}: {_shown(parent)} on the way is a file; expected a folder to "
+                        "write into"
+                    )
+                break
         return
     ours = Manifest.read(out).owned()
     for name in names:

@@ -72,6 +72,11 @@ def rod_transform(phi: float, omega: float, psi: float, v: Sequence[float]) -> A
     return T
 
 
+ROUNDOFF_PER_LENGTH = 64 * float(np.finfo(float).eps)
+"""The misfit a loop closes to in floating point, per unit of its links' total length (a few ulps for each of a
+few dozen products): the floor of the misfit accepted as closed, whatever ``closure_tol`` says."""
+
+
 def _chain_twists(constants: Sequence[Array], thetas: Array, rotation_first: bool) -> tuple[Array, Array]:
     """Joint twists at ``thetas`` and the loop product ``G`` there.
 
@@ -179,6 +184,10 @@ def assemble_chain(
     written = np.asarray(thetas, dtype=float)
     _, G0 = _chain_twists(constants, written, rotation_first)
     before = float(np.linalg.norm(log_se3(G0)))
+    # The misfit accepted: closure_tol, or the round-off of closing a loop of this size if that is larger (a
+    # Bennett linkage written 1e5 times larger closes only to 2.2e-11: its product of lengths of 1e5 rounds so).
+    size = float(sum(np.linalg.norm(np.asarray(c)[:3, 3]) for c in constants))
+    closure_tol = max(closure_tol, ROUNDOFF_PER_LENGTH * size)
     # Well-determined directions first (no slide along a near-motion), then every direction above round-off
     # (a loop at a near-singular start); the second pass is kept only when it closes the loop.
     closed, misfit = close_serial_loop(constants, written, rotation_first=rotation_first)

@@ -88,6 +88,11 @@ def trace(
     raise: ``stats.unmet`` then says why in one line (the command line exits with code 3 on it).
     """
     check_trace_arguments(until, steps, max_step, min_step, max_turn, max_steps, limits, closure_tol)
+    # Plain Python numbers from here on: a numpy int32 or float32 would make numba compile the kernels again.
+    max_step, min_step, max_steps = float(max_step), float(min_step), int(max_steps)
+    steps = None if steps is None else int(steps)
+    if max_turn is not _MAX_TURN:
+        max_turn = float(max_turn)
     m = mech.n_unknowns
     if m == 0:
         raise LinkworkError(f"{mech.name}: every joint is fixed; nothing can move")
@@ -98,11 +103,13 @@ def trace(
             f"({max_steps}, --max-steps); expected steps <= max_steps"
         )
     tol = tol if closure_tol is None else tol.with_closure(closure_tol)
-    tol = _at_scale(mech, tol)
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
     backend = select_backend(warm_up=warm_up)
     started = time.perf_counter()
-    start = _path_start(mech, backend, tol)
+    start = _path_start(
+        mech, backend, tol
+    )  # (its rank and tangent do not use the corrector's round-off levels)
+    tol = _at_scale(mech, tol)
     r_path = start.r_path
     sign = 1.0
     if target is not None:
@@ -213,18 +220,23 @@ def _length(mech: Mechanism) -> float:
 
 
 def _at_scale(mech: Mechanism, tol: Tolerances) -> Tolerances:
-    """``tol`` with the corrector's round-off level ``exact`` scaled to a linkage smaller than unity:
-    ``exact * L`` when ``L < 1``.
+    """``tol`` with the corrector's round-off levels scaled to the linkage's own length ``L``: ``exact * L`` when
+    ``L < 1``, ``roundoff * L`` when ``L > 1``.
 
     ``exact`` bounds the closure residual, whose translation part is a length: a loop a thousandth of the unit in
     size closed to ``1e-12`` is closed only to ``1e-9`` of its size (a crank-rocker of 4 mm written in metres
     was 1.2e-8 deg off the closed form, 8.4e-7 deg at 40 um). Scaled, the corrector goes on to the loop's own
     round-off; the rotation part (radians) is then held tighter than it needs, which costs at most an iteration.
-    A linkage of unit size or larger is as before. ``closure`` (play in the hinges, a length the user gives) is
-    not scaled."""
+    For a linkage larger than unity the residual's round-off floor grows as ``L``: a residual that stalls below
+    ``roundoff * exact * L`` (not ``roundoff * exact``) is accepted, or a Bennett linkage of size 1e6 could not be
+    traced (its floor is about 1e-10). ``closure`` (play in the hinges, a length the user gives) is not scaled."""
     length = _length(mech)
-    if not (0.0 < length < 1.0):
+    if not (0.0 < length and np.isfinite(length)) or length == 1.0:
         return tol
+    if (
+        length > 1.0
+    ):  # the residual's round-off floor grows with the size: a stall there is accepted as closed
+        return replace(tol, roundoff=tol.roundoff * length)
     return replace(tol, exact=tol.exact * length)
 
 

@@ -18,7 +18,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
-from linkwork.geometry.polygon import contains
+from linkwork.geometry.polygon import contains, is_simple
+from linkwork.limits import MAX_MAGNITUDE
+from linkwork.messages import show
 from linkwork.progress import Progress
 
 Array = NDArray[np.float64]
@@ -272,6 +274,7 @@ def _region(value: Any) -> Any:
         raise _error(expected, value)
     if isinstance(value, list) and len(value) == 4 and all(_number(v) is not None for v in value):
         x0, y0, x1, y1 = (float(v) for v in value)
+        _within_magnitude(value)
         if x0 < x1 and y0 < y1:
             return (x0, y0, x1, y1)
         raise _Bad("a box needs xmin < xmax and ymin < ymax")
@@ -280,12 +283,25 @@ def _region(value: Any) -> Any:
         and len(value) >= 3
         and all(isinstance(v, list) and len(v) == 2 and all(_number(c) is not None for c in v) for v in value)
     ):
-        return np.array(value, dtype=float)
+        _within_magnitude([c for v in value for c in v])
+        polygon = np.array(value, dtype=float)
+        if not is_simple(polygon):
+            raise _Bad(
+                "a polygon's edges must not cross or touch but at their shared corners (which side is inside?)"
+            )
+        return polygon
     raise _error(expected, value)
 
 
+def _within_magnitude(numbers: list[Any]) -> None:
+    """Refuse a coordinate beyond :data:`linkwork.limits.MAX_MAGNITUDE` (as every length of a problem)."""
+    for v in numbers:
+        if abs(float(v)) > MAX_MAGNITUDE:
+            raise _Bad(f"expected coordinates within +-{MAX_MAGNITUDE:g}, got {show(v)}")
+
+
 _CHECKS: dict[str, tuple[Callable[[Any], Any], str]] = {
-    "dof": (lambda v: _whole(v, 1), "a whole number >= 1"),
+    "dof": (lambda v: _whole(v, 1, 20), "a whole number of degrees of freedom, 1 to 20 (as --dof)"),
     "drive": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a joint name"),
     "root": (lambda v: v.strip() if isinstance(v, str) and v.strip() else None, "a body name"),
     "actuator": _one_of(ACTUATORS),

@@ -21,6 +21,7 @@ from typing import Any
 from linkwork.errors import SpecError
 from linkwork.io.toml_reader import show
 from linkwork.messages import show_path
+from linkwork.names import csv_cell
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.search import MEASURE_COLUMNS, SearchStudy, evaluate, ranked
 
@@ -245,7 +246,7 @@ def _write_ranked(rows: list[dict[str, Any]], cols: list[str], file: Path) -> No
         writer = csv.writer(fh)
         writer.writerow(cols)
         for row in rows:
-            writer.writerow(["" if row.get(c) is None else row.get(c) for c in cols])
+            writer.writerow(["" if row.get(c) is None else csv_cell(row.get(c)) for c in cols])
 
 
 def _write_gallery(search: SearchStudy, rows: list[dict[str, Any]], stage: Path, none_pass: bool) -> None:

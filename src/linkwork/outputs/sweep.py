@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from linkwork.io.writer import json_text
-from linkwork.names import COLUMN_PREFIX
+from linkwork.names import COLUMN_PREFIX, csv_cell
 from linkwork.outputs.staging import console, have_matplotlib, staged_output
 from linkwork.studies.study_file import Study
 
@@ -57,7 +57,7 @@ def write_table(rows: list[dict[str, Any]], cols: list[str], parquet: Path, csv_
         writer = csv.writer(fh)
         writer.writerow(cols)
         for row in rows:
-            writer.writerow(["" if _value(row.get(c)) is None else row.get(c) for c in cols])
+            writer.writerow(["" if _value(row.get(c)) is None else csv_cell(row.get(c)) for c in cols])
 
 
 def write_sweep_outputs(

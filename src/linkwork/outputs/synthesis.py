@@ -130,9 +130,15 @@ def rerun_synthesis(folder: Path, spec: Problem) -> SynthesisResult:
     result = synthesize(spec)
     same = design == result.design and math.isclose(e_max, result.joined_e_max, rel_tol=1e-9, abs_tol=1e-12)
     if not same:
+        if design != result.design:
+            differs = f"design {show(design)}, where it gives design {show(result.design)}"
+        else:
+            differs = (
+                f"design {show(design)} with joined E_max {e_max:.6g}, where it gives E_max "
+                f"{result.joined_e_max:.6g} on its {len(result.joined)} profile(s)"
+            )
         raise SpecError(
-            f"{chain_file}: the chain (design {show(design)}) is not what {spec.source} gives now "
-            f"(design {result.design}); run `linkwork synth` again"
+            f"{chain_file}: the chain is not what {spec.source} gives now ({differs}); run `linkwork synth` again"
         )
     return result
 

@@ -222,8 +222,6 @@ def prepare_study(study: Study) -> Study:
         study = replace(study, extra={"problem": problem, "segments": problem.segments})
         check_work(reader, study)  # design "each" now knows the problem's number of segments
         return study
-    from linkwork.io.spec import resolve_spec
-
     if study.grid:  # a built-in: its name, its parameters' names, and every value within its range
         from linkwork.io.spec import import_builtins
         from linkwork.linkages.registry import get
@@ -257,9 +255,27 @@ def prepare_study(study: Study) -> Study:
                         f"grid.{key}[{i}]",
                         f"expected {kind} from {low:g} to {high:g}{unit}, got {show(value)}",
                     )
-    else:
-        resolve_spec(study.target)
+    mech = _joints_of(study)
+    if mech is not None and study.until is not None and study.until[0] not in mech.joint_names:
+        raise reader.error(
+            "trace.until",
+            f"{mech.name} has no joint {show(study.until[0])}; expected one of {', '.join(mech.joint_names)}",
+        )
     return study
+
+
+def _joints_of(study: Study) -> Any:
+    """The study's linkage at its first grid point (a spec file as it is), for the names of its joints; ``None``
+    when that point does not assemble (its own trace then says why, as any point's)."""
+    from linkwork.io.spec import resolve_spec
+
+    if not study.grid:
+        return resolve_spec(study.target).mechanism  # a spec file: it must load, every point is it
+    first = {key: values[0] for key, values in study.grid.items() if values}
+    try:
+        return resolve_spec(study.target, first).mechanism
+    except LinkworkError:
+        return None
 
 
 def read_study(path: str | Path) -> Study:

@@ -30,6 +30,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from linkwork.names import csv_cell
 from linkwork.synthesis.frames import arc_length, to_local_frame
 from linkwork.synthesis.problem import Problem
 
@@ -503,9 +504,10 @@ def target_profile_rows(targets: Sequence[TargetProfile]) -> list[tuple[str, int
 
 
 def write_target_profiles_csv(targets: Sequence[TargetProfile], path: str | Path) -> None:
-    """Write ``target_profiles.csv``: header ``profile,index,x,y`` then one row per target point."""
+    """Write ``target_profiles.csv``: header ``profile,index,x,y`` then one row per target point (a profile
+    name a spreadsheet would run as a formula is written as text, :func:`~linkwork.names.csv_cell`)."""
     with open(path, "w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(("profile", "index", "x", "y"))
         for row in target_profile_rows(targets):
-            writer.writerow((row[0], row[1], repr(row[2]), repr(row[3])))
+            writer.writerow((csv_cell(row[0]), row[1], repr(row[2]), repr(row[3])))

@@ -16,6 +16,7 @@ import numpy as np
 
 from linkwork.errors import RequestNotMetError, SpecError
 from linkwork.interrupts import requested, stop_text
+from linkwork.messages import escape_line
 from linkwork.progress import Progress
 from linkwork.synthesis.compound import merge_joints
 from linkwork.synthesis.problem import Problem
@@ -200,9 +201,14 @@ def _designs_to_try(problem: Problem, pieces: list[int]) -> list[str]:
     else:
         assert problem.design is not None
         designs = [check_design(problem.design)]
-    for design in designs:
-        check_feasible(design, pieces, problem.min_pieces)
-    _check_initial(problem, designs[0], pieces)
+    try:
+        for design in designs:
+            check_feasible(design, pieces, problem.min_pieces)
+        _check_initial(problem, designs[0], pieces)
+    except SpecError as exc:  # a rule of the problem as a whole: the line names the problem's file
+        if exc.source is not None or problem.source is None:
+            raise
+        raise SpecError(exc.detail, source=escape_line(str(problem.source)), key=exc.key) from None
     return designs
 
 
