@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from linkwork.kinematics.jit import select_backend
+from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.mechanism import Array, Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank
 
@@ -71,8 +71,9 @@ def hinge_centre(axes: ArrayLike, joint_types: Sequence[str]) -> tuple[Array, fl
     return c[0], float(L[0])
 
 
-def _full_jacobians(mech: Mechanism, q: Array) -> Array:
-    """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)``."""
+def _full_jacobians(mech: Mechanism, q: Array, kernels: Backend | None = None) -> Array:
+    """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)``, by ``kernels`` (default:
+    chosen now; a trace passes the backend it chose for the whole call)."""
     joints, signs, ptr = mech.loop_arrays()
     n = mech.n_joints
     E = 6 * len(mech.loops)
@@ -81,7 +82,8 @@ def _full_jacobians(mech: Mechanism, q: Array) -> Array:
     rows = np.arange(6, dtype=np.int64)
     groups = np.arange(n, dtype=np.int64)
     twists = np.ascontiguousarray(mech.twists)
-    kernel = select_backend().closure_jacobian  # compiled, or its plain-Python twin while the cache is cold
+    # compiled, or its plain-Python twin while the cache is cold
+    kernel = (kernels if kernels is not None else select_backend()).closure_jacobian
     for k, qk in enumerate(q):
         kernel((twists, joints, signs, ptr, rows, groups), np.ascontiguousarray(qk), n, residual, out[k])
     return out
@@ -149,13 +151,14 @@ def hinge_centres_along(mech: Mechanism, angles: ArrayLike) -> tuple[Array, Arra
     return hinge_centres(_axes(jac, len(mech.loops)), mech.joint_types)
 
 
-def length_scale(mech: Mechanism, angles: ArrayLike | None = None) -> float:
+def length_scale(mech: Mechanism, angles: ArrayLike | None = None, kernels: Backend | None = None) -> float:
     """The linkage's own length ``L`` (RMS distance of the revolute hinge lines from their centre) at ``angles``.
 
-    ``angles`` default to the reference configuration (``mech.offsets``).
+    ``angles`` default to the reference configuration (``mech.offsets``); ``kernels`` the backend to evaluate with
+    (default: chosen now).
     """
     values = mech.offsets if angles is None else np.asarray(angles, dtype=float)
-    jac = _full_jacobians(mech, np.atleast_2d(values - mech.offsets))
+    jac = _full_jacobians(mech, np.atleast_2d(values - mech.offsets), kernels)
     return float(hinge_centres(_axes(jac, len(mech.loops)), mech.joint_types)[1][0])
 
 

@@ -109,7 +109,7 @@ def trace(
     start = _path_start(
         mech, backend, tol
     )  # (its rank and tangent do not use the corrector's round-off levels)
-    tol = _at_scale(mech, tol)
+    tol = _at_scale(mech, tol, backend)
     r_path = start.r_path
     sign = 1.0
     if target is not None:
@@ -121,7 +121,7 @@ def trace(
     settings = record(
         MarchSettings, drive=d_unknown, target=target, min_step=min_step, max_step=max_step, cos_turn=cos_turn,
         r_path=r_path, n_sigma=start.n_sigma, periodic=start.periodic, lo=lo, hi=hi, tol=tol, drive_joint=d_joint,
-        weight=_step_weights(mech),
+        weight=_step_weights(mech, backend),
     )  # fmt: skip
     paper = steps is not None
     basis0 = start.basis  # read-only (the start's, shared): the marches get copies
@@ -207,19 +207,19 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
     return mech.derived(key, build)
 
 
-def _length(mech: Mechanism) -> float:
+def _length(mech: Mechanism, backend: Backend) -> float:
     """The linkage's own length ``L`` (:func:`~linkwork.kinematics.normalization.length_scale`, the RMS distance
-    of its hinge lines from their centre), once per mechanism."""
+    of its hinge lines from their centre), once per mechanism, evaluated by the trace's ``backend``."""
 
     def build() -> float:
         from linkwork.kinematics.normalization import length_scale
 
-        return length_scale(mech)
+        return length_scale(mech, kernels=backend)
 
     return mech.derived("length scale", build)
 
 
-def _at_scale(mech: Mechanism, tol: Tolerances) -> Tolerances:
+def _at_scale(mech: Mechanism, tol: Tolerances, backend: Backend) -> Tolerances:
     """``tol`` with the corrector's round-off levels scaled to the linkage's own length ``L``: ``exact * L`` when
     ``L < 1``, ``roundoff * L`` when ``L > 1``.
 
@@ -230,7 +230,7 @@ def _at_scale(mech: Mechanism, tol: Tolerances) -> Tolerances:
     For a linkage larger than unity the residual's round-off floor grows as ``L``: a residual that stalls below
     ``roundoff * exact * L`` (not ``roundoff * exact``) is accepted, or a Bennett linkage of size 1e6 could not be
     traced (its floor is about 1e-10). ``closure`` (play in the hinges, a length the user gives) is not scaled."""
-    length = _length(mech)
+    length = _length(mech, backend)
     if not (0.0 < length and np.isfinite(length)) or length == 1.0:
         return tol
     if (
@@ -240,7 +240,7 @@ def _at_scale(mech: Mechanism, tol: Tolerances) -> Tolerances:
     return replace(tol, exact=tol.exact * length)
 
 
-def _step_weights(mech: Mechanism) -> Array:
+def _step_weights(mech: Mechanism, backend: Backend) -> Array:
     """Each unknown's weight in the step control's metric, once per mechanism: 1 for an angle, ``1 / L`` for a
     length (a prismatic unknown), ``L`` the linkage's own length
     (:func:`~linkwork.kinematics.normalization.length_scale`, the RMS distance of its hinge lines from their
@@ -251,7 +251,7 @@ def _step_weights(mech: Mechanism) -> Array:
         weight = np.ones(mech.n_unknowns)
         prismatic = [k for k, j in enumerate(mech.first_joints) if mech.joint_types[j] != "R"]
         if prismatic:
-            weight[prismatic] = 1.0 / _length(mech)
+            weight[prismatic] = 1.0 / _length(mech, backend)
         weight.flags.writeable = False
         return weight
 
