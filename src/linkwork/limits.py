@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -32,6 +33,23 @@ MAX_SEED = 2**63 - 1
 
 MAX_MAGNITUDE = 1e12
 """The largest absolute value of a length or a tolerance given by a user."""
+
+
+PLAIN_NUMBER = re.compile(
+    r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:nan|inf|infinity)", re.I
+)
+"""A number as a person types it in a flag or a CSV or Selig file writes it: ASCII digits, an optional sign,
+decimal point and exponent, or nan / inf (refused later as not finite, by whoever needs it finite). Python's
+``float`` would also take ``1_000`` (a typo for 1.000 in some locales), surrounding spaces, Arabic-Indic and
+full-width digits, which no spreadsheet or other reader takes for the same number."""
+
+PLAIN_INTEGER = re.compile(r"[+-]?[0-9]+")
+"""A whole number as a person types it: ASCII digits with an optional sign."""
+
+
+def plain_number(text: str) -> float | None:
+    """The number ``text`` is when it is written as :data:`PLAIN_NUMBER` says, else ``None``."""
+    return float(text) if PLAIN_NUMBER.fullmatch(text) else None
 
 
 def machine_cores() -> int:

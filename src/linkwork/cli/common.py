@@ -22,7 +22,7 @@ from rich.text import Text
 from linkwork.errors import LinkworkError, RequestNotMetError
 from linkwork.interrupts import EXIT_SIGINT, Interrupted, Terminated, exit_code, stop_text
 from linkwork.io.toml_reader import escape_line, show
-from linkwork.limits import Limit
+from linkwork.limits import PLAIN_INTEGER, Limit, plain_number
 from linkwork.messages import show_path
 from linkwork.progress import Progress
 
@@ -142,14 +142,11 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
         key, sep, raw = item.partition("=")
         if not sep or not key.strip():
             raise fail(f"{flag} {show(item)}: expected KEY=VALUE")
-        value: Any
-        try:
+        value: Any = raw  # text, unless it is a number as a person types one (limits.PLAIN_NUMBER)
+        if PLAIN_INTEGER.fullmatch(raw):
             value = int(raw)
-        except ValueError:
-            try:
-                value = float(raw)
-            except ValueError:
-                value = raw
+        elif (number := plain_number(raw)) is not None:
+            value = number
         if key.strip() in out:  # the last would win silently: refused, as a repeated --until is
             raise fail(f"{flag} {show(key.strip())} given twice ({show(item)}); expected each key once")
         out[key.strip()] = value
@@ -328,10 +325,8 @@ def parse_joint_value(text: str | None, flag: str, example: str) -> tuple[str, f
     if text is None:
         return None
     name, sep, raw = text.partition("=")
-    try:
-        value = float(raw)
-    except ValueError:
-        value = float("nan")
+    number = plain_number(raw)  # ASCII digits: Python's float would take 1_0 and other scripts' digits
+    value = float("nan") if number is None else number
     if not sep or not name.strip() or not math.isfinite(value):
         raise fail(
             f"{flag} {show(text)}: expected JOINT=VALUE with VALUE in degrees (a length for a prismatic joint), "

@@ -25,6 +25,7 @@ from linkwork.cli.common import (
 from linkwork.cli.out_folder import out_help, run_folder, spec_label
 from linkwork.errors import RequestNotMetError
 from linkwork.interrupts import exit_code, held_signals
+from linkwork.limits import plain_number
 from linkwork.messages import show
 from linkwork.outputs.staging import check_output_folder, console
 
@@ -49,10 +50,12 @@ def _parse_limits(items: list[str] | None) -> dict[str, tuple[float, float]]:
     for item in items or []:
         name, sep, span = item.partition("=")
         lo_text, colon, hi_text = span.partition(":")
-        try:
-            lo, hi = float(lo_text), float(hi_text)
-        except ValueError:
-            lo = hi = float("nan")
+        lo_number, hi_number = (
+            plain_number(lo_text),
+            plain_number(hi_text),
+        )  # ASCII digits (limits.PLAIN_NUMBER)
+        lo = float("nan") if lo_number is None else lo_number
+        hi = float("nan") if hi_number is None else hi_number
         if (
             not sep
             or not colon

@@ -48,6 +48,7 @@ from linkwork.io.outlines import final_chain, write_outline_dxf, write_outline_s
 from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
 from linkwork.io.toml_reader import check_input_file, escape_line
 from linkwork.io.writer import require_finite
+from linkwork.limits import plain_number
 
 __all__ = [
     "COINCIDENT",
@@ -103,7 +104,7 @@ def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     width: tuple[int, int] | None = None  # the cells of every row, and the line that set it
     for number, line in lines:
         cells = [cell.strip() for cell in line.split(",")]
-        if width is None and _csv_number(cells[0]) is None:
+        if width is None and plain_number(cells[0]) is None:
             names = [cell.lower() for cell in cells]
             if "x" not in names or "y" not in names:
                 raise SpecError(
@@ -130,7 +131,9 @@ def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
                 source=source,
             )
         x, y = (
-            (_csv_number(cells[x_col]), _csv_number(cells[y_col])) if len(cells) == width[0] else (None, None)
+            (plain_number(cells[x_col]), plain_number(cells[y_col]))
+            if len(cells) == width[0]
+            else (None, None)
         )
         if x is None or y is None:
             raise SpecError(
@@ -166,7 +169,7 @@ def read_profile_dat(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
     first = (0, "")
     for index, (number, line) in enumerate(_read_lines(path)):
         cells = line.replace(",", " ").split()
-        values = [_csv_number(cell) for cell in cells]
+        values = [plain_number(cell) for cell in cells]
         if index == 0 and (len(values) != 2 or None in values):
             continue  # the airfoil's name
         if len(values) != 2 or values[0] is None or values[1] is None:
@@ -519,14 +522,6 @@ def _read_lines(path: Path) -> list[tuple[int, str]]:
 
 _LINE_END = re.compile(r"\r\n|\r|\n")
 
-#: A number as a CSV or Selig file writes it: ASCII digits, an optional sign, decimal point and exponent, or
-#: nan / inf (refused later as not finite, with the point named). Python's ``float`` would also take
-#: ``1_000`` (a typo for 1.000 in some locales), Arabic-Indic and full-width digits, which no spreadsheet or
-#: other reader of the file takes for the same number.
-_NUMBER = re.compile(
-    r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:nan|inf|infinity)", re.I
-)
-
 
 def _quoted(line: str) -> str:
     """A line of a profile file as a message quotes it: Python's ``repr`` (control characters escaped), cut after
@@ -536,8 +531,3 @@ def _quoted(line: str) -> str:
 
 def _cells(count: int) -> str:
     return f"{count} cell" if count == 1 else f"{count} cells"
-
-
-def _csv_number(text: str) -> float | None:
-    """The number ``text`` writes (see :data:`_NUMBER`), or ``None``."""
-    return float(text) if _NUMBER.fullmatch(text) else None
