@@ -17,6 +17,10 @@ one place they are applied. One function per format:
 - :func:`mathtext` -- matplotlib text: every ``$`` escaped, so mathtext never starts inside a name.
 - :func:`html_text` -- HTML text and attribute values.
 
+Names are kept and compared in one form, :func:`canonical` (Unicode NFC): "é" typed as one character (U+00E9)
+and as ``e`` with a combining accent (U+0301) look the same on every screen, so they are one name, in a file's
+duplicate checks, in the bodies a joint joins and in a flag naming a joint.
+
 Every function that may change a name returns a :class:`NameMap`; its :attr:`NameMap.changes` are the names
 written differently, and :func:`describe` turns them into one line for the command's summary.
 """
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 import html
 import re
+import unicodedata
 from collections.abc import Collection, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TypeVar
@@ -36,6 +41,7 @@ __all__ = [
     "MJCF_RESERVED",
     "NAME_RULE",
     "NameMap",
+    "canonical",
     "csv_cell",
     "csv_columns",
     "describe",
@@ -70,6 +76,13 @@ def csv_cell(value: T) -> T | str:
     if isinstance(value, str) and value[:1] in FORMULA_START:
         return "'" + value
     return value
+
+
+def canonical(name: str) -> str:
+    """``name`` in the one form linkwork keeps and compares names in: Unicode NFC (canonical composition), so
+    names that differ only in how an accented letter was typed are the same name. NFC, not NFKC: "ﬁ" and "fi",
+    or "x²" and "x2", are different text to a reader, not different spellings of one."""
+    return unicodedata.normalize("NFC", name)
 
 
 MJCF_RESERVED = frozenset({"world"})

@@ -337,7 +337,7 @@ def parse_joint_value(text: str | None, flag: str, example: str) -> tuple[str, f
 
 def joint_named(mech: Mechanism, name: str, flag: str) -> int:
     """The index of the joint a flag names, or one line naming the flag and the joints there are."""
-    if name not in mech.joint_names:
+    if not mech.has_joint(name):
         raise fail(f"{flag} {show(name)}: unknown joint; expected one of {', '.join(mech.joint_names)}")
     return mech.index(name)
 

@@ -160,7 +160,7 @@ def _mechanism(spec: str, set_: list[str] | None) -> tuple[Mechanism, str | None
         report = path / "report.json"
         drive = read_report(report).get("drive") if report.is_file() else None
         mech = read_mechanism(path)
-        if drive is not None and drive not in mech.joint_names:
+        if drive is not None and not mech.has_joint(drive):
             raise SpecError(
                 f"expected one of the joints {', '.join(mech.joint_names)} of mechanism.toml, got {drive!r}",
                 source=str(report),

@@ -27,7 +27,9 @@ Example
     rank_by = "error"                   # error | joints (fewest joints with E_max <= e_max_tolerance)
     e_max_tolerance = 0.01              # largest acceptable joined E_max, profile units (rank_by = "joints")
     initial_segment_matrix = [[15, 13, 9, 39], [15, 9, 9, 57], [15, 39, 9, 36]]  # Eq. 11: a row per profile
-    units = "mm"                        # optional: length unit of the profile files, carried into DXF/SVG
+    units = "mm"                        # optional: the problem's length unit, carried into DXF/SVG; a DXF
+                                        # profile drawn in another ($INSUNITS) is converted into it; without
+                                        # it, DXF profiles declaring a unit must agree, and set it
 
 References
 ----------
@@ -43,10 +45,12 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import SpecError
-from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, load_profile
+from linkwork.io.profiles import COINCIDENT, LENGTH_UNITS, check_profile, load_profile, profile_unit
 from linkwork.io.toml_reader import TomlReader, escape_line, input_file_problem, key_path, read_toml, show
 from linkwork.mechanization.options import OPTION_KEYS, options_from_values
+from linkwork.names import canonical
 from linkwork.synthesis.problem import KINDS, Problem, ProfileKind
+from linkwork.units import METRES
 
 __all__ = ["KEYS", "KINDS", "REQUIRED", "load_problem"]
 
@@ -207,13 +211,13 @@ def names_from_files(reader: TomlReader, files: list[str]) -> list[str]:
     """The profiles' names of a problem without a ``names`` key: each file's stem (``a/wing.csv`` is ``wing``).
 
     Two files with the same stem (``a/wing.csv`` and ``b/wing.csv``, or ``wing.csv`` and ``wing.dat``) would give
-    two profiles one name: that is refused here, at ``profiles``, naming both files (names are compared exactly,
-    as everywhere in linkwork; where a format ignores case, the name policy keeps them apart, e.g. the DXF
+    two profiles one name: that is refused here, at ``profiles``, naming both files (names are compared exactly
+    but for Unicode normalisation, :func:`linkwork.names.canonical`, as everywhere in linkwork; where a format ignores case, the name policy keeps them apart, e.g. the DXF
     layers of :func:`linkwork.names.dxf_layers`)."""
     names = [Path(f).stem for f in files]
     first: dict[str, int] = {}
     for index, name in enumerate(names):
-        earlier = first.setdefault(name, index)
+        earlier = first.setdefault(canonical(name), index)  # "é" typed two ways is one name
         if earlier != index:
             raise reader.error(
                 "profiles",
@@ -243,28 +247,65 @@ def _named_after_files(reader: TomlReader, exc: SpecError, files: list[str]) -> 
     )
 
 
-def _load_profiles(reader: TomlReader, folder: Path, files: list[str], kind: ProfileKind) -> list[Any]:
-    """Each profile file (relative to ``folder``) as a polyline; a closed problem's must return to its start."""
-    profiles = []
+def _drawing_units(
+    reader: TomlReader, folder: Path, files: list[str], units: str | None
+) -> tuple[list[float], str | None]:
+    """The factor that brings each profile file's coordinates into the problem's units, and those units.
+
+    A DXF drawing declares its unit (``$INSUNITS``; :func:`~linkwork.io.profiles.profile_unit`): with a
+    ``units`` key it is converted into them (a drawing in inches in a problem in mm is scaled by 25.4); without
+    one, every drawing that declares a unit must declare the same, the coordinates are taken as drawn and the
+    problem is in that unit (when it is one of :data:`~linkwork.units.LENGTH_UNITS`, the outputs say so). A
+    file that declares none (CSV, Selig, SVG, a unitless DXF) is in the problem's units as written."""
+    declared = [profile_unit(folder / name) for name in files]
+    if units is not None:
+        return [1.0 if unit is None else METRES[unit] / METRES[units] for unit in declared], units
+    first = next((i for i, unit in enumerate(declared) if unit is not None), None)
+    if first is None:
+        return [1.0] * len(files), None
+    for index, unit in enumerate(declared):
+        if unit is not None and unit != declared[first]:
+            raise reader.error(
+                key_path("profiles", index),
+                f"{show(files[index])} is drawn in {unit} ($INSUNITS) and {show(files[first])} in "
+                f"{declared[first]}; expected drawings in one unit, or a units key to convert them into",
+            )
+    unit = declared[first]
+    return [1.0] * len(files), unit if unit in LENGTH_UNITS else None
+
+
+def _load_profiles(
+    reader: TomlReader, folder: Path, files: list[str], kind: ProfileKind, units: str | None = None
+) -> tuple[list[Any], str | None]:
+    """Each profile file (relative to ``folder``) as a polyline in the problem's units, and those units (see
+    :func:`_drawing_units`); a closed problem's must return to its start."""
     for index, name in enumerate(files):
         file = folder / name
-        key = key_path("profiles", index)
         problem = input_file_problem(file)
         if problem is not None:
             what = "not found" if problem == "file not found" else problem
-            raise reader.error(key, f'file "{escape_line(str(file))}" {what}; expected a profile file')
+            raise reader.error(
+                key_path("profiles", index),
+                f'file "{escape_line(str(file))}" {what}; expected a profile file',
+            )
+    factors, units = _drawing_units(reader, folder, files, units)
+    profiles = []
+    for index, (name, factor) in enumerate(zip(files, factors, strict=True)):
+        file = folder / name
         points = load_profile(file)
+        if factor != 1.0:
+            points = check_profile(points * factor, source=file)
         if kind == "closed":
             gap = float(np.hypot(*(points[-1] - points[0])))
             size = float(np.hypot(*np.ptp(points, axis=0)))
             if gap > COINCIDENT * size:
                 raise reader.error(
-                    key,
+                    key_path("profiles", index),
                     f'{show(name)} does not return to its first point (gap {gap:.6g}); type "closed" expects '
                     "the curve to end where it starts (repeat the first point at the end)",
                 )
         profiles.append(points)
-    return profiles
+    return profiles, units
 
 
 def load_problem(path: str | Path) -> Problem:
@@ -304,5 +345,7 @@ def load_problem(path: str | Path) -> Problem:
         if "names" in table or not (exc.key or "").startswith("names"):
             raise
         raise _named_after_files(reader, exc, files) from None
-    profiles = _load_profiles(reader, path.parent, files, settings["kind"])
+    profiles, settings["units"] = _load_profiles(
+        reader, path.parent, files, settings["kind"], settings["units"]
+    )
     return Problem(profiles=tuple(profiles), names=tuple(names), source=path, **settings)

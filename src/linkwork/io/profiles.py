@@ -49,6 +49,7 @@ from linkwork.io.toml_reader import MAX_FILE_BYTES as MAX_PROFILE_BYTES
 from linkwork.io.toml_reader import check_input_file, escape_line
 from linkwork.io.writer import require_finite
 from linkwork.limits import plain_number
+from linkwork.units import DXF_INSUNITS
 
 __all__ = [
     "COINCIDENT",
@@ -61,11 +62,13 @@ __all__ = [
     "MAX_PROFILE_BYTES",
     "ProfileFormat",
     "check_profile",
+    "dxf_unit",
     "final_chain",
     "find_self_crossing",
     "is_closed",
     "load_profile",
     "new_dxf",
+    "profile_unit",
     "read_profile_csv",
     "read_profile_dat",
     "read_profile_dxf",
@@ -348,6 +351,54 @@ def _ocs_to_xy(
     return [
         (0.0 - x, y, -bulge) for x, y, bulge in vertices
     ]  # the arbitrary axis x for -z is -x (0 - x: no -0.0)
+
+
+_BINARY_DXF = b"AutoCAD Binary DXF"
+
+
+def dxf_unit(path: str | Path) -> str | None:
+    """The length unit a DXF drawing declares in its header (``$INSUNITS``, a name of
+    :data:`linkwork.units.DXF_INSUNITS`), or ``None`` for a unitless drawing (code 0, no such variable, or a
+    code that is no length unit). The header of a text DXF is scanned as group-code / value line pairs up to the
+    end of its HEADER section (the profile itself is read by :func:`read_profile_dxf`); a binary DXF is read
+    with ezdxf."""
+    path = Path(path)
+    with path.open("rb") as file:
+        start = file.read(len(_BINARY_DXF))
+    code: object = 0
+    if start == _BINARY_DXF:
+        import ezdxf
+
+        code = ezdxf.readfile(str(path)).header.get("$INSUNITS", 0)
+    else:
+        with path.open("r", encoding="utf-8", errors="replace", newline=None) as file:
+            lines = (line.strip() for line in file)
+            for group, value in zip(lines, lines, strict=False):
+                if group == "0" and value in ("ENDSEC", "EOF"):
+                    break  # the header, where $INSUNITS is, has ended
+                if group == "9" and value == "$INSUNITS":
+                    pair = (next(lines, ""), next(lines, ""))
+                    code = pair[1] if pair[0] == "70" else 0
+                    break
+    try:
+        number = int(str(code).strip())
+    except ValueError:
+        return None
+    entry = DXF_INSUNITS.get(number)
+    return entry[0] if entry else None
+
+
+def profile_unit(path: str | Path) -> str | None:
+    """The length unit a profile file declares (a DXF drawing's ``$INSUNITS``, see :func:`dxf_unit`), or
+    ``None``: CSV, Selig and SVG profiles, and unitless drawings, are in the problem's units as written."""
+    path = Path(path)
+    if path.suffix.lower() != ".dxf":
+        return None
+    _check_readable(path)
+    try:
+        return dxf_unit(path)
+    except Exception:  # an unreadable header is said by load_profile, which reads the whole drawing
+        return None
 
 
 def write_profile_dxf(path: str | Path, points: ArrayLike) -> None:

@@ -19,7 +19,7 @@ from linkwork.geometry.names import default_joint_name
 from linkwork.io.toml_reader import MAX_NAME_CHARS, TomlReader, closest, key_path, show
 from linkwork.kinematics.chains import Assembly, from_dh, from_rods
 from linkwork.kinematics.mechanism import Array, Mechanism
-from linkwork.names import name_problem
+from linkwork.names import canonical, name_problem
 
 CONVENTIONS = ("dh", "hinge-lines", "rods")
 """The values of ``loop.convention``."""
@@ -108,6 +108,7 @@ class SpecReader(TomlReader):
                 raise self.error(
                     key, f"expected a joint name without spaces, quotes, '=' or ',', got {_show(name)}"
                 )
+            name = canonical(name)  # "é" typed two ways is one name (names.canonical)
             if name in seen:
                 raise self.error(key, f'duplicate joint name "{name}" (also {_key(path, seen[name])})')
             seen[name] = i
@@ -123,6 +124,7 @@ class SpecReader(TomlReader):
         def joint(value: Any, key: str) -> str:
             if not isinstance(value, str):
                 raise self.error(key, f"expected a joint name, got {_show(value)}")
+            value = canonical(value)
             if value not in names:
                 close = _closest(value, names)
                 hint = f'did you mean "{close}"? ' if close else ""
@@ -267,6 +269,7 @@ def read_mechanism_table(
                     _key(_key(here, "bodies"), b),
                     f"expected {name_problem(body, tab=True)}, got {_show(body)}",
                 )
+        bodies = [canonical(b) for b in bodies]  # one body however its name's accents were typed
         if bodies[0] == bodies[1]:
             raise reader.error(
                 _key(here, "bodies"),
@@ -312,11 +315,12 @@ def read_points_table(reader: SpecReader, value: Any, mech: Mechanism) -> list[d
     for i, entry in enumerate(value):
         here = _key("points", i)
         entry = reader.table(entry, here, POINT_KEYS)
-        name = reader.string(entry, "name", here, default=f"P{i + 1}", limit=MAX_NAME_CHARS)
+        name = canonical(reader.string(entry, "name", here, default=f"P{i + 1}", limit=MAX_NAME_CHARS))
         if name in taken or not _JOINT_NAME.fullmatch(name):
             raise reader.error(_key(here, "name"), f"expected a new name without spaces, got {_show(name)}")
         taken.add(name)
         body = reader.require(entry, "body", here, f"one of the bodies {', '.join(mech.bodies)}")
+        body = canonical(body) if isinstance(body, str) else body
         if body not in mech.bodies:
             raise reader.error(
                 _key(here, "body"), f"expected one of {', '.join(mech.bodies)}, got {_show(body)}"

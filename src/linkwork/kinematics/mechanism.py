@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
 from linkwork.geometry import line_twist
+from linkwork.names import canonical
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -98,6 +99,12 @@ class Mechanism:
     def __post_init__(self) -> None:
         """Check the shapes and keep private, read-only copies of the arrays (a frozen value in full)."""
         n = len(self.joint_names)
+        # names in one Unicode form (names.canonical): "é" typed two ways is one joint or body
+        object.__setattr__(self, "joint_names", tuple(canonical(str(j)) for j in self.joint_names))
+        object.__setattr__(self, "bodies", tuple(canonical(str(b)) for b in self.bodies))
+        object.__setattr__(
+            self, "joint_bodies", tuple((canonical(str(a)), canonical(str(b))) for a, b in self.joint_bodies)
+        )
         twists = _frozen(self.twists, float)
         if twists.shape != (n, 6):
             raise ValueError(f"Expected twists of shape ({n}, 6), got {twists.shape}")
@@ -212,9 +219,14 @@ class Mechanism:
                 raise SpecError(f"joint index {joint} out of range 0..{self.n_joints - 1}")
             return int(joint)
         try:
-            return self.joint_names.index(joint)
+            return self.joint_names.index(canonical(joint) if isinstance(joint, str) else joint)
         except ValueError:
             raise SpecError(f"unknown joint {joint!r}; joints are {', '.join(self.joint_names)}") from None
+
+    def has_joint(self, name: str) -> bool:
+        """Whether a joint is called ``name`` (compared as :func:`linkwork.names.canonical` names, as
+        :meth:`index` finds it)."""
+        return isinstance(name, str) and canonical(name) in self.joint_names
 
     def group_members(self) -> list[list[int]]:
         """Joint indices sharing each unknown, in unknown order."""

@@ -192,7 +192,7 @@ def load_search(path: Any) -> SearchStudy:
             first = resolve_spec(search.study.target, search.study.points()[0]).mechanism
         except LinkworkError:
             return search  # that candidate's own row will say why it cannot be built
-        if criteria.deployed_at[0] not in first.joint_names:
+        if not first.has_joint(criteria.deployed_at[0]):
             raise SpecError(
                 f"no joint {criteria.deployed_at[0]!r}; joints are {', '.join(first.joint_names)}",
                 source=source,

@@ -256,7 +256,7 @@ def prepare_study(study: Study) -> Study:
                         f"expected {kind} from {low:g} to {high:g}{unit}, got {show(value)}",
                     )
     mech = _joints_of(study)
-    if mech is not None and study.until is not None and study.until[0] not in mech.joint_names:
+    if mech is not None and study.until is not None and not mech.has_joint(study.until[0]):
         raise reader.error(
             "trace.until",
             f"{mech.name} has no joint {show(study.until[0])}; expected one of {', '.join(mech.joint_names)}",

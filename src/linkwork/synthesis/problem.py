@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from linkwork.errors import SpecError
 from linkwork.limits import MAX_SEED
 from linkwork.messages import escape_line, show
-from linkwork.names import MAX_NAME_CHARS, name_problem
+from linkwork.names import MAX_NAME_CHARS, canonical, name_problem
 
 ProfileKind = Literal["open", "closed", "fixed-end"]
 RankBy = Literal["error", "joints"]
@@ -288,7 +288,7 @@ def _name_rules(p: Problem) -> list[tuple[str, str]]:
             return [(f"names[{index}]", f"expected {name_problem(name)}, got {show(name)}")]
     first: dict[str, int] = {}
     for index, name in enumerate(p.names):
-        earlier = first.setdefault(name, index)
+        earlier = first.setdefault(canonical(name), index)  # "é" typed two ways is one name
         if earlier != index:
             return [
                 (
