@@ -21,12 +21,12 @@ import select
 import shutil
 import signal
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
 
 import pytest
+from processes import linkwork_command, process_env
 from typer.testing import CliRunner
 
 from linkwork.cli import app
@@ -45,20 +45,11 @@ class Running:
     def __init__(self, args: list[str]) -> None:
         import pty
 
-        script = Path(sys.executable).with_name("linkwork")
-        if not script.exists():
-            pytest.skip("the linkwork script is not installed")
-        env = {
-            **os.environ,
-            "PYTHONPATH": os.pathsep.join(sys.path),
-            "NO_COLOR": "1",
-            "TERM": "xterm",
-            "COLUMNS": "160",
-            "PYTHONUNBUFFERED": "1",
-        }
+        command = linkwork_command(args)
+        env = process_env(TERM="xterm", COLUMNS="160")
         master, slave = pty.openpty()
         self.proc = subprocess.Popen(
-            [str(script), *args], env=env, stdin=subprocess.DEVNULL, stdout=slave, stderr=subprocess.PIPE
+            command, env=env, stdin=subprocess.DEVNULL, stdout=slave, stderr=subprocess.PIPE
         )
         os.close(slave)
         self.master = master

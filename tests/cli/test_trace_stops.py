@@ -12,17 +12,16 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import re
 import signal
 import subprocess
-import sys
 import time
 import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from processes import linkwork_command, process_env
 from typer.testing import CliRunner, Result
 
 import linkwork as lw
@@ -88,18 +87,10 @@ LONG_TRACES = {
 
 
 def start_linkwork(args: list[str]) -> subprocess.Popen[str]:
-    script = Path(sys.executable).with_name("linkwork")
-    if not script.exists():
-        pytest.skip("the linkwork script is not installed")
-    env = {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join(sys.path),
-        "NO_COLOR": "1",
-        "PYTHONUNBUFFERED": "1",
-        "LINKWORK_JIT": "python",  # slow and steady: the trace is surely still running when the signal comes
-    }
+    # the plain-Python kernels: slow and steady, the trace is surely still running when the signal comes
+    env = process_env(LINKWORK_JIT="python")
     return subprocess.Popen(
-        [str(script), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        linkwork_command(args), env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
 
 

@@ -425,50 +425,6 @@ def test_a_profile_saved_as_dxf_declares_no_unit(tmp_path: Path) -> None:
 # --------------------------------------------------------------------------------- self-crossing, bounded
 
 
-def _crosses_brute_force(points: np.ndarray) -> bool:
-    """Whether two non-adjacent pieces of an open polyline in general position cross (every pair tested, the
-    orientation test written out: the reference the sweep is checked against)."""
-
-    def orient(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> float:
-        return float((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
-
-    n = len(points) - 1
-    for i in range(n):
-        for j in range(i + 2, n):
-            a, b, c, d = points[i], points[i + 1], points[j], points[j + 1]
-            if orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0:
-                return True
-    return False
-
-
-@FUZZ
-@given(
-    coordinates=st.lists(
-        st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)), min_size=3, max_size=12, unique=True
-    ),
-    transpose=st.booleans(),
-)
-def test_the_self_crossing_check_agrees_with_every_pair_tested(
-    coordinates: list[tuple[float, float]], transpose: bool
-) -> None:
-    """The sweep now runs along x or y, whichever has fewer candidate pairs; either way it finds a crossing
-    exactly when testing every pair does (random points: general position, open curves)."""
-    from linkwork.io.curves import find_self_crossing
-
-    points = np.array(coordinates)[:, ::-1] if transpose else np.array(coordinates)
-    if np.min(np.hypot(*np.diff(points, axis=0).T)) < 1e-6:
-        return  # repeated points are refused before the crossing check
-    closeness = np.abs(np.diff(points, axis=0)).min()
-    if closeness < 1e-9:
-        return  # nearly axis-parallel pieces: within the check's tolerance, not general position
-    u, v = np.diff(points, axis=0)[:-1], np.diff(points, axis=0)[1:]
-    sine = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]) / (np.hypot(*u.T) * np.hypot(*v.T))
-    if np.any((sine < 1e-9) & (np.sum(u * v, axis=1) < 0.0)):
-        return  # a piece doubling back along the last, within the check's tolerance: it overlaps, which the
-        # every-pair reference (non-adjacent pieces only) does not test; (0, 1e-12) -> (1, 1) -> (0, 0) is one
-    assert (find_self_crossing(points) is not None) == _crosses_brute_force(points)
-
-
 @pytest.mark.parametrize("along", ["x", "y"])
 def test_a_serpentine_profile_of_200000_points_is_checked_in_seconds(tmp_path: Path, along: str) -> None:
     """A zigzag across the whole width (hatching, a serpentine) overlapped every other piece along x: the

@@ -304,6 +304,32 @@ def test_crossing_search_agrees_with_brute_force_on_random_walks(seed: int, coun
     assert (found is not None) == brute_force_crossing(walk)
 
 
+@settings(max_examples=40, derandomize=True, deadline=None)
+@given(
+    coordinates=st.lists(
+        st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)), min_size=3, max_size=12, unique=True
+    ),
+    transpose=st.booleans(),
+)
+def test_the_self_crossing_check_agrees_with_every_pair_tested(
+    coordinates: list[tuple[float, float]], transpose: bool
+) -> None:
+    """The sweep now runs along x or y, whichever has fewer candidate pairs; either way it finds a crossing
+    exactly when testing every pair does (random points: general position, open curves)."""
+    points = np.array(coordinates)[:, ::-1] if transpose else np.array(coordinates)
+    if np.min(np.hypot(*np.diff(points, axis=0).T)) < 1e-6:
+        return  # repeated points are refused before the crossing check
+    closeness = np.abs(np.diff(points, axis=0)).min()
+    if closeness < 1e-9:
+        return  # nearly axis-parallel pieces: within the check's tolerance, not general position
+    u, v = np.diff(points, axis=0)[:-1], np.diff(points, axis=0)[1:]
+    sine = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]) / (np.hypot(*u.T) * np.hypot(*v.T))
+    if np.any((sine < 1e-9) & (np.sum(u * v, axis=1) < 0.0)):
+        return  # a piece doubling back along the last, within the check's tolerance: it overlaps, which the
+        # every-pair reference (non-adjacent pieces only) does not test; (0, 1e-12) -> (1, 1) -> (0, 0) is one
+    assert (find_self_crossing(points) is not None) == brute_force_crossing(points)
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(min_value=0, max_value=2**32 - 1), st.integers(min_value=3, max_value=60))
 def test_star_shaped_polygons_are_simple(seed: int, count: int) -> None:
