@@ -12,6 +12,7 @@ reach, turned its input through whole turns and reported no fold.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -60,3 +61,21 @@ def test_near_change_point_four_bar_keeps_its_assembly_mode(tmp_path: Path, eps:
         assert len(flips) == 2
         for k in flips:  # at a fold: the rows either side are within a small step of the extreme
             assert min(abs(float(wrap_deg(rows[k, 0] - s * top))) for s in (1, -1)) < 0.05
+
+
+def test_a_target_just_beyond_an_extreme_is_told_apart_from_it(tmp_path: Path) -> None:
+    """A triple rocker's input (law of cosines: extreme 93.859364476671 deg) asked to reach 1e-6 deg beyond its
+    extreme: unmet, and the line shows the target and the range's ends with enough decimals to tell them apart.
+
+    Got: "A never reaches 93.86 deg on this path: its range is [-93.86, 93.86] deg"."""
+    case = FourBar("triple-rocker", 3.0, 2.6, 1.9, 2.2, 40.0)
+    spec = tmp_path / "tr.toml"
+    spec.write_text(case.mech.toml())
+    top = max(case.fold_refs("A"))
+    trace = lw.trace(lw.load(str(spec)), until=("A", np.radians(top + 1e-6)))
+    line = trace.stats.unmet
+    assert line is not None
+    numbers = [float(x) for x in re.findall(r"-?\d+\.\d+", line)]
+    target, lo, hi = numbers[0], numbers[-2], numbers[-1]
+    assert target != hi and target != lo
+    assert target == pytest.approx(top + 1e-6, abs=1e-5) and hi == pytest.approx(top, abs=1e-5)

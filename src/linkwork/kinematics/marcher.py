@@ -458,7 +458,9 @@ class BranchMarcher:
         (a step of 8^-3 = 1/512 of the first at the last). The step had jumped when such smaller steps go on
         without a sign change (the path turned away next to the crossing, where the step went straight on); the
         chunk returned then ends with the
-        smaller steps instead. A true crossing changes the sign at every step length, and a sign change that steps
+        smaller steps instead, unless they came within ``Tolerances.loose`` of a rank drop (a crossing, whose
+        round-off gap small steps may turn through). A true crossing changes the sign at every step length, and a
+        sign change that steps
         of an eighth do not see while they pass within an eighth of the step's length of where it landed (the test
         function's basis turned over over a long step, as on Goldberg's linkage written in thousandths) is not a
         jump: ``None``, and the chunk stays as it was; so does a probe that ends for another reason (a target, a
@@ -497,6 +499,8 @@ class BranchMarcher:
                 kept.append(probe)
                 if level == 0 and float(distance(probe.u[: probe.count], u_b).min()) < length / JUMP_SHRINK:
                     return None  # the smaller steps pass where the step landed: the same path, no jump
+                if self._singular_on(kept):
+                    return None  # they pass through a rank drop: a crossing, which the sign change locates
                 return self._retaken(chunk, kept, h)
             j = int(changed[0]) if len(changed) else probe.count - 2  # the last row before the sign change
             if j < 0:
@@ -509,6 +513,18 @@ class BranchMarcher:
                 basis_a = self._basis_before(probe.u[j], probe.t[j], basis_a)
             u_a, t_a = probe.u[j].copy(), probe.t[j].copy()
         return None
+
+    def _singular_on(self, probes: list[Chunk]) -> bool:
+        """Whether the probes' rows come within ``Tolerances.loose`` of a rank drop (``sigma_r / sigma_1``).
+
+        Next to a true crossing small steps turn onto the other branch too, where the corrector's round-off
+        leaves the crossing a gap of its own size; a path that came that close to a singular point meets a point
+        the tracer locates and reports (:meth:`_scan_rank_minima` classifies the same ratio), not a gap."""
+        r = self.cfg.r_path
+        if r < 1:
+            return False
+        ratios = [p.sigma[: p.count, r - 1] / p.sigma[: p.count, 0] for p in probes if p.count > 0]
+        return bool(ratios) and float(np.min(np.concatenate(ratios))) <= self.cfg.tol.loose
 
     @staticmethod
     def _retaken(chunk: Chunk, probes: list[Chunk], h: float) -> Chunk:
