@@ -455,16 +455,15 @@ class BranchMarcher:
         true crossing, with no rank drop there. So the step over which the sign changed is taken again from its
         start in steps of an eighth of its length, never longer, over one and a half times its length; where the
         sign changes again, the step over which it did is taken again in the same way, :data:`JUMP_LEVELS` times
-        (a step of 8^-3 = 1/512 of the first at the last). The step had jumped when such smaller steps go on
-        without a sign change (the path turned away next to the crossing, where the step went straight on); the
-        chunk returned then ends with the
-        smaller steps instead, unless they came within ``Tolerances.loose`` of a rank drop (a crossing, whose
-        round-off gap small steps may turn through). A true crossing changes the sign at every step length, and a
-        sign change that steps
-        of an eighth do not see while they pass within an eighth of the step's length of where it landed (the test
-        function's basis turned over over a long step, as on Goldberg's linkage written in thousandths) is not a
-        jump: ``None``, and the chunk stays as it was; so does a probe that ends for another reason (a target, a
-        limit, a closed path), which the march meets again as it goes on.
+        (a step of 8^-3 = 1/512 of the first at the last). Where such smaller steps go on without a sign change,
+        the step had jumped (the path turned away next to the crossing, where the step went straight on), and the
+        chunk returned ends with the smaller steps instead; unless they came within ``Tolerances.loose`` of a rank
+        drop (a true crossing, whose round-off gap small steps may turn through), or the path they follow, marched
+        on in steps of an eighth of the jumped one, passes within a sixteenth of its length of where it landed (the
+        same path: the test function's basis turned over on a long step, as on Goldberg's linkage moved or written
+        in thousandths). A true crossing changes the sign at every step length. In each of these cases ``None``:
+        the chunk stays as it was; so does a probe that ends for another reason (a target, a limit, a closed path),
+        which the march meets again as it goes on.
         """
         c = chunk.count
         if c < 2 or self._known_on_step(chunk.u[c - 2], chunk.u[c - 1]) is not None:
@@ -484,12 +483,13 @@ class BranchMarcher:
         before = None if c < 3 else np.array([chunk.u[c - 3], chunk.t[c - 3]])
         kept: list[Chunk] = []  # the probes' rows before each sign change, then the probe that went through
         step = length
-        for level in range(JUMP_LEVELS):
+        for _ in range(JUMP_LEVELS):
             h = step / JUMP_SHRINK
             if h < 4.0 * self.cfg.min_step:
                 return None
+            basis_probe = basis_a.copy()
             probe = self.march_chunk(
-                u_a, t_a, u_home, basis_a.copy(), False, h, int(1.5 * JUMP_SHRINK) + 4, check_closed,
+                u_a, t_a, u_home, basis_probe, False, h, int(1.5 * JUMP_SHRINK) + 4, check_closed,
                 reach.copy(), before, max_step=h,
             )  # fmt: skip
             changed = (probe.tau[1 : probe.count] * probe.tau[0] <= 0.0).nonzero()[0]  # its own sign
@@ -497,10 +497,18 @@ class BranchMarcher:
                 if probe.code != StopReason.BUDGET:
                     return None
                 kept.append(probe)
-                if level == 0 and float(distance(probe.u[: probe.count], u_b).min()) < length / JUMP_SHRINK:
-                    return None  # the smaller steps pass where the step landed: the same path, no jump
                 if self._singular_on(kept):
                     return None  # they pass through a rank drop: a crossing, which the sign change locates
+                # On along the path, in steps of an eighth of the jumped one: the same path passes where it landed.
+                m = probe.count - 1
+                on = self.march_chunk(
+                    probe.u[m].copy(), probe.t[m].copy(), u_home, basis_probe, False, length / JUMP_SHRINK,
+                    int(1.5 * JUMP_SHRINK) + 4, False, reach.copy(),
+                    None if m < 1 else np.array([probe.u[m - 1], probe.t[m - 1]]), max_step=length / JUMP_SHRINK,
+                )  # fmt: skip
+                passed = min(float(distance(p.u[: p.count], u_b).min()) for p in [*kept, on])
+                if passed < length / (2.0 * JUMP_SHRINK):
+                    return None  # the same path: the sign change was the test function's, not a jump
                 return self._retaken(chunk, kept, h)
             j = int(changed[0]) if len(changed) else probe.count - 2  # the last row before the sign change
             if j < 0:
