@@ -151,8 +151,11 @@ def correct_in(mech, u, held, corrector, work):
             for e in range(res.shape[0]):
                 c += U[e, i] * res[e]
             c /= s[i]
+            # The held unknown stays exactly where it is: its column is zero, but Vt's entries for it are round-off,
+            # which a small singular value next to a singular point scales up (a paper step 1e-8 deg off its value).
             for a in range(m):
-                u[a] -= Vt[i, a] * c  # Eq. (28): - sum_i w_i u_i^T e / v_ii
+                if a != held:
+                    u[a] -= Vt[i, a] * c  # Eq. (28): - sum_i w_i u_i^T e / v_ii
     return False, max_iter, prev
 
 

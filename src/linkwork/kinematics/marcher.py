@@ -68,6 +68,13 @@ FOLD_PROBE_STEPS = 60
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
 #: branch along which the drive stays put (to round-off) that component only changes sign by noise.
 FOLD_MOVING = 1e-8
+# A step over which the test function changes sign is taken again from its start in steps of 1/JUMP_SHRINK of its
+# length, down to JUMP_LEVELS times: where the smaller steps follow the path without a sign change, the step had
+# jumped across a narrow gap to another branch (next to an imperfect bifurcation, e.g. a four-bar a hair from
+# Grashof's change point), and those steps replace it (BranchMarcher._jumped).
+JUMP_SHRINK = 8.0
+JUMP_LEVELS = 3
+JUMP_RETRIES = 16  # steps taken again per branch: bounds the work
 
 
 def leading_sign(tangent: Array, drive: int, moving: float = 1e-6) -> int:
@@ -208,11 +215,13 @@ class BranchMarcher:
         check_closed: bool,
         reach: Array,
         before: Array | None = None,
+        max_step: float | None = None,
     ) -> Chunk:
         """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place; ``reach
         = [far, longest, t_home...]``: how far the path has gone from ``u_home``, its longest step and its
         tangent there, updated in place; ``before``: the row before ``u`` and its tangent, ``(2, m)``, when the
-        call goes on with the path of the one before, so that the rows do not depend on where calls begin)."""
+        call goes on with the path of the one before, so that the rows do not depend on where calls begin;
+        ``max_step``: a cap below the settings' own, for :meth:`_jumped`'s probes)."""
         cfg, tol, m = self.cfg, self.cfg.tol, len(u)
         out = Chunk(
             u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
@@ -224,7 +233,7 @@ class BranchMarcher:
             cfg.drive,
             h0,
             cfg.min_step,
-            cfg.max_step,
+            cfg.max_step if max_step is None else max_step,
             cfg.cos_turn,
             0.0 if cfg.target is None else cfg.target,
             cfg.target is not None,
@@ -308,6 +317,7 @@ class BranchMarcher:
         reach = np.zeros(2 + len(u0))
         home: Home | None = None if opened_at is None else opened_at[1]
         n_steps, first = 0, True
+        jump_retries = 0  # steps taken again in smaller ones (see _jumped)
         before: Array | None = None  # the row before u when the march goes on with the last call's path
         # A drive turning round towards its target: the step its current cycle began at, the fewest steps a cycle
         # took, and paper mode's count of equal steps to the target.
@@ -327,6 +337,14 @@ class BranchMarcher:
             basis_prev = basis.copy()
             chunk = self.march_chunk(u, t, u_home, basis, paper, h0, n, check_closed, reach, before)
             before = None
+            if chunk.code == StopReason.SIGN_CHANGE and not paper and jump_retries < JUMP_RETRIES:
+                retaken = self._jumped(chunk, basis_prev, u_home, reach, check_closed)
+                if retaken is not None:  # the last step had jumped to another branch: taken in smaller steps
+                    jump_retries += 1
+                    chunk = retaken
+                    basis[:] = self._basis_before(
+                        chunk.u[chunk.count - 1], chunk.t[chunk.count - 1], basis_prev
+                    )
             home = home or Home(chunk.sigma[0].copy(), float(chunk.res[0]), float(chunk.tau[0]))
             if chunk.code == StopReason.CLOSED:
                 home.copy_to(chunk, chunk.count - 1)
@@ -426,6 +444,114 @@ class BranchMarcher:
             if chunk.count >= 2:  # the next call goes on with this path: its first step extrapolates as here
                 before = np.array([chunk.u[chunk.count - 2], chunk.t[chunk.count - 2]])
 
+    def _jumped(
+        self, chunk: Chunk, basis_prev: Array, u_home: Array, reach: Array, check_closed: bool
+    ) -> Chunk | None:
+        """The chunk again with its last step taken in smaller ones, when that step jumped to another branch.
+
+        Gan & Pellegrino's predictor-corrector (Sec. 4) lands wherever its corrector converges: next to an imperfect
+        bifurcation (two branches a narrow gap apart, as where a four-bar is a hair from Grashof's change point) a
+        step longer than the gap lands on the other branch, straight on, and the test function changes sign as at a
+        true crossing, with no rank drop there. So the step over which the sign changed is taken again from its
+        start in steps of an eighth of its length, never longer, over one and a half times its length; where the
+        sign changes again, the step over which it did is taken again in the same way, :data:`JUMP_LEVELS` times
+        (a step of 8^-3 = 1/512 of the first at the last). Where such smaller steps go on without a sign change,
+        the step had jumped (the path turned away next to the crossing, where the step went straight on), and the
+        chunk returned ends with the smaller steps instead; unless they came within ``Tolerances.loose`` of a rank
+        drop (a true crossing, whose round-off gap small steps may turn through), or the path they follow, marched
+        on in steps of an eighth of the jumped one, passes within a sixteenth of its length of where it landed (the
+        same path: the test function's basis turned over on a long step, as on Goldberg's linkage moved or written
+        in thousandths). A true crossing changes the sign at every step length. In each of these cases ``None``:
+        the chunk stays as it was; so does a probe that ends for another reason (a target, a limit, a closed path),
+        which the march meets again as it goes on.
+        """
+        c = chunk.count
+        if c < 2 or self._known_on_step(chunk.u[c - 2], chunk.u[c - 1]) is not None:
+            return None
+        periodic, weight = self.cfg.periodic, self.weight
+
+        def distance(x: Array, y: Array) -> Array:
+            """Step-metric distances between the rows of ``x`` and ``y`` (revolute unknowns modulo a turn)."""
+            diff = np.atleast_2d(x - y)
+            diff[:, periodic] = wrap(diff[:, periodic])
+            return np.asarray(np.linalg.norm(diff * weight, axis=1))
+
+        u_b = chunk.u[c - 1]
+        length = float(distance(u_b, chunk.u[c - 2])[0])
+        u_a, t_a = chunk.u[c - 2].copy(), chunk.t[c - 2].copy()
+        basis_a = self._basis_before(u_a, t_a, basis_prev)
+        before = None if c < 3 else np.array([chunk.u[c - 3], chunk.t[c - 3]])
+        kept: list[Chunk] = []  # the probes' rows before each sign change, then the probe that went through
+        step = length
+        for _ in range(JUMP_LEVELS):
+            h = step / JUMP_SHRINK
+            if h < 4.0 * self.cfg.min_step:
+                return None
+            basis_probe = basis_a.copy()
+            probe = self.march_chunk(
+                u_a, t_a, u_home, basis_probe, False, h, int(1.5 * JUMP_SHRINK) + 4, check_closed,
+                reach.copy(), before, max_step=h,
+            )  # fmt: skip
+            changed = (probe.tau[1 : probe.count] * probe.tau[0] <= 0.0).nonzero()[0]  # its own sign
+            if len(changed) == 0 and probe.code != StopReason.SIGN_CHANGE:
+                if probe.code != StopReason.BUDGET:
+                    return None
+                kept.append(probe)
+                if self._singular_on(kept):
+                    return None  # they pass through a rank drop: a crossing, which the sign change locates
+                # On along the path, in steps of an eighth of the jumped one: the same path passes where it landed.
+                m = probe.count - 1
+                on = self.march_chunk(
+                    probe.u[m].copy(), probe.t[m].copy(), u_home, basis_probe, False, length / JUMP_SHRINK,
+                    int(1.5 * JUMP_SHRINK) + 4, False, reach.copy(),
+                    None if m < 1 else np.array([probe.u[m - 1], probe.t[m - 1]]), max_step=length / JUMP_SHRINK,
+                )  # fmt: skip
+                passed = min(float(distance(p.u[: p.count], u_b).min()) for p in [*kept, on])
+                if passed < length / (2.0 * JUMP_SHRINK):
+                    return None  # the same path: the sign change was the test function's, not a jump
+                return self._retaken(chunk, kept, h)
+            j = int(changed[0]) if len(changed) else probe.count - 2  # the last row before the sign change
+            if j < 0:
+                return None
+            probe.count = j + 1
+            kept.append(probe)
+            step = float(distance(probe.u[j + 1], probe.u[j])[0])
+            if j >= 1:
+                before = np.array([probe.u[j - 1], probe.t[j - 1]])
+                basis_a = self._basis_before(probe.u[j], probe.t[j], basis_a)
+            u_a, t_a = probe.u[j].copy(), probe.t[j].copy()
+        return None
+
+    def _singular_on(self, probes: list[Chunk]) -> bool:
+        """Whether the probes' rows come within ``Tolerances.loose`` of a rank drop (``sigma_r / sigma_1``).
+
+        Next to a true crossing small steps turn onto the other branch too, where the corrector's round-off
+        leaves the crossing a gap of its own size; a path that came that close to a singular point meets a point
+        the tracer locates and reports (:meth:`_scan_rank_minima` classifies the same ratio), not a gap."""
+        r = self.cfg.r_path
+        if r < 1:
+            return False
+        ratios = [p.sigma[: p.count, r - 1] / p.sigma[: p.count, 0] for p in probes if p.count > 0]
+        return bool(ratios) and float(np.min(np.concatenate(ratios))) <= self.cfg.tol.loose
+
+    @staticmethod
+    def _retaken(chunk: Chunk, probes: list[Chunk], h: float) -> Chunk:
+        """``chunk`` without its last row, then the rows of each probe after its first (see :meth:`_jumped`)."""
+        k = chunk.count - 1
+        parts = [(chunk, 0, k)] + [(p, 1, p.count) for p in probes]
+        s, base = [], 0.0
+        for i, (part, lo, hi) in enumerate(parts):
+            s.append(part.s[lo:hi] - (0.0 if i == 0 else part.s[0]) + base)
+            base = float(s[-1][-1]) if hi > lo else base
+        return Chunk(
+            u=np.concatenate([p.u[lo:hi] for p, lo, hi in parts]),
+            t=np.concatenate([p.t[lo:hi] for p, lo, hi in parts]),
+            sigma=np.concatenate([p.sigma[lo:hi] for p, lo, hi in parts]),
+            res=np.concatenate([p.res[lo:hi] for p, lo, hi in parts]),
+            tau=np.concatenate([p.tau[lo:hi] for p, lo, hi in parts]),
+            s=np.concatenate(s), count=k + sum(p.count - 1 for p in probes), code=int(StopReason.BUDGET), h=h,
+        )  # fmt: skip
+
     def _land_on_limit(self, chunk: Chunk) -> tuple[int, str]:
         """Replace the chunk's last row (past a limit) by the point of the step where the joint is at its limit.
 
@@ -480,6 +606,8 @@ class BranchMarcher:
             dim = point.dimension
             text = f"entered a {dim}-dimensional component (mobility {dim}) at point {point.id}"
             return (StopReason.COMPONENT, text, point.id), None
+        self._onto_point(chunk, c - 1, point)
+        u_k = chunk.u[c - 1].copy()
         if len(point.tangents_u) >= 2:
             tangent = point.tangents_u[int(np.argmax(np.abs(point.tangents_u @ t_in)))].copy()
         else:
@@ -491,6 +619,36 @@ class BranchMarcher:
         tangent *= 1.0 if tangent @ t_in >= 0.0 else -1.0
         chunk.t[c - 1] = tangent
         return None, tangent
+
+    def _onto_point(self, chunk: Chunk, row: int, point: Bifurcation) -> None:
+        """Put the chunk's row ``row``, a step that landed on the singular point ``point``, onto the located point.
+
+        The corrector that landed there held the drive at its step's value and stopped at a closure residual of
+        ``Tolerances.exact``, which on a double point leaves the other joints only as close as its square root (a
+        change-point four-bar's paper-mode row at its crossing was 3.8e-5 deg off the closed form); the located
+        point is polished to about 1e-11 rad (docs/tracing.md, Polishing). The row takes the point's unknowns,
+        residual and singular values when it has the point's drive value to round-off (paper mode's equal step,
+        kept exactly) and lies within ``Tolerances.loose`` of it; the row already recorded is changed too.
+        """
+        d = self.cfg.drive
+        u_k, u_p = chunk.u[row].copy(), np.asarray(point.u, dtype=float)
+        if point.kind != "bifurcation" or u_p.shape != u_k.shape or not 0 <= row < chunk.count:
+            return
+        drive_off = abs(float(u_p[d] - u_k[d]))
+        if drive_off > 1e-12 * max(1.0, abs(float(u_k[d]))) or np.linalg.norm(u_p - u_k) > self.cfg.tol.loose:
+            return
+        snapped = u_p.copy()
+        snapped[d] = u_k[d]
+        chunk.u[row] = snapped
+        chunk.sigma[row] = point.sigma
+        chunk.res[row] = point.residual
+        rows = self.rows
+        if rows.u:
+            same = np.flatnonzero(np.all(rows.u[-1] == u_k, axis=1))
+            for i in same[-1:].tolist():
+                rows.u[-1][i] = snapped
+                rows.sigma[-1][i] = point.sigma
+                rows.res[-1][i] = point.residual
 
     def _step_across(
         self, chunk: Chunk, tangent: Array, paper: bool, basis_prev: Array, basis: Array
@@ -744,6 +902,7 @@ class BranchMarcher:
                     self.mech, self.ws, len(self.found), branch_id, base + k, u_min, 0.0, self.cfg
                 )
                 self._add_point(bif, branch_id, chunk.t[k])
+                self._onto_point(chunk, k, bif)
 
     def _scan_folds(self, chunk: Chunk, branch_id: int, base: int) -> None:
         """Locate every fold of the drive in the chunk: where the drive turns back.
@@ -792,6 +951,8 @@ class BranchMarcher:
                 )
             else:
                 self._add_point(bif, branch_id, chunk.t[c - 2])
+                for row in (c - 2, c - 1):
+                    self._onto_point(chunk, row, bif)
         return known
 
     def _known_on_step(self, u_a: Array, u_b: Array) -> int | None:

@@ -506,12 +506,34 @@ def target_verdict(mech: Mechanism, until: tuple[str | int, float], end: End, an
     name = mech.joint_names[j]
     revolute = mech.joint_types[j] == "R"
 
+    lo, hi = float(np.min(angles[:, j])), float(np.max(angles[:, j]))
+    unit = np.degrees if revolute else float
+    # Two decimals (six digits for a length), or as many more as it takes for the target not to read as an end of
+    # the range it is outside (a target 1e-6 deg beyond a rocker's extreme: "never reaches 93.86 ... [-93.86, 93.86]").
+    places = next(
+        (
+            k
+            for k in range(2, 13)
+            if all(
+                f"{float(unit(v)):.{k}f}" != f"{float(unit(until[1])):.{k}f}"
+                for v in (lo, hi)
+                if v != until[1]
+            )
+        ),
+        12,
+    )
+
     def show(x: float) -> str:
         deg = float(np.degrees(x))
-        return (f"{deg:.2f} deg" if abs(deg) < 1e6 else f"{deg:.6g} deg") if revolute else f"{x:.6g}"
+        if not revolute:
+            return f"{x:.{max(6, places + 1)}g}"
+        return f"{deg:.{places}f} deg" if abs(deg) < 1e6 else f"{deg:.6g} deg"
 
-    lo, hi = float(np.min(angles[:, j])), float(np.max(angles[:, j]))
-    span = f"[{np.degrees(lo):.2f}, {np.degrees(hi):.2f}] deg" if revolute else f"[{lo:.6g}, {hi:.6g}]"
+    span = (
+        f"[{np.degrees(lo):.{places}f}, {np.degrees(hi):.{places}f}] deg"
+        if revolute
+        else f"[{show(lo)}, {show(hi)}]"
+    )
     if end.kind in (StopReason.CLOSED, StopReason.TURNING):
         why = "" if end.kind == StopReason.CLOSED else f" (it turns back near {show(float(angles[-1, j]))})"
         return f"{name} never reaches {show(until[1])} on this path{why}: its range is {span}"
