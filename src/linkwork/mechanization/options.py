@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from linkwork.errors import SpecError
 from linkwork.geometry.polygon import contains, is_simple
 from linkwork.limits import MAX_MAGNITUDE
+from linkwork.limits import MECHANIZE as MECHANIZE_LIMITS
 from linkwork.messages import show
 from linkwork.progress import Progress
 
@@ -387,6 +388,9 @@ def _checked(key: str, value: Any) -> Any:
     checked = check(value)
     if checked is None:
         raise _error(expected, value)
+    limit = MECHANIZE_LIMITS.get(key)  # the flag's upper bound (linkwork.limits.MECHANIZE), for the key too
+    if limit is not None and float(value) > limit.upper:
+        raise _error(f"{expected}, at most {limit.upper:g} (as --{key.replace('_', '-')})", value)
     return checked
 
 
