@@ -40,6 +40,10 @@ err_console = Console(stderr=True)
 MAX_MESSAGE_CHARS = 2000
 """An error line longer than this is cut (a hostile value can be megabytes long)."""
 
+MAX_INTEGER_DIGITS = 40
+"""The most characters of a whole number read as one (every bound is far below; Python's ``int`` refuses more
+than 4300 digits with a traceback, and click words its refusal of a long one without the flag's bounds)."""
+
 P = ParamSpec("P")
 R = TypeVar("R")
 
@@ -144,8 +148,10 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
         if not sep or not key.strip():
             raise fail(f"{flag} {show(item)}: expected KEY=VALUE")
         value: Any = raw  # text, unless it is a number as a person types one (limits.PLAIN_NUMBER)
-        if PLAIN_INTEGER.fullmatch(raw):
-            value = int(raw)
+        if PLAIN_INTEGER.fullmatch(
+            raw
+        ):  # kept as text when longer than any bound (int() of 4300 digits raises)
+            value = int(raw) if len(raw) <= MAX_INTEGER_DIGITS else raw
         elif (number := plain_number(raw)) is not None:
             value = number
         if key.strip() in out:  # the last would win silently: refused, as a repeated --until is
@@ -284,7 +290,7 @@ def _typed_number_misuse(param: Any, flag: str, value: str) -> str | None:
     if kind is None:
         return None
     pattern = PLAIN_INTEGER if kind is int else PLAIN_NUMBER
-    if pattern.fullmatch(value):
+    if pattern.fullmatch(value) and not (kind is int and len(value) > MAX_INTEGER_DIGITS):
         return None
     limit = FLAG_LIMITS.get(flag)
     if limit is not None:

@@ -14,6 +14,8 @@ from collections.abc import Mapping
 from numbers import Integral, Real
 from typing import Any
 
+import numpy as np
+
 from linkwork.errors import SpecError
 from linkwork.limits import MAX_TRACE_STEPS
 
@@ -52,7 +54,7 @@ def check_trace_subject(mech: Any, branches: Any, progress: Any) -> None:
     if not isinstance(mech, Mechanism):
         hint = " (lw.load(NAME or FILE) makes one)" if isinstance(mech, str) else ""
         raise SpecError(f"mech={mech!r:.80}: expected a Mechanism{hint}")
-    if not isinstance(branches, bool) and type(branches).__name__ != "bool_":  # numpy's bool too
+    if not isinstance(branches, bool | np.bool_):  # numpy's bool too
         raise SpecError(f"branches={branches!r:.80}: expected True or False")
     if progress is not None and not callable(progress):
         raise SpecError(f"progress={progress!r:.80}: expected a function progress(done, total) or None")
