@@ -258,12 +258,12 @@ def test_joint_values_typed_in_study_files_and_region_flags_follow_the_one_rule(
     study.write_text(
         f'name = "s"\nlinkage = "bennett"\n[trace]\nuntil = "A={typed}"\n[grid]\nalpha1 = [30]\n'
     )
-    with pytest.raises(SpecError, match="trace.until"):
+    with pytest.raises(SpecError, match=r"trace\.until"):
         read_study(study)
     search = tmp_path / "search.toml"
     text = (Path(__file__).parents[2] / "examples" / "studies" / "rect-frame-search.toml").read_text()
     search.write_text(text.replace('deployed_at = "A=0"', f'deployed_at = "A={typed}"'))
-    with pytest.raises(SpecError, match="criteria.deployed_at"):
+    with pytest.raises(SpecError, match=r"criteria\.deployed_at"):
         load_search(search)
     with pytest.raises(SpecError, match="--ground-region"):
         parse_region_flag(f"{typed},0,20,20")
