@@ -268,3 +268,57 @@ def test_joint_values_typed_in_study_files_and_region_flags_follow_the_one_rule(
     with pytest.raises(SpecError, match="--ground-region"):
         parse_region_flag(f"{typed},0,20,20")
     assert parse_region_flag(" 10, 0,20,20") == [10.0, 0.0, 20.0, 20.0]
+
+
+@pytest.mark.parametrize(
+    "planted",
+    [
+        ["thesis.docx"],  # the earliest format: a list of names
+        {"format": 2, "parts": {"run": ["thesis.docx", "path.csv"]}, "files": []},
+        {"format": 2, "parts": {"mechanize": ["thesis.docx"]}, "files": ["thesis.docx"]},
+        {
+            "format": 3,
+            "parts": {"run": ["thesis.docx"]},
+            "files": [],
+            "fingerprints": {"thesis.docx": "sha256:0"},
+        },
+    ],
+    ids=["list", "format-2-run", "format-2-file", "format-3-wrong-print"],
+)
+def test_a_manifest_copied_into_a_users_folder_never_costs_a_file(tmp_path: Path, planted: object) -> None:
+    """A ``.linkwork-manifest.json`` that came with a copied or unpacked folder may list any name; a run into
+    that folder removed a user's ``thesis.docx`` as a stale entry of the earlier run, and an export wrote over a
+    user's file it listed. Removal and overwriting now need the entry's fingerprint (its bytes' sha256) to match
+    what linkwork wrote; the run's own results are still replaced as a whole."""
+    import json as json_module
+
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "thesis.docx").write_bytes(b"precious")
+    (out / ".linkwork-manifest.json").write_text(json_module.dumps(planted))
+    for args in (
+        ["trace", "four-bar", "--until", "A=120", "--no-plots", "--html", "-o", str(out)],
+        ["trace", "bennett", "--max-steps", "10", "--no-plots", "-o", str(out)],
+    ):
+        run = run_cli(args)
+        assert run.code == 0, run
+        assert (out / "thesis.docx").read_bytes() == b"precious"
+    assert not (out / "viewer.html").exists()  # the first run's own stale entry is removed
+    run = run_cli(["export", "stl", str(out), "-o", str(out / "thesis.docx")])
+    assert run.code == 2 and (out / "thesis.docx").read_bytes() == b"precious"
+
+
+def test_an_output_changed_since_linkwork_wrote_it_is_kept(tmp_path: Path) -> None:
+    """A result a user edited (``path.csv`` saved by a spreadsheet) is theirs now: the next run into the folder
+    refuses (exit 2, the file named) instead of writing over it; a copy of the folder is still linkwork's."""
+    out = tmp_path / "results"
+    assert run_cli(["trace", "four-bar", "--until", "A=120", "--no-plots", "-o", str(out)]).code == 0
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    with (out / "path.csv").open("a") as handle:
+        handle.write("my note\n")
+    edited = (out / "path.csv").read_bytes()
+    run = run_cli(["trace", "four-bar", "--until", "A=100", "--no-plots", "-o", str(out)], out=out)
+    assert run.code == 2 and '"path.csv" holds something else than linkwork wrote' in run.stderr
+    assert (out / "path.csv").read_bytes() == edited
+    assert run_cli(["trace", "four-bar", "--until", "A=100", "--no-plots", "-o", str(copy)]).code == 0
