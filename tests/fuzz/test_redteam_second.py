@@ -322,3 +322,25 @@ def test_an_output_changed_since_linkwork_wrote_it_is_kept(tmp_path: Path) -> No
     assert run.code == 2 and '"path.csv" holds something else than linkwork wrote' in run.stderr
     assert (out / "path.csv").read_bytes() == edited
     assert run_cli(["trace", "four-bar", "--until", "A=100", "--no-plots", "-o", str(copy)]).code == 0
+
+
+@pytest.mark.parametrize("rise", [0.1, 1e-3, -2.0])
+def test_a_3d_dxf_polyline_leaving_its_plane_is_refused_not_flattened(tmp_path: Path, rise: float) -> None:
+    """A 3-D POLYLINE whose vertices climb (z = rise * x) was read as its x-y projection, exit 0; one in a plane
+    z = constant is still read, as ezdxf's own vertices say."""
+    ezdxf = pytest.importorskip("ezdxf")
+    from linkwork.io.profiles import load_profile
+
+    circle = [(math.cos(t * math.pi / 30), math.sin(t * math.pi / 30)) for t in range(40)]
+    climbing = tmp_path / "climbing.dxf"
+    document = ezdxf.new()
+    document.modelspace().add_polyline3d([(x, y, rise * x) for x, y in circle])
+    document.saveas(climbing)
+    with pytest.raises(SpecError, match="3-D POLYLINE's z runs from"):
+        load_profile(climbing)
+    flat = tmp_path / "flat.dxf"
+    document = ezdxf.new()
+    document.modelspace().add_polyline3d([(x, y, 5.0) for x, y in circle])
+    document.saveas(flat)
+    points = load_profile(flat)
+    assert np.allclose(points, np.array(circle), rtol=0, atol=1e-12)
