@@ -344,3 +344,43 @@ def test_a_3d_dxf_polyline_leaving_its_plane_is_refused_not_flattened(tmp_path: 
     document.saveas(flat)
     points = load_profile(flat)
     assert np.allclose(points, np.array(circle), rtol=0, atol=1e-12)
+
+
+def test_two_runs_into_one_out_take_turns(tmp_path: Path) -> None:
+    """Two commands writing into one ``--out`` at once: the second waits while the first holds the folder
+    (``io.writer.folder_lock``), so neither is refused as if the other's fresh entries were a user's, and no
+    run's files are mixed with another's. Shown with the lock held by the test: a real ``trace`` writes nothing
+    into the folder until it is released; then four runs at once all succeed, leaving one run's files."""
+    import time
+
+    from linkwork.io.writer import folder_lock
+
+    out = tmp_path / "results"
+    out.mkdir()
+    script = [sys.executable, "-c", "from linkwork.cli import main; main()"]
+    with folder_lock(out):
+        process = subprocess.Popen(
+            [*script, "trace", "four-bar", "--until", "A=120", "--no-plots", "-o", str(out)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+        )
+        time.sleep(4.0)  # time to trace the four-bar several times over: it waits for the folder
+        assert process.poll() is None and not (out / "report.json").exists()
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 0, err.decode()
+    assert (out / "report.json").exists() and not list(tmp_path.glob(".linkwork-*"))
+    runs = [
+        subprocess.Popen(
+            [*script, "trace", name, "--no-plots", "--max-steps", "30", "-o", str(out)],
+            stderr=subprocess.PIPE,
+        )
+        for name in ["four-bar", "hedgepeth-rods", "bennett", "hedgepeth-rods"]
+    ]
+    for run in runs:
+        _, err = run.communicate(timeout=120)
+        assert run.returncode == 0, err.decode()
+    import json as json_module
+
+    joints = json_module.loads((out / "report.json").read_text())["joints"]
+    header = (out / "path.csv").read_text().splitlines()[0].split(",")
+    assert header[3 : 3 + len(joints)] == joints  # the files of one run, not a mix

@@ -53,6 +53,7 @@ __all__ = [
     "check_output_file",
     "check_output_folder",
     "fingerprint",
+    "folder_lock",
     "json_text",
     "require_finite",
     "staged_output",
@@ -64,6 +65,25 @@ MANIFEST = ".linkwork-manifest.json"
 
 RUN = "run"
 """The part name of a whole run (see :func:`staged_output`)."""
+
+
+@contextlib.contextmanager
+def folder_lock(folder: Path) -> Iterator[None]:
+    """Hold an exclusive lock on ``folder`` (``flock`` on the folder itself: no file is added to it) while its
+    entries and :data:`MANIFEST` are checked and changed, so two commands writing into one folder at once take
+    turns: each finds the other's entries recorded with their fingerprints, and no run's files are mixed with
+    another's. Where ``flock`` is not available (Windows) nothing is held."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not on POSIX
+        yield
+        return
+    handle = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(handle)  # closing releases the lock
 
 
 def fingerprint(path: Path) -> str:
@@ -207,8 +227,19 @@ def check_output_folder(out: Path, names: Iterable[str] = (), flag: str = "--out
         :data:`MANIFEST`, or is a symbolic link.
     """
     out = Path(out)
-    with _unwritable_place(out, flag):
+    with _unwritable_place(out, flag), _lock_if_folder(out):
         _check_output_folder(out, names, flag)
+
+
+@contextlib.contextmanager
+def _lock_if_folder(folder: Path) -> Iterator[None]:
+    """:func:`folder_lock` on ``folder`` when it is an existing folder (else nothing to hold): a check reads the
+    entries and the manifest while no other command is half way through changing them."""
+    if folder.is_dir():
+        with folder_lock(folder):
+            yield
+    else:
+        yield
 
 
 @contextlib.contextmanager
@@ -346,11 +377,17 @@ def staged_output(out: Path, *, part: str = RUN, flag: str = "--out") -> Iterato
                     raise  # not a write into the staging (a file read on the way)
                 raise _write_failed(exc, out, flag, stage) from None
             names = sorted(item.name for item in stage.iterdir() if item.name != MANIFEST)
-            check_output_folder(out, names, flag=flag)
             try:
-                _move_into(stage, out, names, part)
+                out.mkdir(parents=True, exist_ok=True)
             except OSError as exc:
                 raise _write_failed(exc, out, flag, stage) from None
+            with folder_lock(out):  # two runs into one --out: one after the other, never mixed
+                with _unwritable_place(out, flag):
+                    _check_output_folder(out, names, flag)
+                try:
+                    _move_into(stage, out, names, part)
+                except OSError as exc:
+                    raise _write_failed(exc, out, flag, stage) from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 
@@ -400,7 +437,7 @@ def check_output_file(file: Path, flag: str = "--out") -> None:
     """Refuse, before any work, a single output ``file`` that is a folder, a symbolic link, or an existing file
     linkwork did not write (not listed in the :data:`MANIFEST` of its folder)."""
     file = Path(file)
-    with _unwritable_place(file, flag):
+    with _unwritable_place(file, flag), _lock_if_folder(file.absolute().parent):
         _check_output_file(file, flag)
 
 
@@ -451,17 +488,19 @@ def write_file(file: str | Path, write: Callable[[Path], Any], *, flag: str = "-
                 if not _is_write_error(exc, tmp):
                     raise
                 raise _write_failed(exc, file, flag, tmp) from None
-            check_output_file(file, flag)
             folder = file.absolute().parent
             try:
                 written = fingerprint(tmp)
-                os.replace(tmp, file)
-                manifest = Manifest.read(folder)
-                manifest.files.add(file.name)
-                manifest.fingerprints[file.name] = written
-                for names in manifest.parts.values():
-                    names.discard(file.name)
-                manifest.write(folder)
+                with folder_lock(folder):  # the manifest read, changed and written by one command at a time
+                    with _unwritable_place(file, flag):
+                        _check_output_file(file, flag)
+                    os.replace(tmp, file)
+                    manifest = Manifest.read(folder)
+                    manifest.files.add(file.name)
+                    manifest.fingerprints[file.name] = written
+                    for names in manifest.parts.values():
+                        names.discard(file.name)
+                    manifest.write(folder)
             except OSError as exc:
                 raise _write_failed(exc, file, flag, tmp) from None
     finally:
