@@ -68,7 +68,33 @@ def load(spec: str | pathlib.Path, **params: Any) -> Mechanism:
     """
     from linkwork.io.spec import resolve_spec
 
+    _check_source("spec", spec, "a built-in name or the path of a spec file (TOML)")
+    params = {key: _plain(value) for key, value in params.items()}
     return resolve_spec(spec, _file_units(spec, params)).mechanism
+
+
+def _check_source(argument: str, value: Any, expected: str) -> None:
+    """Refuse, as one :class:`SpecError` naming the argument, a ``value`` that is neither a string nor a path
+    (``lw.load(3)``, ``lw.load(None)``, bytes: Python's ``TypeError`` from inside ``pathlib``)."""
+    if not isinstance(value, str | pathlib.PurePath):
+        raise SpecError(f"{argument}={value!r:.80}: expected {expected}")
+
+
+def _plain(value: Any) -> Any:
+    """A numpy scalar (``np.float32(0.5)``, ``np.int64(6)``, a 0-d array) as the plain Python number it holds,
+    so that the API takes numpy's numbers wherever it takes Python's (as ``lw.trace`` does); anything else as it
+    is (the parameter's check says what it expected)."""
+    import numbers
+
+    if hasattr(value, "ndim") and getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+        value = value.item()
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value)
+    return value
 
 
 def _file_units(spec: str | pathlib.Path, params: dict[str, Any]) -> dict[str, Any]:
@@ -106,6 +132,9 @@ def synthesize(problem: Problem | str | pathlib.Path, **kwargs: Any) -> Synthesi
     from linkwork.synthesis.problem import Problem as _Problem
 
     if not isinstance(problem, _Problem):
+        _check_source(
+            "problem", problem, "a Problem, the path of a problem file (TOML) or a bundled example's name"
+        )
         from linkwork.data import problem_file
         from linkwork.io.problem import load_problem
 

@@ -33,10 +33,26 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any
 
-import numba
-from numba.core import config as numba_config
 
-from linkwork.version import __version__
+def _set_aside_refused_environment() -> dict[str, str]:
+    """Take out of the environment, before numba is imported, a ``NUMBA_NUM_THREADS`` that numba would refuse
+    with a traceback as it loads (``0``, ``-1``) or with a warning quoting its own source (``x``), and return it:
+    ``linkwork`` refuses it in one line (``cli.common.environment_misuse``); the library runs on numba's default
+    threads instead of failing to import."""
+    refused = {}
+    value = os.environ.get("NUMBA_NUM_THREADS")
+    if value is not None and not (value.strip().isascii() and value.strip().isdigit() and int(value) >= 1):
+        refused["NUMBA_NUM_THREADS"] = os.environ.pop("NUMBA_NUM_THREADS")
+    return refused
+
+
+REFUSED_ENVIRONMENT: dict[str, str] = _set_aside_refused_environment()
+"""Environment variables set aside before numba was imported, with the values given (see above)."""
+
+import numba  # noqa: E402  (after the environment is made safe for it)
+from numba.core import config as numba_config  # noqa: E402
+
+from linkwork.version import __version__  # noqa: E402
 
 KERNEL_MODULES = (
     "kinematics/bidiagonal_7x6.py",

@@ -31,6 +31,10 @@ MAX_PATH_POINTS = 10_000
 MAX_SEED = 2**63 - 1
 """The largest seed (the largest whole number a TOML file can hold)."""
 
+SMALLEST_STEP_DEGREES = math.degrees(1e-9)
+"""The tracer's smallest step (``linkwork.trace``'s ``min_step``, 1e-9 radians) in degrees: the least
+``--max-step`` (a largest step below it spent the whole step budget advancing nothing, exit 0)."""
+
 MAX_MAGNITUDE = 1e12
 """The largest absolute value of a length or a tolerance given by a user."""
 
@@ -136,3 +140,21 @@ WORKERS = Limit(
     whole=True,
     why="the cores of this machine, os.cpu_count()",
 )
+
+
+MECHANIZE: dict[str, Limit] = {
+    "dof": Limit("a whole number of degrees of freedom", 1, 20, whole=True),
+    "link_offset": Limit("a number of body lengths", 0.0, MAX_MAGNITUDE),
+    "max_link": Limit("a length in the profiles' units", 0.0, MAX_MAGNITUDE, open_low=True),
+    "max_link_fraction": Limit(
+        "a multiple of the profiles' largest extent", 0.0, MAX_MAGNITUDE, open_low=True
+    ),
+    "max_structural_error": Limit("a length in the profiles' units", 0.0, MAX_MAGNITUDE, open_low=True),
+    "min_transmission": Limit("an angle in degrees", 0.0, 90.0, open_high=True),
+    "attempts": Limit("a whole number of designs", 1, 100_000, whole=True),
+    "designs": Limit("a whole number of designs", 1, 20, whole=True),
+    "time_limit": Limit("a number of seconds", 0.0, 7 * 24 * 3600.0, open_low=True),
+}
+"""The bounds of the mechanization options, by problem-file key: the flag of the same name (``--time-limit``)
+and the key (``time_limit``) have one bound, so a problem file cannot ask what the flag refuses
+(``time_limit = 1e308`` was taken)."""

@@ -26,7 +26,7 @@ from linkwork.cli import (
     synth,
     trace,
 )
-from linkwork.cli.common import check_flags, fail, option_misuse
+from linkwork.cli.common import check_flags, environment_misuse, fail, option_misuse
 from linkwork.interrupts import Interrupted, exit_code, install_safe_interrupt
 
 try:  # typer >= 0.20 carries its own copy of click, whose exceptions are these
@@ -58,7 +58,7 @@ class OneLineErrors(help.Group):
     ) -> Any:
         check_flags(self)  # every numeric flag's bounds (cli/options.py), checked before any work starts
         given = list(sys.argv[1:] if args is None else args)
-        misuse = option_misuse(self, given)
+        misuse = option_misuse(self, given) or environment_misuse()
         if misuse is not None:
             if not standalone_mode:
                 raise click_exceptions.UsageError(misuse)
@@ -153,6 +153,10 @@ def main() -> None:
     """Entry point of the ``linkwork`` script: a cold run traces with the plain-Python kernels and compiles every
     kernel for the next run in a detached process (only the script does this; library calls, and the command
     group called from Python, compile in the foreground)."""
+    misuse = environment_misuse()  # before numba is imported: it reads NUMBA_NUM_THREADS as it loads
+    if misuse is not None:
+        fail(misuse, code=2)
+        sys.exit(2)
     from linkwork.kinematics import jit
 
     install_safe_interrupt()

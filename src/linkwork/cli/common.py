@@ -10,8 +10,9 @@ from __future__ import annotations
 import contextlib
 import errno
 import math
+import os
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from functools import wraps
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
@@ -38,6 +39,10 @@ err_console = Console(stderr=True)
 
 MAX_MESSAGE_CHARS = 2000
 """An error line longer than this is cut (a hostile value can be megabytes long)."""
+
+MAX_INTEGER_DIGITS = 40
+"""The most characters of a whole number read as one (every bound is far below; Python's ``int`` refuses more
+than 4300 digits with a traceback, and click words its refusal of a long one without the flag's bounds)."""
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -143,8 +148,10 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
         if not sep or not key.strip():
             raise fail(f"{flag} {show(item)}: expected KEY=VALUE")
         value: Any = raw  # text, unless it is a number as a person types one (limits.PLAIN_NUMBER)
-        if PLAIN_INTEGER.fullmatch(raw):
-            value = int(raw)
+        if PLAIN_INTEGER.fullmatch(
+            raw
+        ):  # kept as text when longer than any bound (int() of 4300 digits raises)
+            value = int(raw) if len(raw) <= MAX_INTEGER_DIGITS else raw
         elif (number := plain_number(raw)) is not None:
             value = number
         if key.strip() in out:  # the last would win silently: refused, as a repeated --until is
@@ -265,7 +272,67 @@ def option_misuse(group: Any, args: Sequence[str]) -> str | None:
             value = rest[i + 1] if i + 1 < len(rest) else None
         if value is not None and not value.strip():
             return f"{flag} {show(value)}: expected a value (an empty one is not the working folder or a default)"
+        if value is not None and (typed := _typed_number_misuse(param, flag, value)) is not None:
+            return typed
         i += 1 if attached else 2
+    return None
+
+
+def _typed_number_misuse(param: Any, flag: str, value: str) -> str | None:
+    """What is wrong with the text ``value`` of a numeric flag, or ``None``: one rule for a number a person types
+    (:data:`linkwork.limits.PLAIN_NUMBER`, :data:`linkwork.limits.PLAIN_INTEGER`), the rule of ``--set``,
+    ``--until`` and profile files. click's own conversion takes ``1_0`` for 10, ``3.0`` for a whole 3 and
+    spaces around the digits, and words its refusal of ``1e3`` without the value or the bounds."""
+    from linkwork.cli.options import FLAG_LIMITS
+    from linkwork.limits import PLAIN_NUMBER
+
+    kind = _number_type(param)
+    if kind is None:
+        return None
+    pattern = PLAIN_INTEGER if kind is int else PLAIN_NUMBER
+    if pattern.fullmatch(value) and not (kind is int and len(value) > MAX_INTEGER_DIGITS):
+        return None
+    limit = FLAG_LIMITS.get(flag)
+    if limit is not None:
+        expected = limit.expected(flag)
+    else:
+        expected = "a whole number" if kind is int else "a number"
+    digits = "ASCII digits" + ("" if kind is int else ", a decimal point and an exponent")
+    return f"{flag} {show(value)}: expected {expected} (written with {digits})"
+
+
+ENVIRONMENT_CHECKS: dict[str, str] = {
+    "NUMBA_NUM_THREADS": "a whole number of threads >= 1",
+    "MPLBACKEND": "a matplotlib backend such as agg",
+}
+"""The environment variables linkwork's dependencies read as the command starts, with what each must be: numba
+refuses ``NUMBA_NUM_THREADS=0`` with a traceback when the kernels load and prints one of its own with a source
+line for ``x``; matplotlib refuses an unknown ``MPLBACKEND`` with a traceback when the first figure is drawn."""
+
+
+def environment_misuse(environ: Mapping[str, str] | None = None) -> str | None:
+    """What is wrong with the environment a command runs in, as the words of an ``error:`` line (bad input,
+    exit 2, before any work), or ``None``: a variable of :data:`ENVIRONMENT_CHECKS` set to something its reader
+    refuses with a traceback. The values are checked without importing numba, and matplotlib only when
+    ``MPLBACKEND`` is set."""
+    env = os.environ if environ is None else environ
+    threads = env.get("NUMBA_NUM_THREADS")
+    if environ is None:  # set aside when linkwork was imported (numba reads it as it loads)
+        from linkwork.kernel_cache import REFUSED_ENVIRONMENT
+
+        threads = REFUSED_ENVIRONMENT.get("NUMBA_NUM_THREADS", threads)
+    if threads is not None and not (PLAIN_INTEGER.fullmatch(threads.strip()) and int(threads) >= 1):
+        return f"environment variable NUMBA_NUM_THREADS={show(threads)}: expected {ENVIRONMENT_CHECKS['NUMBA_NUM_THREADS']}"
+    backend = env.get("MPLBACKEND")
+    if backend:
+        try:
+            from matplotlib.rcsetup import validate_backend  # matplotlib reads MPLBACKEND as it loads
+
+            validate_backend(backend)
+        except ImportError:  # no plotting extra: nothing will read it
+            return None
+        except ValueError:
+            return f"environment variable MPLBACKEND={show(backend)}: expected {ENVIRONMENT_CHECKS['MPLBACKEND']}"
     return None
 
 

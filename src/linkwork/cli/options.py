@@ -62,27 +62,23 @@ Workers = Annotated[
 FLAG_LIMITS: dict[str, limits.Limit] = {
     "--steps": limits.STEPS,
     "--max-steps": limits.STEPS,
-    "--max-step": limits.Limit("a number of degrees", 0.0, 90.0, open_low=True),
+    "--max-step": limits.Limit("a number of degrees", limits.SMALLEST_STEP_DEGREES, 90.0),
     "--closure-tol": limits.Limit("a closure misfit", 0.0, limits.MAX_MAGNITUDE, open_low=True),
     "--samples": limits.SAMPLES,
     "--seed": limits.SEED,
     "--hinge-position-tol": limits.POSITION_TOL,
     "--hinge-direction-tol": limits.DIRECTION_TOL,
     "--workers": limits.WORKERS,
-    "--dof": limits.Limit("a whole number of degrees of freedom", 1, 20, whole=True),
-    "--link-offset": limits.Limit("a number of body lengths", 0.0, limits.MAX_MAGNITUDE),
-    "--max-link": limits.Limit("a length in the profiles' units", 0.0, limits.MAX_MAGNITUDE, open_low=True),
-    "--max-link-fraction": limits.Limit(
-        "a multiple of the profiles' largest extent", 0.0, limits.MAX_MAGNITUDE, open_low=True
-    ),
-    "--max-structural-error": limits.Limit(
-        "a length in the profiles' units", 0.0, limits.MAX_MAGNITUDE, open_low=True
-    ),
+    "--dof": limits.MECHANIZE["dof"],
+    "--link-offset": limits.MECHANIZE["link_offset"],
+    "--max-link": limits.MECHANIZE["max_link"],
+    "--max-link-fraction": limits.MECHANIZE["max_link_fraction"],
+    "--max-structural-error": limits.MECHANIZE["max_structural_error"],
     "--gallery": limits.Limit("a number of candidates", 0, 500, whole=True),
-    "--min-transmission": limits.Limit("an angle in degrees", 0.0, 90.0, open_high=True),
-    "--attempts": limits.Limit("a whole number of designs", 1, 100_000, whole=True),
-    "--designs": limits.Limit("a whole number of designs", 1, 20, whole=True),
-    "--time-limit": limits.Limit("a number of seconds", 0.0, 7 * 24 * 3600.0, open_low=True),
+    "--min-transmission": limits.MECHANIZE["min_transmission"],
+    "--attempts": limits.MECHANIZE["attempts"],
+    "--designs": limits.MECHANIZE["designs"],
+    "--time-limit": limits.MECHANIZE["time_limit"],
     "--branch": limits.Limit("a branch number (see report.json)", 0, 1_000_000, whole=True),
     "--point": limits.Limit(
         "a point number (negative counts from the end)",

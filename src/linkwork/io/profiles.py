@@ -323,6 +323,15 @@ def read_profile_dxf(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
             for v in entity.vertices
         ]
         closed = bool(entity.is_closed)
+        if entity.is_3d_polyline:  # its x and y are read: a profile that leaves a plane z = const is refused
+            heights = [float(v.dxf.location.z) for v in entity.vertices]
+            size = max((max(abs(x), abs(y)) for x, y, _ in vertices), default=0.0)
+            if heights and max(heights) - min(heights) > 1e-9 * max(size, max(map(abs, heights))):
+                raise SpecError(
+                    f"the 3-D POLYLINE's z runs from {min(heights):g} to {max(heights):g}; expected a profile "
+                    "drawn in a plane z = constant (its x and y are the profile)",
+                    source=escape_line(str(path)),
+                )
     if kind == "LWPOLYLINE" or entity.is_2d_polyline:
         vertices = _ocs_to_xy(vertices, entity, path)
     return bulge_polyline(vertices, closed, tolerance)

@@ -109,16 +109,31 @@ def read_toml(path: Path, what: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except RecursionError:
         raise SpecError(f"invalid TOML: nested too deeply; {expected}", source=source) from None
-    except tomllib.TOMLDecodeError as exc:
-        message = str(exc)
-        match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)
-        if match:
-            where = f"line {match.group(1)}, column {match.group(2)}"
-            message = message[: match.start()]
-        else:
-            where = f"line {text.count(chr(10)) + 1} (end of file)"
-            message = message.replace(" (at end of document)", "")
-        raise SpecError(f"invalid TOML: {escape_line(message)}", source=source, key=where) from None
+    except ValueError as exc:
+        if isinstance(exc, tomllib.TOMLDecodeError):
+            raise _decode_error(exc, text, source) from None
+        # Python refuses to read a whole number of more than sys.get_int_max_str_digits() digits (4300): tomllib
+        # lets that ValueError out, with a traceback
+        digits = re.search(r"[0-9][0-9_]{999,}", text)
+        where = f"line {text.count(chr(10), 0, digits.start()) + 1}" if digits else None
+        raise SpecError(
+            f"invalid TOML: a number of thousands of digits; expected numbers within +-{MAX_MAGNITUDE:g}",
+            source=source,
+            key=where,
+        ) from None
+
+
+def _decode_error(exc: tomllib.TOMLDecodeError, text: str, source: str) -> SpecError:
+    """The one-line error of a TOML syntax error ``exc`` in ``text``, with its line and column."""
+    message = str(exc)
+    match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)
+    if match:
+        where = f"line {match.group(1)}, column {match.group(2)}"
+        message = message[: match.start()]
+    else:
+        where = f"line {text.count(chr(10)) + 1} (end of file)"
+        message = message.replace(" (at end of document)", "")
+    return SpecError(f"invalid TOML: {escape_line(message)}", source=source, key=where)
 
 
 class TomlReader:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import hashlib
 import json
 import os
 import shutil
@@ -51,6 +52,8 @@ __all__ = [
     "Manifest",
     "check_output_file",
     "check_output_folder",
+    "fingerprint",
+    "folder_lock",
     "json_text",
     "require_finite",
     "staged_output",
@@ -64,14 +67,83 @@ RUN = "run"
 """The part name of a whole run (see :func:`staged_output`)."""
 
 
-class Manifest:
-    """What linkwork wrote into one folder: ``parts`` (part name -> entries of that part of the last run) and
-    ``files`` (single files written there). Stored as JSON ``{"format": 2, "parts": {...}, "files": [...]}``; the
-    earlier format, a list of names, reads as one run."""
+@contextlib.contextmanager
+def folder_lock(folder: Path) -> Iterator[None]:
+    """Hold an exclusive lock on ``folder`` (``flock`` on the folder itself: no file is added to it) while its
+    entries and :data:`MANIFEST` are checked and changed, so two commands writing into one folder at once take
+    turns: each finds the other's entries recorded with their fingerprints, and no run's files are mixed with
+    another's. Where ``flock`` is not available (Windows) nothing is held."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not on POSIX
+        yield
+        return
+    handle = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(handle)  # closing releases the lock
 
-    def __init__(self, parts: dict[str, set[str]] | None = None, files: set[str] | None = None) -> None:
+
+def fingerprint(path: Path) -> str:
+    """What an entry linkwork wrote holds: ``sha256:<hex>`` of a file's bytes, or of a folder's entries (their
+    relative paths and bytes, in order). Recorded in the :data:`MANIFEST`, it tells linkwork's own entry from one
+    with the same name that someone else wrote or changed since (a manifest copied or planted into a folder
+    listing a user's ``thesis.docx``, a ``path.csv`` edited and saved by a spreadsheet): those are never replaced
+    or removed. A copied folder keeps its entries' bytes, so linkwork still owns them there."""
+    digest = hashlib.sha256()
+    if path.is_dir() and not path.is_symlink():
+        for item in sorted(path.rglob("*")):
+            if item.is_file() and not item.is_symlink():
+                digest.update(str(item.relative_to(path)).encode("utf-8", "surrogateescape") + b"\0")
+                _hash_file(item, digest)
+        return "sha256:" + digest.hexdigest()
+    _hash_file(path, digest)
+    return "sha256:" + digest.hexdigest()
+
+
+def _hash_file(path: Path, digest: Any) -> None:
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+
+
+class Manifest:
+    """What linkwork wrote into one folder: ``parts`` (part name -> entries of that part of the last run),
+    ``files`` (single files written there) and ``fingerprints`` (entry -> :func:`fingerprint` when written).
+    Stored as JSON ``{"format": 3, "parts": {...}, "files": [...], "fingerprints": {...}}``; format 2 (no
+    fingerprints) and the earlier list of names are still read, their entries owned by name alone."""
+
+    def __init__(
+        self,
+        parts: dict[str, set[str]] | None = None,
+        files: set[str] | None = None,
+        fingerprints: dict[str, str] | None = None,
+    ) -> None:
         self.parts = parts or {}
         self.files = files or set()
+        self.fingerprints = fingerprints or {}
+
+    def is_ours(self, folder: Path, name: str) -> bool:
+        """Whether the entry ``name`` of ``folder`` is one linkwork wrote and nobody changed since: listed, and
+        holding what its fingerprint says. An entry an earlier manifest (format 2 or a list) lists without a
+        fingerprint is linkwork's by name when it is one of a run's results (``path.csv``: the next run writes
+        the same kind of file over it), never when it is a single file, whose name a user chose (a manifest
+        copied from elsewhere may list any name); and it is never removed (:func:`staged_output`)."""
+        if name not in self.owned():
+            return False
+        recorded = self.fingerprints.get(name)
+        if recorded is None:
+            return any(name in names for names in self.parts.values())
+        try:
+            return fingerprint(folder / name) == recorded
+        except OSError:
+            return False
+
+    def changed(self, folder: Path, name: str) -> bool:
+        """Whether ``name`` is listed but holds something else than linkwork wrote there."""
+        return name in self.owned() and not self.is_ours(folder, name)
 
     @classmethod
     def read(cls, folder: Path) -> Manifest:
@@ -89,9 +161,12 @@ class Manifest:
             return cls()
         parts = data.get("parts")
         parts = parts if isinstance(parts, dict) else {}
+        prints = data.get("fingerprints")
+        prints = prints if isinstance(prints, dict) else {}
         return cls(
             {str(k): _names(v) for k, v in parts.items() if isinstance(v, list)},
             _names(data.get("files")),
+            {k: v for k, v in prints.items() if isinstance(k, str) and isinstance(v, str)},
         )
 
     def owned(self) -> set[str]:
@@ -100,10 +175,12 @@ class Manifest:
 
     def write(self, folder: Path) -> None:
         """Store the manifest (a new file renamed into place: a link in its place is replaced, not followed)."""
+        owned = self.owned()
         data = {
-            "format": 2,
+            "format": 3,
             "parts": {k: sorted(v) for k, v in sorted(self.parts.items()) if v},
             "files": sorted(self.files),
+            "fingerprints": {k: v for k, v in sorted(self.fingerprints.items()) if k in owned},
         }
         fd, name = tempfile.mkstemp(prefix=".linkwork-manifest-", dir=folder)
         _usual_mode(Path(name))
@@ -150,8 +227,19 @@ def check_output_folder(out: Path, names: Iterable[str] = (), flag: str = "--out
         :data:`MANIFEST`, or is a symbolic link.
     """
     out = Path(out)
-    with _unwritable_place(out, flag):
+    with _unwritable_place(out, flag), _lock_if_folder(out):
         _check_output_folder(out, names, flag)
+
+
+@contextlib.contextmanager
+def _lock_if_folder(folder: Path) -> Iterator[None]:
+    """:func:`folder_lock` on ``folder`` when it is an existing folder (else nothing to hold): a check reads the
+    entries and the manifest while no other command is half way through changing them."""
+    if folder.is_dir():
+        with folder_lock(folder):
+            yield
+    else:
+        yield
 
 
 @contextlib.contextmanager
@@ -180,7 +268,7 @@ def _check_output_folder(out: Path, names: Iterable[str], flag: str) -> None:
                     )
                 break
         return
-    ours = Manifest.read(out).owned()
+    manifest = Manifest.read(out)
     for name in names:
         target = out / name
         if target.is_symlink():
@@ -188,7 +276,13 @@ def _check_output_folder(out: Path, names: Iterable[str], flag: str) -> None:
                 f"{flag} {_shown(out)}: {show(name)} is a symbolic link; linkwork never writes through links, "
                 "move it away or choose another folder"
             )
-        if _exists(target) and name not in ours:
+        if _exists(target) and manifest.changed(out, name):
+            raise SpecError(
+                f"{flag} {_shown(out)}: {show(name)} holds something else than linkwork wrote there (changed "
+                f"since, or listed by a {MANIFEST} copied from elsewhere); move it away or choose another {flag} "
+                "(linkwork never overwrites what it did not write)"
+            )
+        if _exists(target) and not manifest.is_ours(out, name):
             raise SpecError(
                 f"{flag} {_shown(out)}: {show(name)} exists and was not written by linkwork; move it away "
                 f"or choose another {flag} (linkwork never overwrites what it did not write)"
@@ -283,11 +377,17 @@ def staged_output(out: Path, *, part: str = RUN, flag: str = "--out") -> Iterato
                     raise  # not a write into the staging (a file read on the way)
                 raise _write_failed(exc, out, flag, stage) from None
             names = sorted(item.name for item in stage.iterdir() if item.name != MANIFEST)
-            check_output_folder(out, names, flag=flag)
             try:
-                _move_into(stage, out, names, part)
+                out.mkdir(parents=True, exist_ok=True)
             except OSError as exc:
                 raise _write_failed(exc, out, flag, stage) from None
+            with folder_lock(out):  # two runs into one --out: one after the other, never mixed
+                with _unwritable_place(out, flag):
+                    _check_output_folder(out, names, flag)
+                try:
+                    _move_into(stage, out, names, part)
+                except OSError as exc:
+                    raise _write_failed(exc, out, flag, stage) from None
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 
@@ -300,7 +400,12 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
     stale = set().union(*(manifest.parts[p] for p in replaced if p in manifest.parts)) - set(names)
     # first record the names about to move in (an interruption between two moves leaves only entries the
     # manifest lists, which the next run may replace), then move
-    early = Manifest({k: set(v) for k, v in manifest.parts.items()}, set(manifest.files))
+    prints = {name: fingerprint(stage / name) for name in names}
+    early = Manifest(
+        {k: set(v) for k, v in manifest.parts.items()},
+        set(manifest.files),
+        {**manifest.fingerprints, **prints},
+    )
     early.parts.setdefault(part, set()).update(names)
     early.write(out)
     for name in names:
@@ -310,8 +415,10 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
         os.replace(stage / name, target)
     for name in sorted(stale):
         target = out / name
-        if target.is_symlink() or not _exists(target):
-            continue  # not ours any more (a link put in its place) or gone: only forgotten
+        if target.is_symlink() or not _exists(target) or name not in manifest.fingerprints:
+            continue  # a link put in its place, gone, or listed without a fingerprint: only forgotten
+        if not manifest.is_ours(out, name):
+            continue  # someone's file under that name, or changed since: only forgotten
         if target.is_dir():
             shutil.rmtree(target)
         else:
@@ -322,6 +429,7 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
         manifest.parts[p] -= set(names)
     manifest.parts[part] = set(names)
     manifest.files -= set(names) | stale
+    manifest.fingerprints.update(prints)
     manifest.write(out)
 
 
@@ -329,7 +437,7 @@ def check_output_file(file: Path, flag: str = "--out") -> None:
     """Refuse, before any work, a single output ``file`` that is a folder, a symbolic link, or an existing file
     linkwork did not write (not listed in the :data:`MANIFEST` of its folder)."""
     file = Path(file)
-    with _unwritable_place(file, flag):
+    with _unwritable_place(file, flag), _lock_if_folder(file.absolute().parent):
         _check_output_file(file, flag)
 
 
@@ -351,6 +459,12 @@ def _check_output_file(file: Path, flag: str) -> None:
         raise SpecError(
             f"{flag} {_shown(file)}: is one of the results of a linkwork run in that folder ({runs[0]}, listed in "
             f"{MANIFEST}), which other commands read back; choose another file name"
+        )
+    if _exists(file) and manifest.changed(file.absolute().parent, file.name):
+        raise SpecError(
+            f"{flag} {_shown(file)}: holds something else than linkwork wrote there (changed since, or listed by "
+            f"a {MANIFEST} copied from elsewhere); move it away or choose another file (linkwork never overwrites "
+            "what it did not write)"
         )
     if _exists(file) and file.name not in manifest.owned():
         raise SpecError(
@@ -374,15 +488,19 @@ def write_file(file: str | Path, write: Callable[[Path], Any], *, flag: str = "-
                 if not _is_write_error(exc, tmp):
                     raise
                 raise _write_failed(exc, file, flag, tmp) from None
-            check_output_file(file, flag)
             folder = file.absolute().parent
             try:
-                os.replace(tmp, file)
-                manifest = Manifest.read(folder)
-                manifest.files.add(file.name)
-                for names in manifest.parts.values():
-                    names.discard(file.name)
-                manifest.write(folder)
+                written = fingerprint(tmp)
+                with folder_lock(folder):  # the manifest read, changed and written by one command at a time
+                    with _unwritable_place(file, flag):
+                        _check_output_file(file, flag)
+                    os.replace(tmp, file)
+                    manifest = Manifest.read(folder)
+                    manifest.files.add(file.name)
+                    manifest.fingerprints[file.name] = written
+                    for names in manifest.parts.values():
+                        names.discard(file.name)
+                    manifest.write(folder)
             except OSError as exc:
                 raise _write_failed(exc, file, flag, tmp) from None
     finally:

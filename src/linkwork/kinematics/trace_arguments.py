@@ -14,9 +14,12 @@ from collections.abc import Mapping
 from numbers import Integral, Real
 from typing import Any
 
-from linkwork.errors import SpecError
+import numpy as np
 
-__all__ = ["check_trace_arguments"]
+from linkwork.errors import SpecError
+from linkwork.limits import MAX_TRACE_STEPS
+
+__all__ = ["check_trace_arguments", "check_trace_subject"]
 
 
 def _real(name: str, value: Any, unit: str, *, positive: bool = False, finite: bool = True) -> float:
@@ -32,11 +35,29 @@ def _real(name: str, value: Any, unit: str, *, positive: bool = False, finite: b
     return x
 
 
-def _count(name: str, value: Any, low: int) -> int:
-    """``value`` as an int of at least ``low``, or a SpecError naming ``name`` (a whole number, not a float)."""
-    if isinstance(value, bool) or not isinstance(value, Integral) or int(value) < low:
-        raise SpecError(f"{name}={value!r}: expected a whole number >= {low}")
+def _count(name: str, value: Any, low: int, high: int = MAX_TRACE_STEPS) -> int:
+    """``value`` as an int from ``low`` to ``high``, or a SpecError naming ``name`` (a whole number, not a
+    float). The top is the command line's (``--max-steps``): ``max_steps=2**70`` was numpy's "Maximum allowed
+    dimension exceeded"."""
+    if isinstance(value, bool) or not isinstance(value, Integral) or not low <= int(value) <= high:
+        raise SpecError(f"{name}={value!r}: expected a whole number, {low} <= {name} <= {high}")
     return int(value)
+
+
+def check_trace_subject(mech: Any, branches: Any, progress: Any) -> None:
+    """Refuse, with one :class:`SpecError` naming the argument, a ``mech`` that is not a
+    :class:`~linkwork.kinematics.mechanism.Mechanism` (a name or a path: ``lw.load`` makes one), a ``branches``
+    that is not a bool (``"no"`` is true) and a ``progress`` that cannot be called: each was a raw
+    ``AttributeError`` or ``TypeError`` from inside the trace."""
+    from linkwork.kinematics.mechanism import Mechanism
+
+    if not isinstance(mech, Mechanism):
+        hint = " (lw.load(NAME or FILE) makes one)" if isinstance(mech, str) else ""
+        raise SpecError(f"mech={mech!r:.80}: expected a Mechanism{hint}")
+    if not isinstance(branches, bool | np.bool_):  # numpy's bool too
+        raise SpecError(f"branches={branches!r:.80}: expected True or False")
+    if progress is not None and not callable(progress):
+        raise SpecError(f"progress={progress!r:.80}: expected a function progress(done, total) or None")
 
 
 def check_trace_arguments(
@@ -60,8 +81,10 @@ def check_trace_arguments(
         _real("until", until[1], "radians, or a length for a prismatic joint")
     if steps is not None:
         _count("steps", steps, 1)
-    _real("max_step", max_step, "radians", positive=True)
-    _real("min_step", min_step, "radians", positive=True)
+    largest = _real("max_step", max_step, "radians", positive=True)
+    smallest = _real("min_step", min_step, "radians", positive=True)
+    if largest < smallest:  # every step would be refused as too small: the budget spent advancing nothing
+        raise SpecError(f"max_step={max_step!r}: expected at least min_step ({min_step!r} radians)")
     turn = _real("max_turn", max_turn, "radians", positive=True)
     if turn > math.pi:
         raise SpecError(f"max_turn={max_turn!r}: expected a positive finite number up to pi (radians)")

@@ -28,7 +28,7 @@ from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.records import record
 from linkwork.kinematics.stops import End, StopReason
-from linkwork.kinematics.trace_arguments import check_trace_arguments
+from linkwork.kinematics.trace_arguments import check_trace_arguments, check_trace_subject
 from linkwork.kinematics.trace_result import Branch, Trace
 from linkwork.kinematics.trace_stats import TraceStats
 from linkwork.kinematics.workspace import Workspace
@@ -87,6 +87,7 @@ def trace(
     A target that is not reached (the path closes or folds back first, or ends for another reason) does not
     raise: ``stats.unmet`` then says why in one line (the command line exits with code 3 on it).
     """
+    check_trace_subject(mech, branches, progress)
     check_trace_arguments(until, steps, max_step, min_step, max_turn, max_steps, limits, closure_tol)
     # Plain Python numbers from here on: a numpy int32 or float32 would make numba compile the kernels again.
     max_step, min_step, max_steps = float(max_step), float(min_step), int(max_steps)

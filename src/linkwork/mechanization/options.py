@@ -19,7 +19,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from linkwork.errors import SpecError
 from linkwork.geometry.polygon import contains, is_simple
-from linkwork.limits import MAX_MAGNITUDE
+from linkwork.limits import MAX_MAGNITUDE, plain_number
+from linkwork.limits import MECHANIZE as MECHANIZE_LIMITS
 from linkwork.messages import show
 from linkwork.progress import Progress
 
@@ -387,7 +388,19 @@ def _checked(key: str, value: Any) -> Any:
     checked = check(value)
     if checked is None:
         raise _error(expected, value)
+    limit = MECHANIZE_LIMITS.get(key)  # the flag's upper bound (linkwork.limits.MECHANIZE), for the key too
+    if limit is not None and float(value) > limit.upper:
+        raise _error(f"{expected}, at most {limit.upper:g} (as --{key.replace('_', '-')})", value)
     return checked
+
+
+def _typed(text: str) -> float:
+    """A coordinate of ``--ground-region`` as :data:`linkwork.limits.PLAIN_NUMBER` reads it (spaces around it
+    allowed), else ``ValueError``."""
+    number = plain_number(text.strip())
+    if number is None:
+        raise ValueError(text)
+    return number
 
 
 def parse_region_flag(text: str | None) -> Any:
@@ -397,10 +410,10 @@ def parse_region_flag(text: str | None) -> Any:
     t = text.strip()
     if t.lower() == "inside":
         return "inside"
-    try:
+    try:  # numbers as a person types them (limits.PLAIN_NUMBER, as --until): not 1_0 or other scripts' digits
         if ";" in t:
-            return [[float(c) for c in vertex.split(",")] for vertex in t.split(";") if vertex.strip()]
-        return [float(v) for v in t.split(",")]
+            return [[_typed(c) for c in vertex.split(",")] for vertex in t.split(";") if vertex.strip()]
+        return [_typed(v) for v in t.split(",")]
     except ValueError:
         raise SpecError(
             f"{text!r}: expected inside, XMIN,YMIN,XMAX,YMAX or X1,Y1;X2,Y2;X3,Y3 (a polygon)",

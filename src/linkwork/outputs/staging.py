@@ -74,7 +74,14 @@ class _SummaryConsole(Console):
     def print(self, *objects: Any, **options: Any) -> None:
         """Print as rich does, with the control characters of every plain string escaped (``\\x1b``) but line
         breaks and tabs: a path or a name a user gave (``-o $'a\\x1b[31m'``) can never send escape sequences to
-        the terminal or move the cursor (``\\r``) from a summary line."""
+        the terminal or move the cursor (``\\r``) from a summary line.
+
+        A line of text is never broken by the console (``soft_wrap``): with ``COLUMNS=10`` in the environment of
+        a pipe, rich broke ``wrote ... to /tmp/a-long/folder/`` inside the path and the file names, so a script
+        reading the line read another path; a terminal still wraps a long line for the eye. Tables keep the
+        console's width."""
+        if "soft_wrap" not in options and all(isinstance(o, str | Text) for o in objects):
+            options["soft_wrap"] = True
         super().print(*(_escaped(o) if isinstance(o, str) else o for o in objects), **options)
 
     def on_broken_pipe(self) -> None:

@@ -20,6 +20,7 @@ import numpy as np
 
 from linkwork.errors import LinkworkError, SpecError
 from linkwork.io.toml_reader import TomlReader
+from linkwork.limits import plain_number
 from linkwork.progress import Progress
 from linkwork.studies.engine import RunStatus, default_workers, map_chunks
 from linkwork.studies.study_file import Study
@@ -138,10 +139,8 @@ def parse_criteria(table: Any, source: str) -> Criteria:
     if "deployed_at" in table:
         text = table["deployed_at"]
         name, sep, raw = str(text).partition("=")
-        try:
-            value = float(raw)
-        except ValueError:
-            value = math.nan
+        number = plain_number(raw)  # the rule of --deployed-at: 1_0 and other scripts' digits are not numbers
+        value = math.nan if number is None else number
         if not isinstance(text, str) or not sep or not name.strip() or not math.isfinite(value):
             raise reader.error("criteria.deployed_at", f'expected "JOINT=VALUE" (degrees), got {text!r}')
         deployed_at = (name.strip(), value)

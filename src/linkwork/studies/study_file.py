@@ -29,7 +29,7 @@ import numpy as np
 from linkwork import limits
 from linkwork.errors import SpecError
 from linkwork.io.toml_reader import MAX_NAME_CHARS, TomlReader, read_toml, show
-from linkwork.limits import Limit
+from linkwork.limits import Limit, plain_number
 from linkwork.names import name_problem
 from linkwork.synthesis.problem import MAX_AUTO_SEGMENTS, MAX_PIECES, MAX_STARTS
 
@@ -270,10 +270,8 @@ def _check_design(reader: TomlReader, value: Any, where: str, values: list[Any])
 
 def _parse_until(reader: TomlReader, text: Any) -> tuple[str, float]:
     name, sep, raw = str(text).partition("=")
-    try:
-        value = float(raw)
-    except ValueError:
-        value = float("nan")
+    number = plain_number(raw)  # the rule of --until: 1_0 and other scripts' digits are not numbers
+    value = float("nan") if number is None else number
     if not isinstance(text, str) or not sep or not name.strip() or not np.isfinite(value):
         raise reader.error("trace.until", f'expected "JOINT=VALUE" (degrees), got {show(text)}')
     return name.strip(), value
