@@ -28,30 +28,22 @@ BAR_COMPOSED = "b\u00e2r"  # bâr
 BAR_DECOMPOSED = "ba\u0302r"
 
 
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "specs" / "four-bar.toml"
+
+
 def four_bar(joint_b: str, joint_c: str, crank_1: str, crank_2: str) -> str:
     """The crank-rocker of examples/specs/four-bar.toml with joints ``A, joint_b, joint_c, D`` and the crank's
     body written ``crank_1`` at joint A and ``crank_2`` at joint B."""
-    return f"""
-name = "four-bar"
-[mechanism]
-planar = true
-[[mechanism.joints]]
-name = "A"
-bodies = ["ground", "{crank_1}"]
-point = [0.0, 0.0]
-[[mechanism.joints]]
-name = "{joint_b}"
-bodies = ["{crank_2}", "coupler"]
-point = [1.0, 1.0]
-[[mechanism.joints]]
-name = "{joint_c}"
-bodies = ["coupler", "rocker"]
-point = [3.5, 3.0]
-[[mechanism.joints]]
-name = "D"
-bodies = ["rocker", "ground"]
-point = [4.0, 0.0]
-"""
+    text = EXAMPLE.read_text(encoding="utf-8")
+    for old, new in [
+        ('name = "B"', f'name = "{joint_b}"'),
+        ('name = "C"', f'name = "{joint_c}"'),
+        ('bodies = ["ground", "crank"]', f'bodies = ["ground", "{crank_1}"]'),
+        ('bodies = ["crank", "coupler"]', f'bodies = ["{crank_2}", "coupler"]'),
+    ]:
+        assert text.count(old) == 1, old  # the example as this test reads it
+        text = text.replace(old, new)
+    return text
 
 
 def test_the_two_forms_differ_as_strings_and_not_as_names() -> None:
