@@ -13,7 +13,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +25,7 @@ from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
 from linkwork.kinematics.mechanism import Mechanism
+from linkwork.kinematics.own_frame import arguments_in_own_frame, own_frame, trace_from_own_frame, twin
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.records import record
 from linkwork.kinematics.stops import End, StopReason
@@ -103,10 +104,15 @@ def trace(
             f"steps ({steps}, --steps) equal drive steps to until need more than the step budget max_steps "
             f"({max_steps}, --max-steps); expected steps <= max_steps"
         )
-    tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     # The kernels of the whole trace, chosen once (compiled or loaded before the clock starts, or plain Python).
     backend = select_backend(warm_up=warm_up)
     started = time.perf_counter()
+    if own_frame(mech).used:  # far from its own frame: decided in it (see linkwork.kinematics.own_frame)
+        return _trace_in_own_frame(
+            mech, drive, until, steps, limits, tol, closure_tol, backend, started, max_step=max_step,
+            min_step=min_step, max_turn=max_turn, max_steps=max_steps, branches=branches, progress=progress,
+        )  # fmt: skip
+    tol = tol if closure_tol is None else tol.with_closure(closure_tol)
     start = _path_start(
         mech, backend, tol
     )  # (its rank and tangent do not use the corrector's round-off levels)
@@ -151,6 +157,49 @@ def trace(
         marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
     marcher.follow_queue()
     return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+
+
+def _trace_in_own_frame(
+    mech: Mechanism,
+    drive: str | int | None,
+    until: tuple[str | int, float] | None,
+    steps: int | None,
+    limits: Mapping[str, tuple[float, float]] | None,
+    tol: Tolerances,
+    closure_tol: float | None,
+    backend: Backend,
+    started: float,
+    **options: Any,
+) -> Trace:
+    """:func:`trace` of ``mech`` through its twin in its own frame (:mod:`linkwork.kinematics.own_frame`): the
+    arguments checked on ``mech`` (errors in the user's units), the start's closure too, then traced as the twin
+    and reported back in the user's units with the user's singular values (``closure_tol``: the call's, in the user's unit)."""
+    _limits_in_unknowns(mech, limits)  # refused in the user's units
+    user_tol = tol if closure_tol is None else tol.with_closure(closure_tol)
+    r0 = start_point(mech, backend)[0]
+    if r0 > user_tol.start_slack * user_tol.closure:
+        raise LinkworkError(f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first")
+    until_own, limits_own, tol_own, closure_own = arguments_in_own_frame(
+        mech, until, limits, tol, closure_tol
+    )
+    result = trace(
+        twin(mech),
+        drive,
+        until_own,
+        steps,
+        limits=limits_own,
+        tol=tol_own,
+        closure_tol=closure_own,
+        **options,
+    )
+    out = trace_from_own_frame(mech, result, Workspace.of(mech, backend), user_tol.closure)
+    unmet = out.stats.unmet
+    if until is not None and unmet is not None:  # the verdict's line again, in the user's units
+        first = out.branches[0]
+        end = End(first.end_kind or StopReason.BUDGET, first.end_reason, first.end_joint, first.end_value)
+        on_branch = [out.angles[out.branch == 0], *[f.angles[None, :] for f in out.folds if f.branch == 0]]
+        unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
+    return replace(out, stats=replace(out.stats, unmet=unmet, seconds=time.perf_counter() - started))
 
 
 def start_point(mech: Mechanism, backend: Backend) -> tuple[float, Array, Array, Array]:
