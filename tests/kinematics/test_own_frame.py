@@ -193,3 +193,30 @@ def test_prismatic_targets_limits_and_verdicts_are_in_the_users_unit() -> None:
     numbers = [float(x) for x in re.findall(r"-?\d+\.?\d*", unmet.split("never reaches", 1)[1])]
     assert numbers[0] == pytest.approx(5000.0)
     assert numbers[-2:] == pytest.approx([2000.0, 4000.0], abs=1e-3)
+
+
+def test_play_in_the_hinges_traces_the_same_in_any_unit_and_placement() -> None:
+    """A Bennett linkage 1e-6 off its exact geometry (rigid without play) with play: the same play relative to its
+    size gives the same path in thousands, in thousands far away and in thousandths (the twin compares a rotation
+    misfit with ``TOL / L``)."""
+    mech = lw.load("bennett")
+    rng = np.random.default_rng(0)
+    twists = mech.twists.copy()
+    twists[:, 3:] += 1e-6 * rng.normal(size=(4, 3))
+    imperfect = replace(mech, twists=twists, hinge_points=np.zeros((0, 3)))
+    with pytest.raises(lw.LinkworkError, match="rigid"):
+        lw.trace(imperfect)
+    paths = []
+    for scale, shift in [
+        (1e3, np.zeros(3)),
+        (1e3, np.array([5e3, 0.0, 0.0])),
+        (1e-3, np.array([0.01, 0.02, 0.0])),
+    ]:
+        variant = placed(imperfect, scale, shift)
+        assert own_frame(variant).used
+        path = lw.trace(variant, closure_tol=1e-5 * scale)
+        assert path.stats.closure_tol == pytest.approx(1e-5 * scale)
+        paths.append(path)
+    for path in paths[1:]:
+        assert path.angles.shape == paths[0].angles.shape
+        np.testing.assert_allclose(wrapped(path.angles - paths[0].angles), 0.0, atol=1e-9)
