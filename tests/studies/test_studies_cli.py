@@ -190,3 +190,38 @@ def test_robustness_short_of_until_keeps_the_study_and_exits_3(tmp_path):
     assert summary["samples"] == 10
     # where it says it stopped is the last point of the study's drive grid (degrees)
     assert stopped == pytest.approx(summary["bands"]["drive_deg"][-1], abs=1e-4)
+
+
+def test_robustness_prints_the_normalised_ratio_beside_the_papers(tmp_path):
+    """The four-bar example written in millimetres 25 m from the origin: the paper's (raw) ratio grows with the
+    distance and the unit, the normalised one printed beside it is the unit file's, and both are robustness.json's."""
+    text = (SPECS / "four-bar.toml").read_text()
+    far = re.sub(
+        r"point = \[([-0-9.]+), ([-0-9.]+)\]",
+        lambda m: f"point = [{float(m[1]) * 1000 + 25000.0}, {float(m[2]) * 1000 - 12000.0}]",
+        text,
+    )
+    (tmp_path / "far.toml").write_text(far)
+    lines = {}
+    for name, spec, tol in (
+        ("unit", str(SPECS / "four-bar.toml"), "0.001"),
+        ("far", str(tmp_path / "far.toml"), "1"),
+    ):
+        out = tmp_path / name
+        res = invoke(
+            "robustness", spec, "--samples", "10", "--hinge-position-tol", tol, "--hinge-direction-tol", "0.01",
+            "--workers", "0", "-o", str(out),
+        )  # fmt: skip
+        assert res.exit_code == 0, res.stderr
+        bands = json.loads((out / "robustness.json").read_text())["bands"]
+        line = next(x for x in ANSI.sub("", res.stdout).splitlines() if x.startswith("Sec. 5 ratio"))
+        found = re.search(r"\): ([-+.\deE]+); normalised \(.*\) ([-+.\deE]+)$", line)
+        assert found, line
+        paper, normalised = float(found[1]), float(found[2])
+        lines[name] = (paper, normalised)
+        assert paper == pytest.approx(max(v for v in bands["ratio"] if v is not None), rel=1e-3)
+        assert normalised == pytest.approx(
+            max(v for v in bands["ratio_normalised"] if v is not None), rel=1e-3
+        )
+    assert lines["far"][1] == pytest.approx(lines["unit"][1], rel=1e-3)
+    assert lines["far"][0] > 1e4 * lines["unit"][0]

@@ -158,6 +158,14 @@ def print_robustness_summary(summary: dict[str, Any]) -> None:
         )
     if np.any(np.isfinite(ratio)):
         k = int(np.nanargmax(ratio))
+        normalised = np.array([np.nan if v is None else v for v in b.get("ratio_normalised", [])], dtype=float)
+        # The paper's ratio is the raw Jacobian's: it grows with the distance from the file's origin and with the
+        # unit; the normalised one (moments about the hinge centre, lengths in L) does not.
+        own = (
+            f"; normalised (moments about the hinge centre, lengths in L) {np.nanmax(normalised):.4g}"
+            if normalised.size and np.any(np.isfinite(normalised))
+            else ""
+        )
         console.print(
-            f"Sec. 5 ratio largest at {summary['drive']} = {b[key][k]:.5g}{unit} (point {k}): {ratio[k]:.4g}"
+            f"Sec. 5 ratio largest at {summary['drive']} = {b[key][k]:.5g}{unit} (point {k}): {ratio[k]:.4g}{own}"
         )
