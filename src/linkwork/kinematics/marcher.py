@@ -946,6 +946,23 @@ class BranchMarcher:
         if known is None:
             bif = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u_star, width, cfg)
             if bif.kind != "component" and bif.rank >= cfg.r_path:
+                # No rank drop where the test function vanishes: next to a bifurcation opened by an imperfection
+                # (an over-constrained loop written with rounded numbers) the path turns sharply and the test
+                # function changes sign there, while the rank drops at the nearest approach, within the step.
+                u_min, r_min = locate_minimum(
+                    self.ws,
+                    chunk.u[c - 2],
+                    chunk.t[c - 2],
+                    chunk.u[c - 1],
+                    chunk.t[c - 1],
+                    cfg.r_path,
+                    cfg.tol,
+                )
+                if r_min <= cfg.tol.loose and self._match(u_min) is None:
+                    bif = classify_point(
+                        self.mech, self.ws, len(self.found), branch_id, step, u_min, 0.0, cfg
+                    )
+            if bif.kind != "component" and bif.rank >= cfg.r_path:
                 self.spurious += (
                     1  # the test function changed sign without a rank drop: not a point to report
                 )

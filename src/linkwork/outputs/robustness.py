@@ -158,7 +158,9 @@ def print_robustness_summary(summary: dict[str, Any]) -> None:
         )
     if np.any(np.isfinite(ratio)):
         k = int(np.nanargmax(ratio))
-        normalised = np.array([np.nan if v is None else v for v in b.get("ratio_normalised", [])], dtype=float)
+        normalised = np.array(
+            [np.nan if v is None else v for v in b.get("ratio_normalised", [])], dtype=float
+        )
         # The paper's ratio is the raw Jacobian's: it grows with the distance from the file's origin and with the
         # unit; the normalised one (moments about the hinge centre, lengths in L) does not.
         own = (

@@ -1,0 +1,55 @@
+"""An over-constrained linkage written with rounded numbers keeps its bifurcations.
+
+Guest's frame (and the rectangular frame) has six bifurcation points on its paths. Written with every hinge line
+moved by 1e-12 or 1e-11 of its size (what 12 significant digits, or coordinates far from the origin, leave) the
+loop is strictly a slightly different linkage whose crossings open into near misses: the path turns sharply at
+each, the test function changes sign where it turns, and the Jacobian's rank drops at the nearest approach within
+that step, not where the test function vanishes. Before, the located zero had ``sigma_5 / sigma_1`` near 2e-4, the
+sign change was counted "without a rank drop" and the bifurcations were lost (two or none of six at 1e-12). The
+points found must be the exact frame's (configurations within 1e-4 rad), each a rank drop, and every crossing the
+traced path passes must be found (four to six of the six, as each opens).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from bookkeeping_reference import wrapped
+
+import linkwork as lw
+from linkwork.kinematics.mechanism import Mechanism
+
+
+def rounded(mech: Mechanism, size: float, seed: int) -> Mechanism:
+    """``mech`` with every hinge line's moment moved by ``size`` (random, seeded): a written imperfection."""
+    rng = np.random.default_rng(seed)
+    twists = mech.twists.copy()
+    twists[:, 3:] += size * rng.normal(size=twists[:, 3:].shape)
+    return replace(mech, twists=twists, hinge_points=np.zeros((0, 3)))
+
+
+@pytest.mark.parametrize("name", ["guest-frame", "rect-frame"])
+@pytest.mark.parametrize("size", [1e-12, 1e-11])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_rounded_frame_keeps_every_bifurcation(name: str, size: float, seed: int) -> None:
+    exact = lw.trace(lw.load(name), branches=True)
+    assert len(exact.bifurcations) == 6
+    imperfect = lw.trace(rounded(lw.load(name), size, seed), branches=True)
+    # Each crossing opens one way or the other: the nearest approach has two real branch tangents (a bifurcation,
+    # branches leave it) or none (the path touches the singular set and turns back: a "fold" point, and the
+    # branches beyond it are not on this path).
+    assert {b.kind for b in imperfect.bifurcations} <= {"bifurcation", "fold"}
+    assert imperfect.stats.sign_changes_without_rank_drop == 0
+    for point in imperfect.bifurcations:  # each one of the exact frame's, and a rank drop where reported
+        distance = min(float(np.abs(wrapped(point.angles - b.angles)).max()) for b in exact.bifurcations)
+        assert distance < 1e-4
+        assert point.sigma[point.rank] < 1e-4 * point.sigma[0]
+    for b in exact.bifurcations:  # every crossing the traced path passes is located
+        passes = np.abs(wrapped(imperfect.angles - b.angles)).max(axis=1).min() < 0.05
+        if passes:
+            assert (
+                min(float(np.abs(wrapped(p.angles - b.angles)).max()) for p in imperfect.bifurcations) < 1e-4
+            )
+    assert len(imperfect.bifurcations) >= 4
