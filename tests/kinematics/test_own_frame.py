@@ -137,6 +137,7 @@ def assert_same_linkage_traced(
         if all(b.kind != "component" for b in reference.bifurcations):
             assert [b.kind for b in variant.bifurcations] == [b.kind for b in reference.bifurcations]
         assert len(variant.folds) == len(reference.folds)
+        assert [b.end_kind for b in variant.branches] == [b.end_kind for b in reference.branches]
         return
     assert variant.angles.shape == reference.angles.shape
     revolute = np.array([t == "R" for t in reference.mechanism.joint_types])

@@ -44,6 +44,12 @@ OWN_FRAME_GATE = 10.0
 its own frame; below it, the raw ratios are within this factor of the twin's."""
 
 
+ROUNDOFF_CARRIED = 100.0
+"""In the twin, a residual that stalls below this many times the round-off the file's coordinates carry into it
+(``eps (|c| + L) / L``) is accepted as closed: Hedgepeth's hoop in thousandths 42 units from the origin carries
+3e-11 of its size and stalled at 1.4e-9 (raw) before its path closed."""
+
+
 @dataclass(frozen=True)
 class OwnFrame:
     """A linkage's own frame: its hinge ``centre (3,)`` and ``length`` at the start, the condition number ``kappa``
@@ -126,7 +132,8 @@ def arguments_in_own_frame(
 ) -> tuple[tuple[str | int, float] | None, dict[str, tuple[float, float]] | None, Tolerances, float | None]:
     """A trace's ``until``, ``limits`` and tolerances for the twin of ``mech`` (checked on ``mech`` already):
     lengths divided by the linkage's own length, the start's closure checked already (so not again on the twin,
-    whose start carries the raw start's residual in its own unit)."""
+    whose start carries the raw start's residual in its own unit), and a stalled residual accepted at the
+    round-off the file's coordinates carry (:data:`ROUNDOFF_CARRIED`)."""
     frame = own_frame(mech)
     scale = frame.joint_scale
     if until is not None:
@@ -139,7 +146,13 @@ def arguments_in_own_frame(
     else:
         limits = None
     play = tol.closure > tol.exact  # a length the user gave (play in the hinges): in the linkage's unit too
-    tol = replace(tol, start_slack=math.inf, closure=tol.closure / frame.length if play else tol.closure)
+    closure = tol.closure / frame.length if play else tol.closure
+    # The twin's geometry carries the file's round-off: coordinates |c| from the origin hold each number to
+    # eps |c|, which is eps (|c| + L) / L of the linkage's size, and a residual stalling at a hundred times that
+    # is closed (as `roundoff` accepts a hundred times the round-off of a loop of unit size).
+    carried = np.finfo(float).eps * (float(np.linalg.norm(frame.centre)) + frame.length) / frame.length
+    roundoff = max(tol.roundoff, ROUNDOFF_CARRIED * carried / max(closure, tol.exact))
+    tol = replace(tol, start_slack=math.inf, closure=closure, roundoff=roundoff)
     if closure_tol is not None:
         closure_tol = closure_tol / frame.length
     return until, limits, tol, closure_tol
