@@ -53,3 +53,19 @@ def test_a_rounded_frame_keeps_every_bifurcation(name: str, size: float, seed: i
                 min(float(np.abs(wrapped(p.angles - b.angles)).max()) for p in imperfect.bifurcations) < 1e-4
             )
     assert len(imperfect.bifurcations) >= 4
+
+
+@pytest.mark.parametrize("size", [1e-13, 1e-12])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_rounded_sarrus_linkage_meets_its_components_once(size: float, seed: int) -> None:
+    """Sarrus's linkage meets two 2-dimensional components (its two planar four-bar motions) at four points.
+    Rounded, the corrected samples around those points no longer all converge; the small sphere around one then
+    met the solution set in a curve (34 lines), each line was traced as a branch, and each branch entered the
+    component at a point of its own: 138 points and 135 branches at 1e-13. A continuum of lines is a component."""
+    exact = lw.trace(lw.load("sarrus"), branches=True)
+    imperfect = lw.trace(rounded(lw.load("sarrus"), size, seed), branches=True)
+    assert len(imperfect.bifurcations) <= len(exact.bifurcations)
+    assert len(imperfect.branches) <= len(exact.branches) + 1
+    for point in imperfect.bifurcations:
+        distance = min(float(np.abs(wrapped(point.angles - b.angles)).max()) for b in exact.bifurcations)
+        assert distance < 1e-3

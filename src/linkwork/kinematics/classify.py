@@ -35,6 +35,9 @@ Array = NDArray[np.float64]
 COMPONENT_SAMPLES = 12
 #: Distance (in the unknowns) of those samples from the point.
 COMPONENT_RADIUS = 1e-3
+#: More lines through a point than this, found by sampling a small sphere around it, are a continuum: a
+#: rounded Sarrus linkage's point where two 2-dimensional components meet gave 34, and as many branches each way.
+CONTINUUM_LINES = 4
 #: How far (in the unknowns) a located point may move onto the singular point next to it.
 NODE_RADIUS = 1e-2
 
@@ -99,6 +102,12 @@ def classify_point(
             if moved is not None:
                 width = float(np.linalg.norm(moved[0] - u))
                 u, (tangents_u, method, rank, sigma) = moved
+        if method == "sphere" and len(tangents_u) > CONTINUUM_LINES:
+            # The solution set crosses the small sphere in a curve, not in a few points: a continuum of
+            # directions leaves the point, which lies on a set of dimension 2 or more (a component whose
+            # corrected samples did not all converge: an over-constrained loop written with rounded numbers).
+            dim, method = 2, "component"
+            tangents_u = np.zeros((0, len(u)))
         if len(tangents_u) == 2:
             polished, gap, accuracy = polish(ws, u, tangents_u, tol)
             if np.isfinite(gap) and gap < tol.polish_gap:
