@@ -69,3 +69,21 @@ def test_a_rounded_sarrus_linkage_meets_its_components_once(size: float, seed: i
     for point in imperfect.bifurcations:
         distance = min(float(np.abs(wrapped(point.angles - b.angles)).max()) for b in exact.bifurcations)
         assert distance < 1e-3
+
+
+@pytest.mark.parametrize("name", ["bennett", "goldberg", "hedgepeth"])
+@pytest.mark.parametrize("size", [1e-10, 1e-9])
+def test_a_loop_rigid_by_a_hair_says_what_play_lets_it_move(name: str, size: float) -> None:
+    """Written to ten digits or fewer an over-constrained loop is rigid: its least-squares path's misfit grows
+    until the corrector fails. The end says how well the loop closes there and suggests a closure tolerance,
+    with which the path closes (checked: the misfit met stays below it)."""
+    loop = rounded(lw.load(name), size, 1)
+    failed = lw.trace(loop)
+    end = failed.branches[0]
+    assert end.end_kind == lw.StopReason.FAILED
+    assert "rigid by a hair" in end.end_reason
+    play = float(end.end_reason.rsplit(" ", 1)[1])
+    assert 10.0 * size <= play <= 1e4 * size
+    moved = lw.trace(loop, closure_tol=play)
+    assert moved.branches[0].end_kind == lw.StopReason.CLOSED
+    assert size / 10.0 < moved.stats.max_misfit < play

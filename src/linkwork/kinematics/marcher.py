@@ -157,6 +157,13 @@ class QueuedBranch:
     direction: int
 
 
+PLAY_PROBE = 1e-6
+PLAY_MARGIN = 100.0
+"""The play an adaptive march that failed is probed with (:meth:`BranchMarcher._closure_floor`): a loop that closes
+no better than this just ahead has met something else than rounded numbers. ``PLAY_MARGIN``: the play suggested
+then, over the misfit met (rounded up to a power of ten)."""
+
+
 class BranchMarcher:
     """Traces branches and collects their points, bifurcation points, folds and the branch graph."""
 
@@ -819,13 +826,43 @@ class BranchMarcher:
         if chunk.code == StopReason.FAILED:
             if paper:
                 return "corrector failed at a fixed drive step (the drive cannot take that value here)"
-            return f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
+            text = f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
+            floor = self._closure_floor(chunk)
+            if floor is not None:
+                # The misfit of a loop moved off its exact geometry grows along the path (to about four times the
+                # imperfection on the built-ins): a hundred times the floor met here, to a power of ten.
+                play = 10.0 ** np.ceil(np.log10(PLAY_MARGIN * floor))
+                text += (
+                    f"; the loop closes no better than {floor:.1e} here: rigid by a hair (an over-constrained "
+                    f"loop written with rounded numbers?); accept play in the hinges, e.g. closure_tol / "
+                    f"--closure-tol {play:.0e}"
+                )
+            return text
         if chunk.code == StopReason.NO_PROGRESS:
             return (
                 f"no progress ({self.cfg.tol.stall_steps} steps advanced less than "
                 f"{self.cfg.tol.stall_length:g} of the largest step)"
             )
         return StopReason(chunk.code).text
+
+    def _closure_floor(self, chunk: Chunk) -> float | None:
+        """Where an adaptive march failed: the closure residual at its last row, or the least one reached a short
+        step (an eighth of the largest) ahead by Gauss-Newton until it stalls, when that is ten times the closure
+        tolerance or more (the march went on only by accepting stalled residuals) and below :data:`PLAY_PROBE`:
+        the loop is rigid by a hair there (a Bennett linkage written to ten digits stalled at 5.5e-11 and failed 83
+        deg along its path). ``None`` otherwise."""
+        c = chunk.count - 1
+        tol = self.cfg.tol
+        if c < 0 or tol.closure >= PLAY_PROBE:
+            return None
+        u, t = chunk.u[c], chunk.t[c]
+        length = float(np.linalg.norm(t * self.weight))
+        if not length > 0.0:
+            return None
+        step = (self.cfg.max_step / 8.0) / length
+        _, ahead, _ = correct_on_plane(self.ws, u + step * t, t, tol.with_closure(PLAY_PROBE))
+        floor = max(float(ahead), float(chunk.res[c]))
+        return floor if 10.0 * max(tol.closure, tol.exact) < floor < PLAY_PROBE else None
 
     def _record(self, chunk: Chunk, branch_id: int, first: bool, n_steps: int) -> None:
         """Append a chunk's rows (all of them for the branch's first chunk, else without its start row)."""
