@@ -104,6 +104,31 @@ def test_long_equal_steps_past_a_fold_end_at_its_turning_point(
     np.testing.assert_allclose(values, start + (target - start) / steps * np.arange(len(values)), atol=1e-9)
 
 
+TRIPLE = FourBar("triple-rocker", 4.0, 2.0, 3.5, 2.4, 20.0)  # its input A rocks in [-157.76, 157.76] deg
+
+
+GAP_CASES = {
+    # 20 -> 85 -> 150 -> 215: the last step, 65 deg, lands beyond the gap (157.76, 202.24) (= -145 deg)
+    "triple rocker, 3 x 65 deg": (TRIPLE.mech.toml(), "A", 20.0, TRIPLE.fold_refs("A"), 215.0, 3),
+    # one step of 340 deg (= -20 deg, inside the range) from 0
+    "crank-rocker, 1 x 340 deg": (CROCKER.mech.toml(), "D", 0.0, CROCKER.fold_refs("D"), 340.0, 1),
+    # one step of 330 deg (= 0 deg, inside the range) from 30
+    "spherical 4R, 1 x 330 deg": (SPHERE.toml(), "A", 30.0, CASES["spherical 4R at the input"][3], 360.0, 1),
+}
+
+
+@pytest.mark.parametrize("name", sorted(GAP_CASES))
+def test_a_long_step_across_the_gap_beyond_a_fold_is_not_a_reached_target(tmp_path: Path, name: str) -> None:
+    """A step that would land past the range's gap, where the drive's value comes round again, meets the fold as
+    short steps do. Was: 'reached target', the last row on the other side of the gap (the four-bars: in closed
+    form and by the predictor-corrector alike)."""
+    text, drive, start, extremes, target, steps = GAP_CASES[name]
+    trace = lw.trace(load(tmp_path, text), drive=drive, until=(drive, target * RAD), steps=steps)
+    assert trace.branches[0].end_kind == lw.StopReason.TURNING, (name, trace.branches[0].end_reason)
+    fold = expected_extreme(start, extremes, target)
+    assert [np.degrees(f.value) for f in trace.folds] == [pytest.approx(fold, abs=FOLD_TOL)]
+
+
 def test_the_command_line_exits_3_at_the_turning_point_of_three_long_steps(tmp_path: Path) -> None:
     """``linkwork trace --steps 3 --until D=-240`` of the crank-rocker driven at its rocker: 80-deg steps."""
     spec = tmp_path / "crank-rocker.toml"
