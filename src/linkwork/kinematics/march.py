@@ -598,6 +598,9 @@ def march(mech, start, steps, corrector, bounds, out):
         along = step * tn  # the prediction's length in that metric
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
+        # a part's drive value from the row's, not a running sum of parts (which drifts over many rows)
+        if paper and parts > 1 and not landing:
+            u_try[drive] = u_row[drive] + (h if part == parts - 1 else (part + 1) * (h / parts))
         if (
             paper and parts == 1
         ):  # the last two points and their tangents predict better than the tangent alone
