@@ -12,10 +12,12 @@ from linkwork.kinematics.mechanism import Mechanism
 
 
 def kernel_rows(
-    mech: Mechanism, until: tuple[str, float], steps: int
+    mech: Mechanism, until: tuple[str, float], steps: int, max_step: float | None = None
 ) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
     """``(arguments, outputs)`` of the compiled closed-form kernel on one paper-mode trace, whatever its status
-    (rows ``0 .. count - 1`` are the closed form's, also where it then handed the path over)."""
+    (rows ``0 .. count - 1`` are the closed form's, also where it then handed the path over). ``max_step``: the
+    trace's (default its own); a drive step longer than it is solved at points no further apart
+    (``dyads.closed_form_rows``), so the kernel sees ``steps`` steps only where each is at most ``max_step``."""
     from linkwork.kinematics import dyad_solver
 
     original = dyad_solver.closed_form_path
@@ -28,7 +30,7 @@ def kernel_rows(
 
     try:
         dyad_solver.closed_form_path = watched  # type: ignore[assignment]
-        lw.trace(mech, until=until, steps=steps)
+        lw.trace(mech, until=until, steps=steps, **({} if max_step is None else {"max_step": max_step}))
     finally:
         dyad_solver.closed_form_path = original
     assert seen, "the closed form was not tried"

@@ -25,9 +25,12 @@ def compiled(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("LINKWORK_JIT", "compiled")
 
 
-def kernel_call(mech: Mechanism, turn: float, steps: int) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
-    """``(arguments, outputs)`` of the closed-form kernel on a paper-mode trace of ``turn`` radians of joint A."""
-    return kernel_rows(mech, ("A", float(mech.offsets[mech.index("A")] + turn)), steps)
+def kernel_call(
+    mech: Mechanism, turn: float, steps: int, max_step: float | None = None
+) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+    """``(arguments, outputs)`` of the closed-form kernel on a paper-mode trace of ``turn`` radians of joint A
+    (``max_step``: see ``closed_form_probe.kernel_rows``)."""
+    return kernel_rows(mech, ("A", float(mech.offsets[mech.index("A")] + turn)), steps, max_step)
 
 
 def passes(args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -199,10 +202,11 @@ def test_a_path_back_at_its_start_ends_closed_where_the_march_would_see_it() -> 
 
 
 def test_a_drive_step_over_a_quarter_turn_ends_the_path_at_once() -> None:
-    """Three steps for a full turn (120 degrees each): the march reads a jump of more than 90 degrees at the first
-    step, so the kernel returns row 0 only, with JUMP (the tracer then decides)."""
+    """Three steps for a full turn (120 degrees each, with max_step 120 degrees: the kernel is given the three
+    steps): the march reads a jump of more than 90 degrees at the first step, so the kernel returns row 0 only,
+    with JUMP (the tracer then decides)."""
     mech = lw.load("four-bar")
-    args, (count, status, *_rest) = kernel_call(mech, np.radians(360.0), 3)
+    args, (count, status, *_rest) = kernel_call(mech, np.radians(360.0), 3, max_step=np.radians(120.0))
     assert (count, status) == (1, dyad_solver.JUMP)
     assert abs(args[2][0][dyad_solver.S_STEP]) > 0.5 * np.pi
 
@@ -278,9 +282,12 @@ def test_rpr_and_prp_dyads_equal_the_predictor_corrector(
 
 def test_a_drive_step_of_whole_turns_is_no_jump() -> None:
     """One step of two whole turns brings every body back where it was: the march reads the drive's step wrapped
-    (0), so the kernel reaches the target (2 rows) with the crank's value 720 degrees and every other joint at 0."""
+    (0), so the kernel reaches the target (2 rows) with the crank's value 720 degrees and every other joint at 0
+    (max_step 720 degrees: the kernel is given the one step)."""
     mech = lw.load("four-bar")
-    _args, (count, status, angles, *_rest) = kernel_call(mech, np.radians(720.0), 1)
+    _args, (count, status, angles, *_rest) = kernel_call(
+        mech, np.radians(720.0), 1, max_step=np.radians(720.0)
+    )
     assert (count, status) == (2, dyad_solver.CLEAN)
     q = angles[1] - mech.offsets
     a = mech.index("A")

@@ -312,7 +312,8 @@ def _arc_points(
 
 
 def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
-    """A DXF SPLINE flattened by ezdxf to ``tolerance`` times the size of its control points."""
+    """A DXF SPLINE flattened by ezdxf to ``tolerance`` times the size of its control points (refused when they
+    leave a plane z = constant by more than ``1e-9`` of their size)."""
     count = len(entity.control_points)
     order = int(entity.dxf.get("degree", 3)) + 1
     if count < max(2, order) and len(entity.fit_points) < 2:
@@ -321,10 +322,19 @@ def spline_points(entity: Any, tolerance: float, path: Path) -> Points:
             source=escape_line(str(path)),
         )
     spline = entity.construction_tool()
-    control = np.array([(v.x, v.y) for v in spline.control_points], dtype=float)
-    if not np.all(np.isfinite(control)) or np.abs(control).max() > MAX_COORDINATE:
+    control_xyz = np.array([(v.x, v.y, v.z) for v in spline.control_points], dtype=float).reshape(-1, 3)
+    control, heights = control_xyz[:, :2], control_xyz[:, 2]
+    if not np.all(np.isfinite(control_xyz)) or np.abs(control_xyz).max() > MAX_COORDINATE:
         raise SpecError(
             f"the SPLINE has a control point that is not finite or beyond +-{MAX_COORDINATE:g}",
+            source=escape_line(str(path)),
+        )
+    # A SPLINE is in world coordinates: its x and y are the profile only when it lies in a plane z = constant
+    # (as a 3-D POLYLINE's, read_profile_dxf); one that leaves it would be read as its projection.
+    if float(np.ptp(heights)) > 1e-9 * float(np.abs(control_xyz).max()):
+        raise SpecError(
+            f"the SPLINE's control points' z runs from {heights.min() + 0.0:g} to {heights.max() + 0.0:g}; expected a "
+            "profile drawn in a plane z = constant (its x and y are the profile)",
             source=escape_line(str(path)),
         )
     absolute = tolerance * bounding_size(control)

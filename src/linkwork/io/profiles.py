@@ -90,20 +90,28 @@ _CONTROLS = ("control1", "control2", "control")  # svgelements' names of Bézier
 
 
 def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> Points:
-    """Read a profile from a CSV file of ``x,y`` rows.
+    """Read a profile from a CSV file of ``x,y`` rows (or ``x,y,z`` rows of a curve in a plane z = constant).
 
-    A header row is optional; when present it must name an ``x`` and a ``y`` column once each (any order, any
-    other columns ignored). Without a header the first two columns are x and y. Every row has as many cells as
-    the header (or, without one, as the first row): a row with more is refused rather than read wrong, since a
-    thousands separator (``1,000.5``) or a decimal comma splits a number into two cells. Numbers are written
-    as CSV files write them (:func:`_csv_number`). Blank lines and lines starting with ``#`` are skipped.
-    ``tolerance`` is unused (the points are taken as they are).
+    A header row is optional; when present it must name an ``x`` and a ``y`` column once each (any order), and
+    at most one ``z`` column; other columns are ignored. Without a header the first two columns are x and y and
+    a third, if any, is z. A z column is read as DXF's 3-D polylines are (:func:`read_profile_dxf`): one whose
+    every value is the first row's (to ``1e-9`` of the curve's size) is dropped, since x and y are then the
+    curve; one that varies is refused, naming its first line off the plane, since x and y alone would be the
+    curve's projection, not the curve. Every row has as many cells as the header (or, without one, as the first
+    row): a row with more is refused rather than read wrong, since a thousands separator (``1,000.5``) or a
+    decimal comma splits a number into two cells. Numbers are written as CSV files write them
+    (:func:`_csv_number`). Blank lines and lines starting with ``#`` are skipped. ``tolerance`` is unused (the
+    points are taken as they are).
     """
     path = Path(path)
     source = escape_line(str(path))
     lines = _read_lines(path)
     x_col, y_col = 0, 1
+    z_col: int | None = None
+    header = False
     rows: list[tuple[float, float]] = []
+    # each row's line, z and z as written, when there is a z column
+    heights: list[tuple[int, float, str]] = []
     width: tuple[int, int] | None = None  # the cells of every row, and the line that set it
     for number, line in lines:
         cells = [cell.strip() for cell in line.split(",")]
@@ -114,18 +122,20 @@ def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
                     f"line {number}: header {_quoted(line)} names no x and y columns; expected e.g. 'x,y'",
                     source=source,
                 )
-            for column in ("x", "y"):
+            for column in ("x", "y", "z"):
                 if names.count(column) > 1:
                     raise SpecError(
                         f"line {number}: header {_quoted(line)} names column {column} {names.count(column)} times; "
-                        "expected one x and one y column",
+                        "expected one x and one y column (and at most one z)",
                         source=source,
                     )
             x_col, y_col = names.index("x"), names.index("y")
-            width = (len(cells), number)
+            z_col = names.index("z") if "z" in names else None
+            width, header = (len(cells), number), True
             continue
         if width is None:
             width = (len(cells), number)
+            z_col = 2 if len(cells) > 2 else None  # no header: x, y, z
         if len(cells) != width[0] and len(cells) > max(x_col, y_col):
             raise SpecError(
                 f"line {number}: {_cells(len(cells))} in {_quoted(line)}, but line {width[1]} has {width[0]}; "
@@ -142,8 +152,43 @@ def read_profile_csv(path: str | Path, tolerance: float = FLATTEN_TOLERANCE) -> 
             raise SpecError(
                 f"line {number}: expected numbers in columns x and y, got {_quoted(line)}", source=source
             )
+        if z_col is not None:
+            z = plain_number(cells[z_col])
+            if z is None:
+                raise SpecError(
+                    f"line {number}: expected a number in column {_z_column(z_col, header)}, got "
+                    f"{_quoted(cells[z_col])} in {_quoted(line)}",
+                    source=source,
+                )
+            heights.append((number, z, cells[z_col]))
         rows.append((x, y))
-    return np.array(rows, dtype=float).reshape(-1, 2)
+    points = np.array(rows, dtype=float).reshape(-1, 2)
+    if heights and z_col is not None:
+        _check_plane(points, heights, _z_column(z_col, header), source)
+    return points
+
+
+def _z_column(index: int, header: bool) -> str:
+    """How a message names a CSV file's z column: by its header's name, or by its place and meaning."""
+    return "z" if header else f"{index + 1} (z)"
+
+
+def _check_plane(points: Points, heights: list[tuple[int, float, str]], column: str, source: str) -> None:
+    """Refuse a curve whose z (``heights``: each row's line, z, and z as written) leaves the plane of its first
+    row by more than ``1e-9`` of the curve's size (the largest |x|, |y| or |z|), as a 3-D DXF polyline is."""
+    z = np.array([height for _, height, _ in heights])
+    finite = points[np.isfinite(points)]
+    size = max(float(np.abs(finite).max(initial=0.0)), float(np.abs(z[np.isfinite(z)]).max(initial=0.0)))
+    off = np.flatnonzero(~(np.abs(z - z[0]) <= 1e-9 * size))
+    if len(off) == 0:
+        return
+    number, _, written = heights[int(off[0])]
+    first, _, written0 = heights[0]
+    raise SpecError(
+        f"line {number}: column {column} is {written}, but line {first} has {written0}; expected a profile "
+        "drawn in a plane z = constant (a constant z column is dropped: x and y are the profile)",
+        source=source,
+    )
 
 
 def write_profile_csv(path: str | Path, points: ArrayLike) -> None:

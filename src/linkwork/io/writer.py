@@ -5,7 +5,13 @@ The rules every command inherits by writing through here:
 - **Ownership.** linkwork never replaces or deletes what it did not write. What it wrote into a folder is listed in
   that folder's :data:`MANIFEST` (``.linkwork-manifest.json``): the entries of each *run* (``trace``, ``synth``
   ...), and the single files written there (``export stl -o mine.stl`` records ``mine.stl`` in the manifest of
-  ``mine.stl``'s folder). An existing entry not listed there stops the command (exit 2) naming it.
+  ``mine.stl``'s folder), each with its :func:`fingerprint`. An existing entry not listed there, or listed but
+  holding something else (edited since), stops the command (exit 2) naming it.
+- **Folders from before fingerprints.** An entry an older manifest (format 2, or a list of names) lists is
+  linkwork's only if it was not modified after that manifest was written (the old writer wrote it after every
+  entry): an edited one is refused as a changed one is. A stale one is removed only when the command also writes
+  anew, unchanged, entries the old manifest lists in the same part (a manifest copied into a user's folder may
+  list any name); an old entry the command leaves keeps its manifest's time in the new manifest (``legacy``).
 - **A run replaces its own earlier results as a whole.** The entries an earlier run wrote into the folder and this
   run does not write are removed, so no stale file (an old ``viewer.html``) stays behind. A *part* of a run (the
   mechanization a ``synth`` run adds, ``linkwork mechanize`` into a synth folder) replaces only the entries of the
@@ -57,6 +63,7 @@ __all__ = [
     "json_text",
     "require_finite",
     "staged_output",
+    "unmodified_since",
     "write_file",
 ]
 
@@ -111,31 +118,40 @@ def _hash_file(path: Path, digest: Any) -> None:
 
 class Manifest:
     """What linkwork wrote into one folder: ``parts`` (part name -> entries of that part of the last run),
-    ``files`` (single files written there) and ``fingerprints`` (entry -> :func:`fingerprint` when written).
-    Stored as JSON ``{"format": 3, "parts": {...}, "files": [...], "fingerprints": {...}}``; format 2 (no
-    fingerprints) and the earlier list of names are still read, their entries owned by name alone."""
+    ``files`` (single files written there), ``fingerprints`` (entry -> :func:`fingerprint` when written) and
+    ``legacy`` (entry -> when the manifest that listed it without a fingerprint was written, in ns since the
+    epoch).
+
+    Stored as JSON ``{"format": 3, "parts": {...}, "files": [...], "fingerprints": {...}, "legacy": {...}}``;
+    format 2 (no fingerprints) and the earlier list of names are still read. An entry such a manifest lists has
+    no fingerprint: it is *legacy*, its time that manifest file's modification time (the old writer wrote the
+    manifest after every entry of the command), and it keeps that time in every manifest written after, until a
+    command writes the entry anew (see :meth:`is_ours` and :func:`staged_output` for what a legacy entry may
+    be used for)."""
 
     def __init__(
         self,
         parts: dict[str, set[str]] | None = None,
         files: set[str] | None = None,
         fingerprints: dict[str, str] | None = None,
+        legacy: dict[str, int] | None = None,
     ) -> None:
         self.parts = parts or {}
         self.files = files or set()
         self.fingerprints = fingerprints or {}
+        self.legacy = legacy or {}
 
     def is_ours(self, folder: Path, name: str) -> bool:
         """Whether the entry ``name`` of ``folder`` is one linkwork wrote and nobody changed since: listed, and
-        holding what its fingerprint says. An entry an earlier manifest (format 2 or a list) lists without a
-        fingerprint is linkwork's by name when it is one of a run's results (``path.csv``: the next run writes
-        the same kind of file over it), never when it is a single file, whose name a user chose (a manifest
-        copied from elsewhere may list any name); and it is never removed (:func:`staged_output`)."""
+        holding what its fingerprint says. A legacy entry (listed by a manifest from before fingerprints) counts
+        as unchanged when it was not modified after that manifest was written (:func:`unmodified_since`): a
+        result a user edited since is newer than the manifest, and is refused as a changed one is."""
         if name not in self.owned():
             return False
         recorded = self.fingerprints.get(name)
         if recorded is None:
-            return any(name in names for names in self.parts.values())
+            written = self.legacy.get(name)
+            return written is not None and unmodified_since(folder / name, written)
         try:
             return fingerprint(folder / name) == recorded
         except OSError:
@@ -152,22 +168,33 @@ class Manifest:
         try:
             if file.is_symlink() or not file.is_file() or file.stat().st_size > 1 << 20:
                 return cls()
+            written = file.stat().st_mtime_ns
             data = json.loads(file.read_text(encoding="utf-8"))
         except (OSError, ValueError, RecursionError):
             return cls()
         if isinstance(data, list):
-            return cls({RUN: _names(data)})
-        if not isinstance(data, dict):
+            manifest = cls({RUN: _names(data)})
+        elif isinstance(data, dict):
+            parts = data.get("parts")
+            parts = parts if isinstance(parts, dict) else {}
+            prints = data.get("fingerprints")
+            prints = prints if isinstance(prints, dict) else {}
+            times = data.get("legacy")
+            times = times if isinstance(times, dict) else {}
+            manifest = cls(
+                {str(k): _names(v) for k, v in parts.items() if isinstance(v, list)},
+                _names(data.get("files")),
+                {k: v for k, v in prints.items() if isinstance(k, str) and isinstance(v, str)},
+                {k: v for k, v in times.items() if isinstance(k, str) and type(v) is int},
+            )
+        else:
             return cls()
-        parts = data.get("parts")
-        parts = parts if isinstance(parts, dict) else {}
-        prints = data.get("fingerprints")
-        prints = prints if isinstance(prints, dict) else {}
-        return cls(
-            {str(k): _names(v) for k, v in parts.items() if isinstance(v, list)},
-            _names(data.get("files")),
-            {k: v for k, v in prints.items() if isinstance(k, str) and isinstance(v, str)},
-        )
+        # Every listed entry without a fingerprint is legacy: its recorded time, else this manifest's own.
+        manifest.legacy = {
+            name: min(manifest.legacy.get(name, written), written)
+            for name in manifest.owned() - set(manifest.fingerprints)
+        }
+        return manifest
 
     def owned(self) -> set[str]:
         """Every entry linkwork wrote into the folder."""
@@ -181,6 +208,9 @@ class Manifest:
             "parts": {k: sorted(v) for k, v in sorted(self.parts.items()) if v},
             "files": sorted(self.files),
             "fingerprints": {k: v for k, v in sorted(self.fingerprints.items()) if k in owned},
+            "legacy": {
+                k: v for k, v in sorted(self.legacy.items()) if k in owned and k not in self.fingerprints
+            },
         }
         fd, name = tempfile.mkstemp(prefix=".linkwork-manifest-", dir=folder)
         _usual_mode(Path(name))
@@ -191,6 +221,23 @@ class Manifest:
         finally:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(name)
+
+
+def unmodified_since(path: Path, written: int) -> bool:
+    """Whether the entry ``path`` (a file, or a folder and everything in it; never a symbolic link) was last
+    modified no later than ``written`` (ns since the epoch): an entry a legacy manifest lists, unchanged since that
+    manifest was written. Modification times are the file system's own, compared on one file system; an entry
+    changed and then given an older time (``touch -d``, ``cp -p`` from elsewhere) is not told apart."""
+    try:
+        if path.is_symlink() or not _exists(path):
+            return False
+        latest = path.lstat().st_mtime_ns
+        if path.is_dir():
+            for item in path.rglob("*"):
+                latest = max(latest, item.lstat().st_mtime_ns)
+    except OSError:
+        return False
+    return latest <= written
 
 
 def _usual_mode(file: Path) -> None:
@@ -393,11 +440,27 @@ def staged_output(out: Path, *, part: str = RUN, flag: str = "--out") -> Iterato
 
 
 def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
-    """Move the staged ``names`` into ``out``, remove the stale entries of the replaced parts, record them."""
+    """Move the staged ``names`` into ``out``, remove the stale entries of the replaced parts, record them.
+
+    A stale entry with a fingerprint is removed when it still holds what linkwork wrote. A stale legacy entry
+    (listed by a manifest from before fingerprints) is removed only when its part is *vouched for*: this command
+    writes anew at least one legacy entry of that part, and every such one was there, unchanged since that
+    manifest (checked before any work, :func:`_check_output_folder`); and it is itself unchanged since. Otherwise
+    it is only forgotten (left where it is, no longer listed): a manifest copied or planted into a user's folder
+    may list any name, and nothing else tells a user's file from linkwork's."""
     out.mkdir(parents=True, exist_ok=True)
     manifest = Manifest.read(out)
     replaced = set(manifest.parts) if part == RUN else {part}
     stale = set().union(*(manifest.parts[p] for p in replaced if p in manifest.parts)) - set(names)
+    vouched = {p for p in replaced if _vouched(manifest, out, p, names)}
+    removable = {
+        name
+        for name in stale
+        if not (out / name).is_symlink()
+        and _exists(out / name)
+        and manifest.is_ours(out, name)
+        and (name in manifest.fingerprints or any(name in manifest.parts.get(p, ()) for p in vouched))
+    }  # decided before any move: the entries to be written anew are compared as they were
     # first record the names about to move in (an interruption between two moves leaves only entries the
     # manifest lists, which the next run may replace), then move
     prints = {name: fingerprint(stage / name) for name in names}
@@ -405,6 +468,7 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
         {k: set(v) for k, v in manifest.parts.items()},
         set(manifest.files),
         {**manifest.fingerprints, **prints},
+        {k: v for k, v in manifest.legacy.items() if k not in prints},
     )
     early.parts.setdefault(part, set()).update(names)
     early.write(out)
@@ -413,12 +477,8 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
         if target.is_dir() and not target.is_symlink():
             shutil.rmtree(target)
         os.replace(stage / name, target)
-    for name in sorted(stale):
+    for name in sorted(removable):
         target = out / name
-        if target.is_symlink() or not _exists(target) or name not in manifest.fingerprints:
-            continue  # a link put in its place, gone, or listed without a fingerprint: only forgotten
-        if not manifest.is_ours(out, name):
-            continue  # someone's file under that name, or changed since: only forgotten
         if target.is_dir():
             shutil.rmtree(target)
         else:
@@ -430,7 +490,16 @@ def _move_into(stage: Path, out: Path, names: list[str], part: str) -> None:
     manifest.parts[part] = set(names)
     manifest.files -= set(names) | stale
     manifest.fingerprints.update(prints)
+    for name in names:
+        manifest.legacy.pop(name, None)
     manifest.write(out)
+
+
+def _vouched(manifest: Manifest, out: Path, part: str, names: list[str]) -> bool:
+    """Whether the legacy entries of ``part`` that this command writes anew (``names``) show the manifest's
+    ``part`` to be linkwork's own: at least one, each there and unchanged since that manifest was written."""
+    anew = [name for name in names if name in manifest.parts.get(part, ()) and name in manifest.legacy]
+    return bool(anew) and all(manifest.is_ours(out, name) for name in anew)
 
 
 def check_output_file(file: Path, flag: str = "--out") -> None:
@@ -498,6 +567,7 @@ def write_file(file: str | Path, write: Callable[[Path], Any], *, flag: str = "-
                     manifest = Manifest.read(folder)
                     manifest.files.add(file.name)
                     manifest.fingerprints[file.name] = written
+                    manifest.legacy.pop(file.name, None)
                     for names in manifest.parts.values():
                         names.discard(file.name)
                     manifest.write(folder)

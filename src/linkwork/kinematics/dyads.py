@@ -37,6 +37,7 @@ from linkwork.kinematics.dyad_solver import (
     S_STEPS,
     S_TARGET,
 )
+from linkwork.kinematics.march import MAX_PARTS, PART_SLACK
 from linkwork.kinematics.marcher import MarchSettings
 from linkwork.kinematics.mechanism import PLANAR_ROWS, Mechanism
 
@@ -258,10 +259,17 @@ def closed_form_rows(
         ("closed-form settings", basis.shape, basis.tobytes(), tol.local_min, tol.loose),
         lambda: _fixed_settings(mech, basis, tol.local_min, tol.loose),
     )
+    # A step longer than max_step (the drive's part of it, in the step's metric) is solved at points no further
+    # apart than that, as the march takes it in parts (march.march): the rows kept are every ``parts``-th, and a
+    # gap of the path between two rows (where the drive turns back and comes round again) is met, not jumped.
+    weight = 1.0 if settings.weight is None else float(settings.weight[settings.drive])
+    parts = min(
+        MAX_PARTS, max(1, math.ceil(abs(settings.target / steps) * weight / settings.max_step - PART_SLACK))
+    )
     run = fixed.copy()
-    run[S_STEP] = settings.target / steps
+    run[S_STEP] = settings.target / (steps * parts)
     run[S_TARGET] = settings.target
-    run[S_STEPS] = steps
+    run[S_STEPS] = steps * parts
     run[S_HMAX] = settings.max_step
     periodic = np.ascontiguousarray(settings.periodic, dtype=np.bool_)
     _count, status, angles, sigma, res, tau, s, full_rank = dyad_solver.closed_form_path(
@@ -269,6 +277,8 @@ def closed_form_rows(
     )
     if status != CLEAN:
         return None
+    if parts > 1:
+        angles, sigma, res, tau, s = (np.ascontiguousarray(a[::parts]) for a in (angles, sigma, res, tau, s))
     k = settings.n_sigma
     if k != sigma.shape[1]:  # (the path's rank is the number of equations: never taken)
         sigma, full_rank = np.ascontiguousarray(sigma[:, :k]), False

@@ -38,6 +38,9 @@ MAX_PARTS = 1024
 """Paper mode: the most equal parts a row's drive step is taken in where the whole step jumps or fails (next to
 a fold of the drive the path moves as the square root of the drive's distance to the fold); beyond, the march
 fails there."""
+PART_SLACK = 1e-9
+"""Paper mode: a drive step longer than ``hmax`` by less than this fraction of it (a step of ``hmax`` to
+round-off) is taken whole, not in two parts."""
 
 MECHANISM = ("twists", "loop_joint", "loop_sign", "loop_ptr", "rows", "groups")
 """The members of the mechanism tuple every kernel takes (see :mod:`linkwork.kinematics.kernels`)."""
@@ -580,8 +583,12 @@ def march(mech, start, steps, corrector, bounds, out):
     count = 1
     # Paper mode: a row's equal drive step is taken in ``parts`` equal parts where one step jumps or fails (next
     # to a fold the tangent's prediction ``h / t_drive`` is far too long); only the last part writes a row. The
-    # row's start is kept to go back to.
-    parts, part = 1, 0
+    # row's start is kept to go back to. A step longer than ``hmax`` (the drive's part of it, in the step's metric)
+    # is taken in parts no longer than that from the start (``base``): one long step could land beyond a gap of the
+    # path where the drive turns back and comes round again (a triple rocker's input, 150 -> 215 deg across its
+    # extremes at +-157.8 deg), where short steps meet the fold. At most MAX_PARTS (a step of many turns).
+    base = min(MAX_PARTS, max(1, int(np.ceil(abs(h) * weight[drive] / hmax - PART_SLACK)))) if paper else 1
+    parts, part = base, 0
     u_row, t_row, basis_row = u.copy(), t.copy(), basis.copy()
     while count <= max_steps:
         # ---- predictor (Sec. 4.1)
@@ -591,6 +598,9 @@ def march(mech, start, steps, corrector, bounds, out):
         along = step * tn  # the prediction's length in that metric
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
+        # a part's drive value from the row's, not a running sum of parts (which drifts over many rows)
+        if paper and parts > 1 and not landing:
+            u_try[drive] = u_row[drive] + (h if part == parts - 1 else (part + 1) * (h / parts))
         if (
             paper and parts == 1
         ):  # the last two points and their tangents predict better than the tangent alone
@@ -639,7 +649,7 @@ def march(mech, start, steps, corrector, bounds, out):
             part += 1
             continue
         if paper:
-            parts, part = 1, 0
+            parts, part = base, 0
             u_row[:] = u
             t_row[:] = t
             basis_row[:, :] = basis

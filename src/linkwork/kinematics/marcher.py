@@ -62,7 +62,8 @@ class MarchSettings:
 #: start at full step length and repeat it, so the margin only covers round-off in the step control.
 CYCLE_SLACK = 0.9
 
-#: Paper mode: the adaptive steps of the probe that looks for a fold of the drive past a failed equal step.
+#: Paper mode: the adaptive steps of each call of the probe that looks for a fold of the drive past a failed equal
+#: step (it goes on in such calls until it settles: :meth:`BranchMarcher._fold_ahead`).
 FOLD_PROBE_STEPS = 60
 
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
@@ -793,33 +794,50 @@ class BranchMarcher:
     def _fold_ahead(self, chunk: Chunk, basis: Array, branch_id: int, step: int) -> bool:
         """Paper mode, the chunk's last equal drive step failed (in every number of parts): whether a fold of the
         drive lies between its last row and the value that step asked for, where equal drive steps cannot go on.
-        A short adaptive march from the last row, towards larger drive values for a positive step, looks for the
-        drive turning back (:meth:`_scan_folds` locates it and records the fold, at step ``step``); its rows are
-        not kept. True when a fold was found short of the step's value."""
+
+        An adaptive march from the last row, towards larger drive values for a positive step, looks for the drive
+        turning back (:meth:`_scan_folds` locates it and records the fold, at step ``step``); its rows are not
+        kept. It goes on in calls of :data:`FOLD_PROBE_STEPS` steps, through sign changes of the test function,
+        until the drive turns back, passes the value the step asked for, the probe comes back round to the row
+        it left (a closed path) or ends otherwise, or it has taken as many steps as the trace has left: however
+        long the equal step (a few steps of 80 deg take dozens of adaptive ones to reach the fold, the other
+        joints turning further than the drive), the fold is found as with short steps. True when a fold was
+        found short of the step's value."""
         cfg, d, c = self.cfg, self.cfg.drive, chunk.count - 1
         if c < 0 or chunk.h == 0.0:
             return False
         u, t = chunk.u[c].copy(), chunk.t[c].copy()
         if t[d] * chunk.h < 0.0:
             t = -t
-        h0 = min(cfg.max_step, abs(chunk.h)) / 4.0
-        probe = self.march_chunk(
-            u, t, u.copy(), basis.copy(), False, h0, FOLD_PROBE_STEPS, False, np.zeros(2 + len(u))
-        )
-        td = probe.t[: probe.count, d]
-        turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
-        if len(turned) == 0:
-            return False
+        u_start, sign, asked = u.copy(), float(np.sign(chunk.h)), abs(chunk.h)
+        h = min(cfg.max_step, asked) / 4.0
+        basis_probe, reach = basis.copy(), np.zeros(2 + len(u))
+        before: Array | None = None
+        left = max(self.budget, FOLD_PROBE_STEPS)  # one call at least, else the steps the trace has left
+        while True:
+            probe = self.march_chunk(
+                u, t, u_start, basis_probe, False, h, min(FOLD_PROBE_STEPS, left), True, reach, before
+            )
+            left -= probe.count - 1
+            td = probe.t[: probe.count, d]
+            turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
+            if len(turned) > 0:
+                break
+            if float(np.max(sign * (probe.u[: probe.count, d] - u_start[d]))) >= asked:
+                return False  # the drive passes the value asked for without turning back
+            if probe.code not in (StopReason.BUDGET, StopReason.SIGN_CHANGE) or probe.count < 2 or left <= 0:
+                return False  # closed, failed, at a limit or the target, or out of steps: no fold ahead
+            last = probe.count - 1
+            u, t, h = probe.u[last].copy(), probe.t[last].copy(), probe.h
+            before = np.array([probe.u[last - 1], probe.t[last - 1]])
         k = int(turned[0])
-        reach = np.max(np.sign(chunk.h) * (probe.u[k : k + 2, d] - u[d]))
-        if reach >= abs(
-            chunk.h
-        ):  # the drive turns back beyond the value asked for: not what stopped the step
+        reach_fold = np.max(sign * (probe.u[k : k + 2, d] - u_start[d]))
+        if reach_fold >= asked:  # the drive turns back beyond the value asked for: not what stopped the step
             return False
         probe.count = k + 2  # the fold's step only
-        before = len(self.folds)
+        known = len(self.folds)
         self._scan_folds(probe, branch_id, step)
-        return len(self.folds) > before
+        return len(self.folds) > known
 
     def _end_reason(self, chunk: Chunk, paper: bool) -> str:
         """The end reason a user reads for a chunk's stop code."""
