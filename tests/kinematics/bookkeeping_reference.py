@@ -1,5 +1,6 @@
 """An independent reference for the bookkeeping properties: loop products by scipy's matrix exponential and the
-closure Jacobian by central finite differences of them, plus generators of linkages from their closed forms.
+closure Jacobian by central finite differences of them, the same Jacobian in closed form (Rodrigues' exponential and
+the adjoint, :func:`fresh_rows`), plus generators of linkages from their closed forms.
 
 Nothing here calls linkwork's own closure, Jacobian or kernels: the twists of a :class:`Mechanism` (its written
 geometry) are the only input taken from the code under test.
@@ -70,6 +71,56 @@ def jacobian(mech: Mechanism, angles: np.ndarray, step: float = 1e-6) -> np.ndar
 def singular_values(mech: Mechanism, angles: np.ndarray) -> np.ndarray:
     """numpy's singular values of :func:`jacobian`."""
     return np.linalg.svd(jacobian(mech, angles), compute_uv=False)
+
+
+def rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues' rotation by ``angle`` about ``axis``."""
+    k = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * K @ K
+
+
+def exp_twist(xi: np.ndarray, theta: float) -> np.ndarray:
+    """``exp(xi theta)`` as a 4x4 matrix in closed form (Rodrigues; a pure translation for ``omega = 0``); for a
+    revolute twist ``|omega| = 1``."""
+    w, v = xi[:3], xi[3:]
+    g = np.eye(4)
+    if not np.any(w):
+        g[:3, 3] = v * theta
+        return g
+    R = rotation(w, theta)
+    g[:3, :3] = R
+    g[:3, 3] = (np.eye(3) - R) @ np.cross(w, v) + np.outer(w, w) @ v * theta
+    return g
+
+
+def adjoint(g: np.ndarray) -> np.ndarray:
+    """The 6x6 adjoint of a rigid transform acting on twists ``(omega, v)``."""
+    R, p = g[:3, :3], g[:3, 3]
+    P = np.array([[0.0, -p[2], p[1]], [p[2], 0.0, -p[0]], [-p[1], p[0], 0.0]])
+    out = np.zeros((6, 6))
+    out[:3, :3] = out[3:, 3:] = R
+    out[3:, :3] = P @ R
+    return out
+
+
+def fresh_rows(mech: Mechanism, angles: np.ndarray) -> tuple[np.ndarray, float]:
+    """Singular values of the reduced closure Jacobian at ``angles`` and the closure residual (2-norm of the kept
+    rows of ``P - I``), from the twists alone: ``dP P^-1 = sum_j Ad(e_1 ... e_(j-1)) xi_j dq_j`` per loop (the
+    spatial product-of-exponentials Jacobian, Murray, Li and Sastry 1994, Sec. 3.4)."""
+    q = angles - mech.offsets
+    rows = list(mech.rows)
+    blocks, misfit = [], []
+    for loop in mech.loops:
+        g, block = np.eye(4), np.zeros((6, mech.n_joints))
+        for j, sign in zip(loop.joints, loop.signs, strict=True):
+            xi = sign * mech.twists[j]
+            block[:, j] += adjoint(g) @ xi
+            g = g @ exp_twist(xi, q[j])
+        blocks.append(block[rows])
+        misfit.append(vee(g - np.eye(4))[rows])
+    jac = np.concatenate(blocks) @ mech.coupling_matrix()
+    return np.linalg.svd(jac, compute_uv=False), float(np.linalg.norm(np.concatenate(misfit)))
 
 
 def wrapped(x: np.ndarray) -> np.ndarray:
