@@ -370,3 +370,32 @@ def test_closure_columns_on_a_reused_jacobian_equal_the_full_closure(jit: str) -
         kernels.planar_closure(flat, rel, q, full, full_res, scratch)
         assert np.array_equal(jac, full) and np.array_equal(res, full_res), mech.name
         assert np.array_equal(np.signbit(jac), np.signbit(full)), mech.name  # zeros' signs too
+
+
+def test_block_width_shares_the_steps_evenly_in_whole_groups_of_lanes() -> None:
+    """Every path of 1 to 5,000 steps is covered by the fewest blocks of at most ``BLOCK`` points, each a whole
+    number of the rows' lanes (so that each lane continues its own points from block to block), and the columns
+    past the last point number fewer than a group of lanes a block (a last block of a few points no longer costs a
+    whole block)."""
+    from linkwork.kinematics.bidiagonal_rows import LANES
+
+    width = getattr(dyad_solver.block_width, "py_func", dyad_solver.block_width)
+    for steps in range(1, 5001):
+        w = width(steps)
+        blocks = -(-steps // w)
+        assert w % LANES == 0 and LANES <= w <= dyad_solver.BLOCK, steps
+        assert blocks == -(-steps // dyad_solver.BLOCK), steps
+        assert blocks * w - steps < LANES * blocks, steps
+
+
+@pytest.mark.parametrize("steps", [3600, 2 * 256 + 3, 100])
+def test_watt_rows_equal_numpy_whatever_the_blocks(steps: int) -> None:
+    """The closed form's rows of the Watt six-bar over 350 degrees of the crank in ``steps`` steps (15 blocks of
+    240 points, 3 of 176; 100 steps are solved in 200, longer than the longest step, one block of 208) are numpy's
+    singular values of the closure Jacobian at each row's joint values, to 1e-13 of sigma_1."""
+    mech = lw.load(str(WATT))
+    _args, (count, status, angles, sigma, *_rest) = kernel_call(mech, np.radians(350.0), steps)
+    assert status == dyad_solver.CLEAN and count in (steps + 1, 2 * steps + 1)
+    J = np.stack([jacobian(mech, a - mech.offsets) for a in angles[:count]])
+    reference = np.linalg.svd(J, compute_uv=False)
+    assert np.max(np.abs(sigma[:count] - reference) / reference[:, :1]) < 1e-13

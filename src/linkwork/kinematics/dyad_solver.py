@@ -39,6 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from linkwork.kernel_cache import kernel
+from linkwork.kinematics.bidiagonal_rows import LANES
 from linkwork.kinematics.kernels import log_coefficient
 from linkwork.kinematics.planar_rows import multi_loop_rows, multi_loop_state, one_loop_rows
 from linkwork.kinematics.small_svd import orthonormalise
@@ -64,7 +65,8 @@ S_STEP, S_TARGET, S_STEPS, S_HMAX, S_DET_BASIS, S_MIN_RATIO, S_MIN_DRIVE, S_MIN_
 )
 N_SETTINGS = 9
 TWO_PI = 2.0 * np.pi
-#: Points per block of :func:`closed_form_path` (a block's arrays stay in the second-level cache).
+#: The most points a block of :func:`closed_form_path` holds (a block's arrays stay in the second-level cache;
+#: :func:`block_width` shares a path's steps evenly among its blocks).
 BLOCK = 256
 
 
@@ -797,7 +799,8 @@ def closed_form_path(flat, plan, run):
     full_rank = E > 0  # every stored row's ratios above loose (kernels.every_row_full_rank), so far
     # A block's arrays: column i is point first - 1 + i; column 0 the block before's last point (the start for
     # the first block), columns 1 .. BLOCK this block's points (past the last point: harmless extrapolation).
-    C = BLOCK + 1
+    block = block_width(steps)
+    C = block + 1
     drive_q = np.zeros(C)
     poses = np.zeros((head[2], 4, C))
     poses[:, 0, :] = 1.0  # the fixed body keeps the identity, every body is the reference at the start
@@ -822,7 +825,7 @@ def closed_form_path(flat, plan, run):
     turn_bits = np.empty(C, dtype=np.int64)
     near_start = 1.5 * abs(h)  # a path closes where it comes back this near its start
     limits = (min_ratio, min_drive, near_start, hmax, det_basis)
-    for first in range(1, steps + 1, BLOCK):
+    for first in range(1, steps + 1, block):
         # Positions: the drive's values (a running sum, as the march steps), the bodies' poses, the joints.
         drive_values(drive_q, first, steps, h, target)
         status[:] = CLEAN
@@ -830,7 +833,7 @@ def closed_form_path(flat, plan, run):
         place_driver(joint_int, joint_geo, head, drive_q, poses)
         place_dyads(joint_int, joint_geo, dyads, modes, poses, min_margin, status)
         joint_values(joint_int, joint_geo, poses, drive, drive_q, rel, q, jump, carry)
-        size, ended = first_failure(status, jump, min(BLOCK, steps + 1 - first))
+        size, ended = first_failure(status, jump, min(block, steps + 1 - first))
         for i in range(size + 1, C):  # past the block's last point: its copies (no NaN, no work for the rows)
             rel[:, :, i] = rel[:, :, size]
             q[:, i] = q[:, size]
@@ -855,14 +858,26 @@ def closed_form_path(flat, plan, run):
         if ended != CLEAN:
             return zero_tail(first + size, ended, outs)
         # The block's last column is the next block's column 0.
-        poses[:, :, 0] = poses[:, :, BLOCK]
-        drive_q[0] = drive_q[BLOCK]
+        poses[:, :, 0] = poses[:, :, block]
+        drive_q[0] = drive_q[block]
         for j in range(n):
-            carry[0][j] = q[j, BLOCK]
-        sigma[:, 0] = sigma[:, BLOCK]
-        tangent[:, 0] = tangent[:, BLOCK]
-        raw_tau[0] = raw_tau[BLOCK]
+            carry[0][j] = q[j, block]
+        sigma[:, 0] = sigma[:, block]
+        tangent[:, 0] = tangent[:, block]
+        raw_tau[0] = raw_tau[block]
     return steps + 1, CLEAN, out_angles, out_sigma, out_res, out_tau, out_s, full_rank
+
+
+@kernel(inline="always")
+def block_width(steps):
+    """Points a block of a path of ``steps`` steps: the fewest blocks of at most :data:`BLOCK` points, the steps
+    shared evenly among them, rounded up to a multiple of the rows' lanes
+    (:data:`~linkwork.kinematics.bidiagonal_rows.LANES`: from block to block each lane continues its own points).
+    Every pass runs over a whole block, so a last block of a few points in a block of ``BLOCK`` columns cost as
+    much as a full one (3600 steps: 15 blocks of 240, not 14 of 256 and one of 16 in 256 columns)."""
+    blocks = max(1, -(-steps // BLOCK))
+    width = -(-steps // blocks)
+    return max(LANES, -(-width // LANES) * LANES)
 
 
 @kernel(inline="always")
