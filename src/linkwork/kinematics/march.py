@@ -481,6 +481,15 @@ def predict(u, t, h, paper, drive, target, has_target, first, u_try, tn):
 
 
 @kernel(inline="always")
+def passes(a, b, target, slope):
+    """Whether an adaptive step moving the drive from ``a`` to ``b`` passed strictly over ``target`` in the
+    direction the tangent's drive component ``slope`` points (so that the tangent's prediction reaches it)."""
+    if abs(slope) <= 1e-12 or (target - a) * slope <= 0.0:
+        return False
+    return (target - a) * (b - target) > 0.0
+
+
+@kernel(inline="always")
 def extrapolate(u_prev, t_prev, u, t, drive, u_try, cap):
     """Paper mode's predictor from the last two points: the cubic (Hermite) through ``u_prev`` and ``u`` with
     their tangents ``t_prev`` and ``t`` (as derivatives in the drive), at the drive value of the tangent
@@ -611,6 +620,17 @@ def march(mech, start, steps, corrector, bounds, out):
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
             ok, _, r = correct_across(mech, u_try, t, corrector, work, weight)
+            if ok and has_target and passes(u[drive], u_try[drive], target, t[drive]):
+                # The prediction fell short of the target but the corrected point is beyond it (the path curves
+                # towards it): the step lands on the target instead, the drive held there, from the tangent's
+                # prediction at the target's drive value (else the target would be stepped over, never reached).
+                step = (target - u[drive]) / t[drive]
+                along = step * tn
+                for a in range(m):
+                    u_try[a] = u[a] + step * t[a]
+                u_try[drive] = target
+                landing, held = True, drive
+                ok, _, r = correct_in(mech, u_try, held, corrector, work)
         else:
             ok, _, r = correct_in(mech, u_try, held, corrector, work)
         turn, dist, tau_new = 1.0, 0.0, 0.0
