@@ -783,7 +783,7 @@ class Goldberg:
     """
 
     def __init__(self, name: str, k: float, al1: float, al2: float, al3: float, t1: float, p1: float) -> None:
-        a1, a2, a3 = (k * np.sin(np.radians(x)) for x in (al1, al2, al3))
+        a1, a3 = (k * np.sin(np.radians(x)) for x in (al1, al3))
         self.b1 = Bennett("b1", a1, al1, al2, t1)
         self.b2 = Bennett("b2", a3, al3, al2, p1)
         self.t10, self.p10 = t1, p1

@@ -129,3 +129,39 @@ def test_a_target_round_a_closed_path_the_other_way_is_reached(tmp_path: Path, p
             s_ref = np.linalg.svd(reference.jacobian(row), compute_uv=False)
             sig = np.asarray(trace.sigma)[-1]
             assert np.max(np.abs(sig - s_ref[: sig.shape[0]])) < 1e-11 * s_ref[0]
+
+
+#: Four-bars whose links all lie on the ground line with the crank at 180 deg: a crossing of two branches there
+#: (Grashof's change point; the parallelogram also crosses at 0 deg). (ground, crank, coupler, rocker, start).
+CROSSING_AT_180 = {
+    "parallelogram": (3.0, 1.0, 3.0, 1.0, 30.0),
+    "change-point": (4.0, 1.5, 3.0, 2.5, 60.0),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CROSSING_AT_180))
+def test_the_step_landing_on_a_target_past_a_crossing_reports_it(tmp_path: Path, name: str) -> None:
+    """The last step, the one that lands on the target, passes the crossing at A = 180 deg: the crossing is
+    reported (at the closed form's point: A = 180 deg, every link on the ground line) and the target reached.
+
+    Got: no bifurcation (the landing step ended the march before its sign change of the test function was
+    looked at), in paper mode (one or two equal steps from the start to 190 or 210 deg) and adaptively."""
+    dims = CROSSING_AT_180[name]
+    case = FourBar(name, *dims)
+    mech = load(tmp_path, name, case.mech.toml())
+    free = np.degrees(np.asarray(lw.trace(mech).angles)[:, 0])
+    i = int(np.flatnonzero((free[:-1] < 180.0) & (free[1:] > 180.0))[0])
+    adaptive_target = 180.0 + 0.5 * (free[i + 1] - 180.0)  # within the step that crosses
+    for target, steps in ((190.0, 1), (210.0, 2), (adaptive_target, None)):
+        trace = lw.trace(mech, until=("A", target * RAD), steps=steps)
+        assert trace.stats.unmet is None
+        assert np.degrees(trace.angles[-1, 0]) == pytest.approx(target, abs=1e-10)
+        assert len(trace.bifurcations) == 1, (target, steps)
+        at = np.degrees(np.asarray(trace.bifurcations[0].angles))
+        row = dict(zip("ABCD", at, strict=True))
+        assert row["A"] == pytest.approx(180.0, abs=1e-7)
+        err, _ = nearest(case.solve("A", 180.0), row, list("ABCD"), set())
+        assert err < 1e-6  # degrees: a crossing located to Tolerances.locate, a double root's square root off
+        for r in np.degrees(np.asarray(trace.angles)):
+            err, _ = nearest(case.solve("A", r[0]), dict(zip("ABCD", r, strict=True)), list("ABCD"), set())
+            assert err < 1e-8
