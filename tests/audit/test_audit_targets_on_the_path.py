@@ -165,3 +165,60 @@ def test_the_step_landing_on_a_target_past_a_crossing_reports_it(tmp_path: Path,
         for r in np.degrees(np.asarray(trace.angles)):
             err, _ = nearest(case.solve("A", r[0]), dict(zip("ABCD", r, strict=True)), list("ABCD"), set())
             assert err < 1e-8
+
+
+def _moved_spatial(case: FourBar, scale: float) -> str:
+    """The four-bar as a spatial [mechanism] (its hinges still parallel), lengths times ``scale``, turned and moved."""
+    g = np.eye(4)
+    c, s = np.cos(0.7), np.sin(0.7)
+    g[:3, :3] = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]) @ np.array(
+        [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    )
+    g[:3, 3] = [40.0, -25.0, 60.0]
+    return case.mech.toml(scale=scale, motion=g).replace("planar = true", "planar = false")
+
+
+@pytest.mark.parametrize("variant", ["planar", "x1000", "spatial-moved"])
+def test_equal_steps_in_parts_across_a_parallelogram_crossing_stay_on_it(
+    tmp_path: Path, variant: str
+) -> None:
+    """A parallelogram (ground = coupler 2.5, crank = rocker 1) driven from 50 to 410 deg in 18 equal steps of
+    20 deg, each taken in parts no longer than max_step (2 deg): every row on the parallelogram's own closed form
+    (coupler translating: B = -(A - 50), C = A - 50, D = -(A - 50)), both crossings (A = 180 and 360 deg)
+    reported, the target reached.
+
+    Got: the parts of 170 -> 190 deg met the crossing at 180 exactly, where the tangent has no direction: as
+    written, 'drive turning point' at 170 deg (the drive never turns back) and the target unmet; x1000 and moved
+    in space, the path went on along the other branch (the anti-parallelogram) at 190 deg, one crossing reported."""
+    case = FourBar("parallelogram", 2.5, 1.0, 2.5, 1.0, 50.0)
+    text = {
+        "planar": case.mech.toml(),
+        "x1000": case.mech.toml(scale=1000.0),
+        "spatial-moved": _moved_spatial(case, 1.0),
+    }[variant]
+    trace = lw.trace(load(tmp_path, "pg", text), until=("A", 410.0 * RAD), steps=18)
+    assert trace.stats.unmet is None, trace.stats.unmet
+    rows = np.degrees(np.asarray(trace.angles))
+    np.testing.assert_allclose(rows[:, 0], np.linspace(50.0, 410.0, 19), rtol=0.0, atol=1e-9)
+    turned = rows[:, 0] - 50.0
+    expected = np.column_stack([rows[:, 0], -turned, turned, -turned])
+    assert np.max(np.abs(wrap_deg(rows - expected))) < 1e-9
+    crossings = sorted(float(np.degrees(b.angles[0])) % 360.0 for b in trace.bifurcations)
+    assert len(crossings) == 2
+    assert min(crossings[0], 360.0 - crossings[-1]) < 1e-7  # A = 0 (mod 360)
+    assert 180.0 in [pytest.approx(c, abs=1e-7) for c in crossings]
+
+
+def test_one_equal_step_across_a_change_point_crossing(tmp_path: Path) -> None:
+    """Grashof's change-point four-bar (4, 1.5, 3, 2.5) from 60 to 190 deg in one step (65 parts of 2 deg, one
+    of them at the crossing at 180 deg in the equal division): reached, on the closed form, the crossing reported.
+
+    Got: 'corrector failed at a fixed drive step', range [60, 60] (the part at 180 failed, and so did every
+    retake in twice as many parts, which met 180 exactly again)."""
+    case = FourBar("change-point", 4.0, 1.5, 3.0, 2.5, 60.0)
+    trace = lw.trace(load(tmp_path, "cp", case.mech.toml()), until=("A", 190.0 * RAD), steps=1)
+    assert trace.stats.unmet is None, trace.stats.unmet
+    for r in np.degrees(np.asarray(trace.angles)):
+        err, _ = nearest(case.solve("A", r[0]), dict(zip("ABCD", r, strict=True)), list("ABCD"), set())
+        assert err < 1e-9
+    assert [np.degrees(b.angles[0]) for b in trace.bifurcations] == [pytest.approx(180.0, abs=1e-7)]
