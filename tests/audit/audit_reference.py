@@ -770,3 +770,59 @@ def bricard_plane(name: str) -> DHLoop:
             break
     loop.theta0 = list(th)
     return loop
+
+
+class Goldberg:
+    """Goldberg's 5R linkage from two Bennett loops (Goldberg 1943), written by its hinge lines.
+
+    Bennett loop 1 has joints J1, J2, J3, J4 and links (a1, al1), (a2, al2), (a1, al1), (a2, al2); loop 2 has
+    J1, J5, J6, J4 and links (a3, al3), (a2, al2), (a3, al3), (a2, al2) (every ``a_i = k sin al_i``). Both start
+    from the frame on J1 whose x-axis is the common normal from J4 (the shared link J4-J1), so they share the
+    lines J1 and J4. The shared link is removed and the links J1-J2 and J1-J5 are fused: the 5R loop J2, J3, J4,
+    J6, J5, in which both Bennett loops turn their J1 by the same ``delta`` (:meth:`predict`).
+    """
+
+    def __init__(self, name: str, k: float, al1: float, al2: float, al3: float, t1: float, p1: float) -> None:
+        a1, a3 = (k * np.sin(np.radians(x)) for x in (al1, al3))
+        self.b1 = Bennett("b1", a1, al1, al2, t1)
+        self.b2 = Bennett("b2", a3, al3, al2, p1)
+        self.t10, self.p10 = t1, p1
+        lines = []
+        for b in (self.b1, self.b2):
+            g, frames = np.eye(4), []
+            for p in b.params(np.array(b.theta0)):
+                frames.append(g.copy())
+                g = g @ dh(*p)
+            assert np.abs(g - np.eye(4)).max() < 1e-12  # both Bennett loops close at their start
+            lines.append([(f[:3, 3].copy(), f[:3, 2].copy()) for f in frames])
+        (_, j2, j3, j4), (_, j5, j6, _) = lines
+        self.lines = [j2, j3, j4, j6, j5]
+        self.names = list("ABCDE")
+        self.mech = Mech(
+            name,
+            [
+                dict(name=n, bodies=[f"L{(i - 1) % 5}", f"L{i}"], point=list(p), direction=list(d))
+                for i, (n, (p, d)) in enumerate(zip(self.names, self.lines, strict=True))
+            ],
+            planar=False,
+            root="L4",
+        )
+
+    def predict(self, delta: float) -> np.ndarray:
+        """The five joints' displacements (deg) when both Bennett loops turn J1 by ``delta`` (deg): Bennett's
+        relation in each; at J4, ``theta4 = -theta2`` turns the shared link against J3-J4 and ``phi4 = -phi5``
+        against J6-J4, so J6-J4 turns against J3-J4 by their difference; J6 and J5 are crossed against loop 2's
+        order (``phi6 = -phi1``)."""
+        th2, th20 = self.b1.t2(self.t10 + delta), self.b1.theta0[1]
+        ph5, ph50 = self.b2.t2(self.p10 + delta), self.b2.theta0[1]
+        d4 = (th20 - th2) - (ph50 - ph5)
+        return np.array([th2 - th20, -delta, d4, delta, ph50 - ph5])
+
+    def toml(self, thetas: list[float] | None = None) -> str:
+        """The loop as a ``hinge-lines`` spec (reported angles ``thetas`` at the start, default 0)."""
+        th = [0.0] * 5 if thetas is None else thetas
+        out = [f'name = "{self.mech.name}"', "", "[loop]", 'convention = "hinge-lines"']
+        for n, (p, d), t in zip(self.names, self.lines, th, strict=True):
+            out += ["", "[[loop.joints]]", f'name = "{n}"', f"point = {_fmt(p)}", f"direction = {_fmt(d)}"]
+            out.append(f"theta = {float(t)!r}")
+        return "\n".join(out) + "\n"

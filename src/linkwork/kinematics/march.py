@@ -39,6 +39,11 @@ MAX_PARTS = 1024
 a fold of the drive the path moves as the square root of the drive's distance to the fold); beyond, the march
 fails there."""
 PART_SLACK = 1e-9
+PART_SHIFT = 0.3819660112501051
+"""Paper mode: the parts of a row's drive step end this fraction of a part short of the equal division (2 minus the
+golden ratio; the last part is that much longer): a part never lands on a round drive value where a row does not,
+such as a parallelogram's crossing at 180 deg met by the equal parts of 170 -> 190 deg, where the tangent has no
+direction and the next part went on along the other branch (or failed, reported as a turning point)."""
 """Paper mode: a drive step longer than ``hmax`` by less than this fraction of it (a step of ``hmax`` to
 round-off) is taken whole, not in two parts."""
 
@@ -481,6 +486,15 @@ def predict(u, t, h, paper, drive, target, has_target, first, u_try, tn):
 
 
 @kernel(inline="always")
+def passes(a, b, target, slope):
+    """Whether an adaptive step moving the drive from ``a`` to ``b`` passed strictly over ``target`` in the
+    direction the tangent's drive component ``slope`` points (so that the tangent's prediction reaches it)."""
+    if abs(slope) <= 1e-12 or (target - a) * slope <= 0.0:
+        return False
+    return (target - a) * (b - target) > 0.0
+
+
+@kernel(inline="always")
 def extrapolate(u_prev, t_prev, u, t, drive, u_try, cap):
     """Paper mode's predictor from the last two points: the cubic (Hermite) through ``u_prev`` and ``u`` with
     their tangents ``t_prev`` and ``t`` (as derivatives in the drive), at the drive value of the tangent
@@ -598,9 +612,17 @@ def march(mech, start, steps, corrector, bounds, out):
         along = step * tn  # the prediction's length in that metric
         if held == TURNED:  # paper mode: the drive has turned back, equal drive steps cannot go on
             return count, TURNING, h
-        # a part's drive value from the row's, not a running sum of parts (which drifts over many rows)
-        if paper and parts > 1 and not landing:
-            u_try[drive] = u_row[drive] + (h if part == parts - 1 else (part + 1) * (h / parts))
+        # a part's drive value from the row's, not a running sum of parts (which drifts over many rows); the last
+        # part ends on the row's value, the target when it is there
+        if paper and parts > 1:
+            landing = False
+            if part < parts - 1:
+                u_try[drive] = u_row[drive] + (part + 1 - PART_SHIFT) * (h / parts)
+            else:
+                u_try[drive] = u_row[drive] + h
+                if has_target and abs(u_try[drive] - target) < 1e-9 * max(1.0, abs(target)):
+                    landing = True
+                    u_try[drive] = target
         if (
             paper and parts == 1
         ):  # the last two points and their tangents predict better than the tangent alone
@@ -611,6 +633,17 @@ def march(mech, start, steps, corrector, bounds, out):
         # ---- corrector (Sec. 4.2, Eq. (28)), then the new tangent and the adaptive step's acceptance
         if held < 0:  # adaptive: on the hyperplane through the prediction normal to the tangent (scale-free)
             ok, _, r = correct_across(mech, u_try, t, corrector, work, weight)
+            if ok and has_target and passes(u[drive], u_try[drive], target, t[drive]):
+                # The prediction fell short of the target but the corrected point is beyond it (the path curves
+                # towards it): the step lands on the target instead, the drive held there, from the tangent's
+                # prediction at the target's drive value (else the target would be stepped over, never reached).
+                step = (target - u[drive]) / t[drive]
+                along = step * tn
+                for a in range(m):
+                    u_try[a] = u[a] + step * t[a]
+                u_try[drive] = target
+                landing, held = True, drive
+                ok, _, r = correct_in(mech, u_try, held, corrector, work)
         else:
             ok, _, r = correct_in(mech, u_try, held, corrector, work)
         turn, dist, tau_new = 1.0, 0.0, 0.0
@@ -624,10 +657,13 @@ def march(mech, start, steps, corrector, bounds, out):
             elif paper:
                 ok = not jumps(u, u_try, periodic)
         if not ok:
-            if paper:  # the row's step again from its start, in twice as many parts
+            if paper:  # the row's step again from its start, in twice as many parts and one
                 if parts >= MAX_PARTS:
                     return count, FAILED, h
-                parts, part = 2 * parts, 0
+                # An odd count moves every inner part's drive value: a part that failed on a singular point (a
+                # change-point four-bar's crossing at 180 deg, met exactly by the parts of 60 -> 190 deg in 65,
+                # 130, 260, ... parts) is not met exactly again, where doubling met it every time.
+                parts, part = 2 * parts + 1, 0
                 u[:] = u_row
                 t[:] = t_row
                 basis[:, :] = basis_row
@@ -738,8 +774,12 @@ def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
 @kernel(inline="always")
 def step_event(u, landing, lo, hi, detect, tau_product):
     """The stop code an accepted step ends the march with (the target reached, a joint limit passed, a sign change
-    of the test function, ``tau_product`` being the product of its last two values), ``NO_EVENT`` for none."""
+    of the test function, ``tau_product`` being the product of its last two values), ``NO_EVENT`` for none. A step
+    landing on the target over which the test function changed sign ends with the sign change (the bifurcation it
+    passed is located; the march then ends on the target it reached, ``BranchMarcher``)."""
     if landing:
+        if detect and tau_product < 0.0:
+            return SIGN_CHANGE
         return TARGET
     for a in range(u.shape[0]):
         if u[a] < lo[a] or u[a] > hi[a]:

@@ -423,6 +423,8 @@ class BranchMarcher:
                     return n_steps, StopReason.KNOWN_POINT, f"reached bifurcation {known}", None, known
                 if known is not None:  # through a known point and on: the arcs on both sides are traced
                     self._passed(known, chunk)
+                if self._on_target(chunk):  # the step that changed sign had landed on the target: done
+                    return n_steps, StopReason.TARGET, StopReason.TARGET.text, None, None
             elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
                 # A full turn of the drive: the target is further round, unless the budget cannot go that far.
                 cycle = n_steps - cycle_from
@@ -709,6 +711,12 @@ class BranchMarcher:
         if cfg.target is not None and self._target_on_last_step(across) and self._land(across, d, cfg.target):
             across.code = StopReason.TARGET
         return across
+
+    def _on_target(self, chunk: Chunk) -> bool:
+        """Whether the chunk's last row is on the drive's target (a step that lands there holds the drive at the
+        target exactly)."""
+        target = self.cfg.target
+        return target is not None and float(chunk.u[chunk.count - 1, self.cfg.drive]) == target
 
     def _target_on_last_step(self, chunk: Chunk) -> bool:
         """Whether the drive's target lies on the chunk's last step (between its last two rows' drive values).

@@ -148,6 +148,19 @@ def trace(
     n0, end0 = marcher.run_branch(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
     )
+    if _closed_away_from_target(mech, settings, paper, end0) and not marcher.stop_requested():
+        # The first step moved the drive towards the target, but round the closed path it turned whole turns
+        # away from it: going round the other way, the drive's values are those of this path less its turns, so
+        # the target is on the path that way (one turn below the start of a crank turning up when it first moved
+        # down). Traced again in the other direction, from scratch.
+        marcher = BranchMarcher(
+            mech, settings, max_steps, switch_branches=branches, progress=progress, kernels=backend,
+            workspace=Workspace.of(mech, backend),
+        )  # fmt: skip
+        t_start = -t_start
+        n0, end0 = marcher.run_branch(
+            0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
+        )
     marcher.branches.append(Branch.ended(0, None, None, 1, n0, end0))
     if branches and target is None and end0.kind != StopReason.CLOSED and not marcher.stop_requested():
         # The start is in the middle of its branch: trace the other direction too.
@@ -317,6 +330,18 @@ def _periodic(mech: Mechanism) -> NDArray[np.bool_]:
         return periodic
 
     return mech.derived("periodic unknowns", build)
+
+
+def _closed_away_from_target(mech: Mechanism, settings: MarchSettings, paper: bool, end: End) -> bool:
+    """Whether an adaptive first branch closed without reaching its target, having turned its (revolute) drive by
+    whole turns away from it: the target is then on the path the other way round (see :func:`trace`)."""
+    target = settings.target
+    if paper or target is None or end.kind != StopReason.CLOSED or end.value is None or end.joint is None:
+        return False
+    if not settings.periodic[settings.drive]:
+        return False
+    turned = end.value - float(mech.offsets[mech.index(end.joint)])  # the drive's unknown at the end
+    return abs(turned) > np.pi and turned * target < 0.0
 
 
 def _drive_and_target(
