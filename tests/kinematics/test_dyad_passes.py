@@ -5,6 +5,7 @@ joint limit, a dyad without a solution) where an independent reading of the rows
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -399,3 +400,28 @@ def test_watt_rows_equal_numpy_whatever_the_blocks(steps: int) -> None:
     J = np.stack([jacobian(mech, a - mech.offsets) for a in angles[:count]])
     reference = np.linalg.svd(J, compute_uv=False)
     assert np.max(np.abs(sigma[:count] - reference) / reference[:, :1]) < 1e-13
+
+
+@pytest.mark.parametrize("C", [17, 113, 241, 257])
+def test_block_arrays_are_disjoint_and_start_apart_within_a_page(C: int) -> None:
+    """The block arrays carved from one buffer (``carve_buffer``, ``carve``) lie inside it, overlap nowhere, and
+    start at distinct places within a 4 KiB page (22 places, ``STAGGER`` doubles apart), the first half a page
+    from the rows' state, whatever the sizes: no two of them are a multiple of 4 KiB apart at their starts."""
+    carve_buffer = getattr(dyad_solver.carve_buffer, "py_func", dyad_solver.carve_buffer)
+    carve = getattr(dyad_solver.carve, "py_func", dyad_solver.carve)
+    page = dyad_solver.PAGE
+    state = np.empty(1000)
+    sizes = (C, 6 * 4 * C, 7 * 2 * C, 7 * C, C, C, 4 * C, C, C, 6 * 7 * C, C, 6 * C, 7 * C) + (C,) * 9
+    buffer, base = carve_buffer(sizes, state)
+    origin = buffer.ctypes.data
+    assert ((origin + 8 * base) - state.ctypes.data) % (8 * page) == 8 * (page // 2)
+    at, spans, starts = base, [], set()
+    for index, size in enumerate(sizes):
+        part, at = carve(buffer, at, base, index, size)
+        begin = (part.ctypes.data - origin) // 8
+        assert part.shape == (size,) and np.shares_memory(part, buffer)
+        spans.append((begin, begin + size))
+        starts.add((begin - base) % page)
+    assert len(starts) == len(sizes)
+    spans.sort()
+    assert all(a[1] <= b[0] for a, b in itertools.pairwise(spans)) and spans[-1][1] <= len(buffer)

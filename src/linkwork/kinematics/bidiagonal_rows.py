@@ -112,6 +112,8 @@ BELOW = 1e-3
 """From the bounds, root ``i + 1``'s first iterate is root ``i`` times ``1 - BELOW`` (below it, off its pole)."""
 FLOOR = 1e-300
 """Divisors are at least this (a degenerate lane gives finite nonsense, which fails its certification)."""
+PAGE = 512
+"""Doubles (or 64-bit integers) in 4 KiB."""
 
 
 @kernel(inline="always")
@@ -533,7 +535,12 @@ def lanes_pass(jac, sigma, tangent, raw_tau, begin, state, m, E):
         np.empty(m),
         np.empty(m, dtype=np.int64),
     )
-    points = np.empty(CHUNK, dtype=np.int64)
+    # The lanes' points a quarter page from the state (modulo 4 KiB), wherever the allocator put either: about one
+    # process in four had them a multiple of 4 KiB from a row of the chunk, whose stores then held up the loads of
+    # the points (4K aliasing; the Watt six-bar's rows 160 -> 220 ns a point).
+    pad = np.empty(CHUNK + PAGE, dtype=np.int64)
+    shift = (state.ctypes.data + 8 * (PAGE // 4) - pad.ctypes.data) % (8 * PAGE) // 8
+    points = pad[shift : shift + CHUNK]
     groups = (K - begin + L - 1) // L
     first = K - groups * L
     count = 0
