@@ -851,7 +851,12 @@ class BranchMarcher:
         """The end reason a user reads for a chunk's stop code."""
         if chunk.code == StopReason.FAILED:
             if paper:
-                return "corrector failed at a fixed drive step (the drive cannot take that value here)"
+                # No fold of the drive was found ahead (that ends as a turning point): the corrector did not
+                # converge at the next equal step, even in parts; an adaptive trace follows the path regardless.
+                return (
+                    "corrector failed at a fixed drive step (no turning point of the drive found before it; "
+                    "more equal steps, or an adaptive trace without steps / --steps, may pass)"
+                )
             text = f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
             floor = self._closure_floor(chunk)
             if floor is not None:
