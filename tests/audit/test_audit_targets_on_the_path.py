@@ -47,18 +47,26 @@ def targets_short_of_rows(values: np.ndarray, every: int) -> list[float]:
     return out
 
 
-def test_targets_a_crank_rocker_steps_near_are_landed_on(tmp_path: Path) -> None:
-    """Every target on the crank's first turn is reached, exactly, on the circle intersections."""
-    case = FourBar("crank-rocker", 4.0, 1.3, 3.7, 2.9, 35.0)
-    mech = load(tmp_path, "cr", case.mech.toml())
+def landed_rows(mech: lw.Mechanism) -> list[tuple[float, np.ndarray]]:
+    """``(target, last row in degrees)`` of an adaptive trace of ``mech`` to each target a thousandth of a step short
+    of every sixth row of its free trace (more than 40): each reached, A exactly on it."""
     free = np.degrees(np.asarray(lw.trace(mech).angles))
     targets = targets_short_of_rows(free[:, 0], every=6)
     assert len(targets) > 40
+    out = []
     for target in targets:
         trace = lw.trace(mech, until=("A", target * RAD))
         assert trace.stats.unmet is None, trace.stats.unmet
         last = np.degrees(np.asarray(trace.angles)[-1])
         assert last[0] == pytest.approx(target, abs=1e-10)
+        out.append((target, last))
+    return out
+
+
+def test_targets_a_crank_rocker_steps_near_are_landed_on(tmp_path: Path) -> None:
+    """Every target on the crank's first turn is reached, exactly, on the circle intersections."""
+    case = FourBar("crank-rocker", 4.0, 1.3, 3.7, 2.9, 35.0)
+    for target, last in landed_rows(load(tmp_path, "cr", case.mech.toml())):
         err, _ = nearest(case.solve("A", target), dict(zip("ABCD", last, strict=True)), list("ABCD"), set())
         assert err < 1e-9
 
@@ -67,15 +75,7 @@ def test_targets_a_goldberg_linkage_steps_near_are_landed_on(tmp_path: Path) -> 
     """Goldberg 5R (two Bennett loops 40/100 and 70/100 deg): every target of A's first turn reached exactly,
     the last row on both Bennett loops' closed form (delta = -B)."""
     case = Goldberg("goldberg-audit", 1.0, 40.0, 100.0, 70.0, 50.0, 30.0)
-    mech = load(tmp_path, "gb", case.toml())
-    free = np.degrees(np.asarray(lw.trace(mech).angles))
-    targets = targets_short_of_rows(free[:, 0], every=6)
-    assert len(targets) > 40
-    for target in targets:
-        trace = lw.trace(mech, until=("A", target * RAD))
-        assert trace.stats.unmet is None, trace.stats.unmet
-        last = np.degrees(np.asarray(trace.angles)[-1])
-        assert last[0] == pytest.approx(target, abs=1e-10)
+    for _target, last in landed_rows(load(tmp_path, "gb", case.toml())):
         assert np.max(np.abs(wrap_deg(case.predict(-last[1]) - last))) < 1e-9
 
 
