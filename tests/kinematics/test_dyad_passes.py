@@ -411,7 +411,8 @@ def test_block_arrays_are_disjoint_and_start_apart_within_a_page(C: int) -> None
     carve = getattr(dyad_solver.carve, "py_func", dyad_solver.carve)
     page = dyad_solver.PAGE
     state = np.empty(1000)
-    sizes = (C, 6 * 4 * C, 7 * 2 * C, 7 * C, C, C, 4 * C, C, C, 6 * 7 * C, C, 6 * C, 7 * C) + (C,) * 9
+    sizes = getattr(dyad_solver.block_sizes, "py_func", dyad_solver.block_sizes)(C, 6, 7, 7, 6)
+    assert len(sizes) == 22
     buffer, base = carve_buffer(sizes, state)
     origin = buffer.ctypes.data
     assert ((origin + 8 * base) - state.ctypes.data) % (8 * page) == 8 * (page // 2)

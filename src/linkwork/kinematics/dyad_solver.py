@@ -804,28 +804,7 @@ def closed_form_path(flat, plan, run):
     svd_state = multi_loop_state(E)  # the Jacobi warm start, from block to block (more loops)
     # Every float array of a block is carved from one buffer, at offsets fixed relative to each other and to the
     # rows' state (see carve): their placement no longer depends on the allocator.
-    sizes = (
-        C,
-        head[2] * 4 * C,
-        n * 2 * C,
-        n * C,
-        C,
-        C,
-        4 * C,
-        C,
-        C,
-        E * m * C,
-        C,
-        E * C,
-        m * C,
-        C,
-        C,
-        C,
-        C,
-        C,
-        C,
-        C,
-    )
+    sizes = block_sizes(C, head[2], n, m, E)
     buffer, base = carve_buffer(sizes, svd_state)
     at = base
     drive_q, at = carve(buffer, at, base, 0, C)
@@ -922,10 +901,20 @@ STAGGER = 24
 
 
 @kernel(inline="always")
+def block_sizes(C, bodies, n, m, E):
+    """The sizes of the 22 block arrays of :func:`closed_form_path`, in the order of their ``carve`` indices:
+    drive, poses, relative rotations, joint values, jumps, turns, scratch (three), Jacobians, residuals, singular
+    values, tangents, raw test function, the four measures, orientations, test function, status, turn bits."""
+    rows = (C, bodies * 4 * C, n * 2 * C, n * C, C, C, 4 * C, C, C, E * m * C, C, E * C, m * C)
+    return (*rows, C, C, C, C, C, C, C, C, C)  # (numba multiplies no tuple)
+
+
+@kernel(inline="always")
 def carve_buffer(sizes, state):
     """One uninitialised buffer for the block arrays of ``sizes`` (see :func:`carve`), and the offset ``base`` of
-    its first: half a page from the rows' ``state`` (modulo a page), wherever the allocator put either. Before, each array had its own allocation, and in about one process of four the allocator
-    placed two hot rows 4 KiB apart (modulo): the Watt six-bar's turn then took 360 ns a point instead of 260."""
+    its first: half a page from the rows' ``state`` (modulo a page), wherever the allocator put either. Before,
+    each array had its own allocation, and in about one process of four the allocator placed two hot rows 4 KiB
+    apart (modulo): the Watt six-bar's turn then took 360 ns a point instead of 260."""
     total = 0
     for size in sizes:
         total += size + 2 * PAGE
