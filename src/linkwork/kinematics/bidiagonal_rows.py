@@ -353,15 +353,16 @@ def lanes_check(S, L, m, E, strict):
 
 
 @kernel(**ROWS_OPTIONS)
-def lanes_cold(S, L, m, E):
+def lanes_cold(S, L, m, E, lanes):
     """Roots into ``XC`` from the bounds: the largest from Samuelson's bound of ``T``'s eigenvalues (``1/E + sqrt(E
     - 1) std``, ``std`` from ``trace(T) = 1`` and ``|T|_F^2``), each next from just below the one before
     (:data:`BELOW`), by :data:`COLD_STEPS` Laguerre steps on ``p(x) / Q(x)``, ``Q = prod (x - x_j)`` over the
     roots found (Maehly's deflation), in the homogeneous form ``f = p Q^2``, ``f' = (p' Q - p Q') Q``, ``f'' = p''
     Q^2 - 2 p' Q' Q - p Q'' Q + 2 p Q'^2`` (Laguerre's step is unchanged when ``f, f', f''`` are scaled
-    together): no division but the step's."""
+    together): no division but the step's. Lanes ``0 .. lanes - 1`` (every lane, or the first alone: see
+    :func:`lanes_roots`)."""
     _, _, _, _, _, _, _, A, W, _, _, _, _, _, XC, _, _, _, _, _, _ = work_rows(m, E)
-    for l in range(L):
+    for l in range(lanes):
         sq = 0.0
         for k in range(E):
             a = S[(A + k) * L + l]
@@ -374,9 +375,11 @@ def lanes_cold(S, L, m, E):
         S[XC * L + l] = (top if top < 1.0 else 1.0) * (1.0 + 8.0 * U)
     for r in range(E - 1):
         n = float(E - r)
-        for l in range(L):
-            x = S[XC * L + l] if r == 0 else S[(XC + r - 1) * L + l] * (1.0 - BELOW)
-            for _ in range(COLD_STEPS):
+        for l in range(lanes):
+            S[(XC + r) * L + l] = S[XC * L + l] if r == 0 else S[(XC + r - 1) * L + l] * (1.0 - BELOW)
+        for _ in range(COLD_STEPS):  # the lanes innermost: each step vectorised across them
+            for l in range(lanes):
+                x = S[(XC + r) * L + l]
                 p, dp, hp, _ = characteristic(S, L, E, l, x)
                 q, dq, hq = 1.0, 0.0, 0.0
                 for j in range(r):
@@ -390,8 +393,7 @@ def lanes_cold(S, L, m, E):
                 disc = (n - 1.0) * ((n - 1.0) * f1 * f1 - n * f * f2)
                 root = math.sqrt(disc if disc > 0.0 else 0.0)
                 den = f1 + root if f1 >= 0.0 else f1 - root
-                x -= n * f / (den if abs(den) > FLOOR else FLOOR)
-            S[(XC + r) * L + l] = x
+                S[(XC + r) * L + l] = x - n * f / (den if abs(den) > FLOOR else FLOOR)
 
 
 @kernel(**ROWS_OPTIONS)
@@ -418,14 +420,24 @@ def lanes_refine(S, L, m, E):
 @kernel(**ROWS_OPTIONS)
 def lanes_roots(S, L, m, E):
     """The roots of every lane, certified where possible (``OK``): refined from the state's previous roots
-    extrapolated one point on (:data:`HISTORY`); if any lane is fresh or not certified, the roots from the bounds
-    for those lanes, refined again."""
+    extrapolated one point on (:data:`HISTORY`), or at a path's first points (every lane fresh) from the first
+    lane's roots from the bounds; any lane then fresh or not certified, from its own roots from the bounds,
+    refined again."""
     _, _, _, _, _, _, _, _, _, _, _, X, _, _, XC, _, OK, _, PREV, SET, _ = work_rows(m, E)
     fresh = 0
     for l in range(L):
         fresh += 1 if S[SET * L + l] == 0.0 else 0
     bad = L
-    if fresh < L:
+    if fresh == L:
+        # A path's first points: the first lane's roots from the bounds, then every lane refined from them (the
+        # lanes' points are at most LANES - 1 points apart). Every lane from the bounds cost as much as a thousand
+        # points' rows (20 us); any lane the refinement does not certify still goes there, below.
+        lanes_cold(S, L, m, E, 1)
+        for r in range(E - 1):
+            for l in range(L):
+                S[(X + r) * L + l] = S[(XC + r) * L]
+        bad = lanes_refine(S, L, m, E)
+    elif fresh < L:
         H = E - 1
         for r in range(E - 1):
             for l in range(L):  # the polynomial through the last points (equally spaced), one point on
@@ -442,11 +454,8 @@ def lanes_roots(S, L, m, E):
                     else (quadratic if seen > 2.0 else (2.0 * x0 - x1 if seen > 1.0 else x0))
                 )
         bad = lanes_refine(S, L, m, E)
-    else:
-        for l in range(L):
-            S[OK * L + l] = 0.0
     if bad > 0:
-        lanes_cold(S, L, m, E)
+        lanes_cold(S, L, m, E, L)
         for r in range(E - 1):
             for l in range(L):
                 x = S[(X + r) * L + l]

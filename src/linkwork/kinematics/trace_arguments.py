@@ -25,20 +25,20 @@ __all__ = ["check_trace_arguments", "check_trace_subject"]
 def _real(name: str, value: Any, unit: str, *, positive: bool = False, finite: bool = True) -> float:
     """``value`` as a float, or a SpecError naming ``name``: a real number (not a bool), finite unless
     ``finite`` is False (then not NaN), above zero when ``positive``."""
+    if type(value) is float or (not isinstance(value, bool) and isinstance(value, Real)):
+        x = float(value)
+        if not (math.isnan(x) or (finite and math.isinf(x)) or (positive and not x > 0.0)):
+            return x
     what = ("a positive " if positive else "a ") + ("finite number" if finite else "number")
-    expected = f"expected {what}{f' ({unit})' if unit else ''}"
-    if isinstance(value, bool) or not isinstance(value, Real):
-        raise SpecError(f"{name}={value!r}: {expected}")
-    x = float(value)
-    if math.isnan(x) or (finite and math.isinf(x)) or (positive and not x > 0.0):
-        raise SpecError(f"{name}={value!r}: {expected}")
-    return x
+    raise SpecError(f"{name}={value!r}: expected {what}{f' ({unit})' if unit else ''}")
 
 
 def _count(name: str, value: Any, low: int, high: int = MAX_TRACE_STEPS) -> int:
     """``value`` as an int from ``low`` to ``high``, or a SpecError naming ``name`` (a whole number, not a
     float). The top is the command line's (``--max-steps``): ``max_steps=2**70`` was numpy's "Maximum allowed
     dimension exceeded"."""
+    if type(value) is int and low <= value <= high:  # the usual case, without the ABCs' checks
+        return value
     if isinstance(value, bool) or not isinstance(value, Integral) or not low <= int(value) <= high:
         raise SpecError(f"{name}={value!r}: expected a whole number, {low} <= {name} <= {high}")
     return int(value)

@@ -293,14 +293,16 @@ def _at_scale(mech: Mechanism, tol: Tolerances, backend: Backend) -> Tolerances:
     For a linkage larger than unity the residual's round-off floor grows as ``L``: a residual that stalls below
     ``roundoff * exact * L`` (not ``roundoff * exact``) is accepted, or a Bennett linkage of size 1e6 could not be
     traced (its floor is about 1e-10). ``closure`` (play in the hinges, a length the user gives) is not scaled."""
-    length = _length(mech, backend)
-    if not (0.0 < length and np.isfinite(length)) or length == 1.0:
-        return tol
-    if (
-        length > 1.0
-    ):  # the residual's round-off floor grows with the size: a stall there is accepted as closed
-        return replace(tol, roundoff=tol.roundoff * length)
-    return replace(tol, exact=tol.exact * length)
+
+    def build() -> Tolerances:
+        length = _length(mech, backend)
+        if not (0.0 < length and np.isfinite(length)) or length == 1.0:
+            return tol
+        if length > 1.0:  # the round-off floor grows with the size: a stall there is accepted as closed
+            return replace(tol, roundoff=tol.roundoff * length)
+        return replace(tol, exact=tol.exact * length)
+
+    return mech.derived(("tolerances at scale", tol), build)  # once per mechanism and tolerances
 
 
 def _step_weights(mech: Mechanism, backend: Backend) -> Array:
