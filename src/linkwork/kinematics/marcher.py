@@ -21,6 +21,7 @@ from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
 from linkwork.kinematics.jit import Backend
+from linkwork.kinematics.march import MAX_CROSSINGS
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
@@ -103,6 +104,9 @@ class Chunk:
     code: int
     h: float
     rank: NDArray[np.int64] | None = None  # each row's numerical rank, once the marcher has computed it
+    # Paper mode: the brackets of the sign changes of the test function within the last row, part by part
+    # (march.CROSSINGS: points, tangents, range bases before, count); None for an adaptive march.
+    crossings: tuple[Array, Array, Array, NDArray[np.int64]] | None = None
 
 
 @dataclass
@@ -236,6 +240,11 @@ class BranchMarcher:
             res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty(n + 1), count=0, code=0, h=h0,
         )  # fmt: skip
         ws = self.ws
+        E, r = basis.shape
+        crossings = (
+            np.empty((MAX_CROSSINGS, 2, m)), np.empty((MAX_CROSSINGS, 2, m)), np.empty((MAX_CROSSINGS, E, r)),
+            np.zeros(1, dtype=np.int64),
+        )  # fmt: skip
         steps = (
             paper,
             cfg.drive,
@@ -255,8 +264,10 @@ class BranchMarcher:
         )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
             ws.kernel_arrays(), (u, t, u_home, basis, reach, self._before(before, m)), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight),
-            (out.u, out.t, out.sigma, out.res, out.tau, out.s),
+            (out.u, out.t, out.sigma, out.res, out.tau, out.s, crossings),
         )  # fmt: skip
+        if paper:
+            out.crossings = crossings
         return out
 
     @staticmethod
@@ -1000,15 +1011,42 @@ class BranchMarcher:
             self.folds.append(Fold(branch_id, base + int(k), float(angles[joint]), angles))
 
     def _on_sign_change(self, chunk: Chunk, basis_prev: Array, branch_id: int, step: int) -> int | None:
-        """Locate the zero of the test function in the chunk's last step; returns the id if already known."""
+        """Locate every zero of the test function over the chunk's last row; returns the id of the point located
+        when it was already known (an adaptive step's one sign change; a paper row's known points are noted as
+        passed here, as it goes on through them).
+
+        An adaptive step is the bracket. A paper row's sign is compared part by part in the march, which hands
+        back the bracket of each part over which it changed (``chunk.crossings``): two crossings inside one row
+        (a parallelogram's at 180 and 360 deg in one equal step from 30 to 370 deg) leave the row's sign as it
+        was, and are each located and reported."""
+        c = chunk.count
+        if chunk.crossings is None:
+            basis_a = self._basis_before(chunk.u[c - 2], chunk.t[c - 2], basis_prev)
+            bracket = (chunk.u[c - 2], chunk.t[c - 2], basis_a, chunk.u[c - 1], chunk.t[c - 1])
+            return self._locate_crossing(chunk, bracket, branch_id, step)
+        cross_u, cross_t, cross_basis, cross_n = chunk.crossings
+        for k in range(min(int(cross_n[0]), MAX_CROSSINGS)):
+            bracket = (cross_u[k, 0], cross_t[k, 0], cross_basis[k], cross_u[k, 1], cross_t[k, 1])
+            known = self._locate_crossing(chunk, bracket, branch_id, step)
+            if known is not None:  # through a known point and on: the arcs on both sides are traced
+                self._arrived(known, cross_u[k, 1] - cross_u[k, 0])
+                self._arrived(known, cross_u[k, 0] - cross_u[k, 1])
+        return None
+
+    def _locate_crossing(
+        self, chunk: Chunk, bracket: tuple[Array, Array, Array, Array, Array], branch_id: int, step: int
+    ) -> int | None:
+        """Locate the zero of the test function in ``bracket = (u_a, t_a, basis_a, u_b, t_b)``, a step (or a
+        paper row's part) of the chunk's last row, ``basis_a`` the oriented range basis at ``u_a``; classify and
+        keep a new point (its branches queued), and put the chunk's last two rows onto it when they are on it.
+        Returns the id if already known."""
         cfg, c = self.cfg, chunk.count
-        passed = self._known_on_step(chunk.u[c - 2], chunk.u[c - 1])
+        u_a, t_a, basis_a, u_b, t_b = bracket
+        passed = self._known_on_step(u_a, u_b)
         if passed is not None:
             return passed
-        basis_a = self._basis_before(chunk.u[c - 2], chunk.t[c - 2], basis_prev)
         u_star, width = locate(
-            self.ws, chunk.u[c - 2], chunk.t[c - 2], basis_a, chunk.u[c - 1], chunk.t[c - 1],
-            cfg.r_path, cfg.tol, cfg.n_sigma, self.weight,
+            self.ws, u_a, t_a, basis_a, u_b, t_b, cfg.r_path, cfg.tol, cfg.n_sigma, self.weight,
         )  # fmt: skip
         known = self._match(u_star)
         if known is None:
@@ -1017,15 +1055,7 @@ class BranchMarcher:
                 # No rank drop where the test function vanishes: next to a bifurcation opened by an imperfection
                 # (an over-constrained loop written with rounded numbers) the path turns sharply and the test
                 # function changes sign there, while the rank drops at the nearest approach, within the step.
-                u_min, r_min = locate_minimum(
-                    self.ws,
-                    chunk.u[c - 2],
-                    chunk.t[c - 2],
-                    chunk.u[c - 1],
-                    chunk.t[c - 1],
-                    cfg.r_path,
-                    cfg.tol,
-                )
+                u_min, r_min = locate_minimum(self.ws, u_a, t_a, u_b, t_b, cfg.r_path, cfg.tol)
                 if r_min <= cfg.tol.loose and self._match(u_min) is None:
                     bif = classify_point(
                         self.mech, self.ws, len(self.found), branch_id, step, u_min, 0.0, cfg
@@ -1035,7 +1065,7 @@ class BranchMarcher:
                     1  # the test function changed sign without a rank drop: not a point to report
                 )
             else:
-                self._add_point(bif, branch_id, chunk.t[c - 2])
+                self._add_point(bif, branch_id, t_a)
                 for row in (c - 2, c - 1):
                     self._onto_point(chunk, row, bif)
         return known
