@@ -673,7 +673,11 @@ def march(mech, start, steps, corrector, bounds, out):
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, along, cos_turn, advance)
             elif paper:
-                ok = not jumps(u, u_try, periodic)
+                # An inner part's drive value is the march's own choice, not a row's: one whose tangent turned by
+                # more than an adaptive step may (a part a hair from a crossing, where the corrector with the
+                # drive held lands on either branch: a parallelogram's part 1e-4 rad short of 360 deg went on
+                # along the antiparallelogram's other branch) is taken again in more parts, which moves it.
+                ok = not jumps(u, u_try, periodic) and (part == parts - 1 or turn >= cos_turn)
         if not ok:
             if paper:  # the row's step again from its start, in twice as many parts and one
                 if parts >= MAX_PARTS:
