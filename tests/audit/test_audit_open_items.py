@@ -19,6 +19,7 @@ the angles of ``linkages.goldberg``'s module docstring, written out again here).
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -105,7 +106,9 @@ def four_pivots_in_line(case: FourBar, reading: float) -> float:
     end=st.floats(365.0, 535.0),
     side=st.sampled_from([0, 1]),
 )
-@example(kind="parallelogram", ground=2.0, ratio=0.5, start=15.0, end=472.6875, side=1)  # a part 0.0007 deg short
+@example(
+    kind="parallelogram", ground=2.0, ratio=0.5, start=15.0, end=472.6875, side=1
+)  # a part 0.0007 deg short
 def test_one_paper_row_over_both_crossings_reports_both(
     tmp_path_factory: object, kind: str, ground: float, ratio: float, start: float, end: float, side: int
 ) -> None:
@@ -137,7 +140,10 @@ def test_one_paper_row_over_both_crossings_reports_both(
     on_special = abs((float(invariant[-1]) + 180.0) % 360.0 - 180.0) < 1e-6
     assert on_special == special, "the row went on along the other branch through a crossing"
     points = [np.degrees(b.angles) for b in trace.bifurcations]
-    assert sorted(round(float(p[0]) % 360.0 / 180.0) % 2 for p in points) == [0, 1]  # one at 0, one at 180 deg
+    assert sorted(round(float(p[0]) % 360.0 / 180.0) % 2 for p in points) == [
+        0,
+        1,
+    ]  # one at 0, one at 180 deg
     for p in points:
         assert four_pivots_in_line(case, float(p[0])) < 1e-7
         # the other joints against the closed form at the crossing's own reading, to the square root of round-off:
@@ -147,3 +153,127 @@ def test_one_paper_row_over_both_crossings_reports_both(
         exact = float(p[0]) - ((float(p[0]) + 90.0) % 180.0 - 90.0)
         assert nearest(case.solve("A", exact), row, list("BCD"), set())[0] < 1e-4
     assert {b.kind for b in trace.bifurcations} == {"bifurcation"}
+
+
+# ---- properties: long paper steps where the drive nearly stops, against the adaptive path and the closed form
+
+
+def wrapped_gap(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest difference (rad) between two rows of joint angles, modulo whole turns."""
+    return float(np.max(np.abs(np.angle(np.exp(1j * (np.asarray(a) - np.asarray(b)))))))
+
+
+@settings(deadline=None, max_examples=8, derandomize=True)
+@given(degrees=st.floats(40.0, 170.0), sign=st.sampled_from([1.0, -1.0]), steps=st.sampled_from([1, 2, 3]))
+@example(
+    degrees=70.0, sign=1.0, steps=1
+)  # before: 19 of the 84 steps of 40, 50, ... 170 deg either way, in 1, 2
+@example(degrees=140.0, sign=1.0, steps=2)  # or 3 steps, failed (every one upwards of 70 deg in one step, of
+@example(degrees=170.0, sign=1.0, steps=1)  # 130 deg in two), though the adaptive trace reached each target
+def test_long_paper_steps_of_the_goldberg_linkage_land_on_the_adaptive_path(
+    tmp_path_factory: object, degrees: float, sign: float, steps: int
+) -> None:
+    """The audit's Goldberg 5R (other joints up to 435 times as fast as the drive A) in ``steps`` equal steps of A
+    over up to 170 deg either way: wherever the adaptive trace reaches the target without a fold of A on the way,
+    the paper trace does too, and each of its rows is the adaptive trace's point landed on that row's value of A,
+    to 1e-10 rad."""
+    spec = tmp_path_factory.mktemp("g") / "g.toml"  # type: ignore[attr-defined]
+    spec.write_text(GOLDBERG)
+    mech = lw.load(str(spec))
+    start = float(mech.offsets[mech.index("A")])
+    target = start + sign * degrees * RAD
+    adaptive = lw.trace(mech, until=("A", target))
+    if adaptive.stats.unmet is not None or adaptive.folds:
+        return  # a fold of A before the target: equal steps of A end at its turning point (tested elsewhere)
+    paper = lw.trace(mech, until=("A", target), steps=steps)
+    assert paper.stats.unmet is None
+    rows = np.asarray(paper.angles)
+    np.testing.assert_allclose(rows[:, 0], np.linspace(start, target, steps + 1), rtol=0.0, atol=1e-12)
+    for row in rows[1:]:
+        landed = lw.trace(mech, until=("A", float(row[0])))
+        assert landed.stats.unmet is None
+        assert wrapped_gap(landed.angles[-1], row) < 1e-10
+
+
+def bennett_partner(t1: np.ndarray, a1: float, a2: float) -> np.ndarray:
+    """Bennett's relation ``tan(t1/2) tan(t2/2) = sin((a2 + a1)/2) / sin((a2 - a1)/2)`` solved for ``t2``
+    (Bennett 1914), by ``atan2`` so that ``t1 = 0`` gives ``t2 = pi``."""
+    k = np.sin((a2 + a1) / 2.0) / np.sin((a2 - a1) / 2.0)
+    return 2.0 * np.arctan2(k * np.cos(t1 / 2.0), np.sin(t1 / 2.0))
+
+
+def goldberg_readings(theta: np.ndarray, alpha: float, beta: float, gamma: float) -> np.ndarray:
+    """Goldberg's 5R joint angles ``(5, n)`` at the first Bennett loop's angles ``theta`` (Goldberg 1943: two
+    Bennett loops sharing the link of twist ``beta``, welded; ``linkages.goldberg``'s docstring), up to whole
+    and half turns a mechanism's readings add."""
+    t2 = bennett_partner(theta, alpha, beta)
+    p1 = bennett_partner(t2, gamma, beta)
+    return np.array([theta + np.pi - p1, t2, -theta, np.pi + p1, -t2])
+
+
+def near_stop(seed: int) -> tuple[float, float, float, int, float, float, float]:
+    """A Goldberg 5R and a stretch of its path along which joint ``j`` moves one way only, through a point where
+    another joint moves at least 50 times as fast: ``(alpha, beta, gamma, j, theta_start, theta_end, theta_far)``
+    (the first loop's angle at the start and at the end of the step; ``theta_far`` the end of the stretch)."""
+    rng = np.random.default_rng(seed)
+    theta = np.linspace(-np.pi, np.pi, 8001)
+    while True:
+        alpha, beta = np.radians(rng.uniform(15.0, 85.0)), np.radians(rng.uniform(50.0, 140.0))
+        gamma = np.radians(rng.choice([-1.0, 1.0]) * rng.uniform(10.0, 70.0))
+        if (
+            min(
+                abs(np.sin((beta - alpha) / 2)),
+                abs(np.sin((beta - gamma) / 2)),
+                abs(np.sin((alpha - gamma) / 2)),
+            )
+            < 0.05
+        ):
+            continue
+        moves = np.diff(np.unwrap(goldberg_readings(theta, alpha, beta, gamma), axis=1), axis=1)
+        fastest = np.abs(moves).max(axis=0)
+        best = None
+        for j in range(5):
+            turns = np.flatnonzero(np.sign(moves[j][1:]) != np.sign(moves[j][:-1])) + 1
+            ends = [0, *turns.tolist(), moves.shape[1]]
+            for lo, hi in itertools.pairwise(ends):
+                ratio = fastest[lo:hi] / np.maximum(np.abs(moves[j][lo:hi]), 1e-300)
+                k = lo + int(np.argmax(ratio))
+                if (
+                    hi - lo >= 100
+                    and 50.0 < ratio.max() < 5000.0
+                    and lo + 0.1 * (hi - lo) < k < hi - 0.1 * (hi - lo)
+                ):
+                    if best is None or ratio.max() > best[0]:
+                        best = (float(ratio.max()), j, lo, hi, k)
+        if best is None:
+            continue
+        _, j, lo, hi, k = best
+        i0 = lo + int(rng.uniform(0.02, 0.3) * (k - lo))
+        i1 = k + int(rng.uniform(0.3, 0.95) * (hi - k))
+        return alpha, beta, gamma, j, float(theta[i0]), float(theta[i1]), float(theta[hi - 1])
+
+
+@settings(deadline=None, max_examples=6, derandomize=True)
+@given(seed=st.integers(0, 2**31 - 1))
+def test_one_paper_step_through_a_near_stop_of_the_drive_is_on_the_closed_form(seed: int) -> None:
+    """Random Goldberg 5Rs driven by a joint over a stretch where another moves 50 to 5,000 times as fast, in one
+    equal step: the row is the closed form's point at the target (its first loop's angle found by bisection on the
+    stretch, where the drive is monotone) to 1e-9 rad, and the adaptive trace's point landed there to 1e-10 rad."""
+    alpha, beta, gamma, j, th0, th1, th_far = near_stop(seed)
+    mech = goldberg(alpha, beta, gamma, 1.0, th0)
+
+    def drive_at(x: float) -> float:  # joint j's reading, continuous along the stretch from th0
+        path = np.unwrap(goldberg_readings(np.linspace(th0, x, 4001), alpha, beta, gamma), axis=1)
+        return float(mech.offsets[j] + path[j, -1] - path[j, 0])
+
+    target = drive_at(th1)
+    name = mech.joint_names[j]
+    paper = lw.trace(mech, until=(name, target), steps=1)
+    adaptive = lw.trace(mech, until=(name, target))
+    assert adaptive.stats.unmet is None
+    assert paper.stats.unmet is None
+    x = brentq(lambda v: drive_at(v) - target, th0, th_far, xtol=1e-15)
+    shift = np.asarray(mech.offsets, dtype=float) - goldberg_readings(np.array(th0), alpha, beta, gamma)
+    reference = goldberg_readings(np.array(x), alpha, beta, gamma) + shift
+    assert wrapped_gap(paper.angles[-1], reference) < 1e-9
+    assert wrapped_gap(paper.angles[-1], adaptive.angles[-1]) < 1e-10

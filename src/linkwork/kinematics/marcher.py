@@ -454,7 +454,7 @@ class BranchMarcher:
                     chunk.h = self._steps_onto_target(chunk, paper_steps - n_steps)
             elif paper and chunk.code == StopReason.FAILED and self.budget > 0:
                 followed = self._follow_row(chunk, basis, branch_id, n_steps)
-                if followed is None:  # the drive's next equal step is beyond a fold of the drive: its turning point
+                if followed is None:  # a fold of the drive before the step's value: its turning point
                     return n_steps, StopReason.TURNING, StopReason.TURNING.text, None, None
                 if followed.count < 2:  # the path could not be followed to the row's value either
                     return n_steps, StopReason.FAILED, self._end_reason(chunk, paper), None, None
@@ -876,9 +876,9 @@ class BranchMarcher:
                 if float(np.max(sign * (probe.u[k : k + 2, d] - u_start[d]))) >= asked:
                     return failed  # beyond the row's value, which the probe passed without landing on it
                 probe.count = k + 2  # the fold's step only
-                known = len(self.folds)
+                folds = len(self.folds)
                 self._scan_folds(probe, branch_id, step)
-                return None if len(self.folds) > known else failed
+                return None if len(self.folds) > folds else failed
             if float(np.max(sign * (probe.u[: probe.count, d] - u_start[d]))) > asked:
                 return failed  # the drive passed the row's value without landing on it
             self._scan_rank_minima(probe, branch_id, step)
