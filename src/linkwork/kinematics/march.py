@@ -46,6 +46,14 @@ PART_SHIFT = 0.3819660112501051
 golden ratio; the last part is that much longer): a part never lands on a round drive value where a row does not,
 such as a parallelogram's crossing at 180 deg met by the equal parts of 170 -> 190 deg, where the tangent has no
 direction and the next part went on along the other branch (or failed, reported as a turning point)."""
+NEAR_CROSSING = 1e-2
+"""Paper mode: an inner part of a row that lands where the path's smallest kept singular value is below this
+fraction of the largest (``Tolerances.local_min``'s default: next to a singular point) and whose tangent turned by
+more than an adaptive step may is taken again in more parts (see :func:`march`)."""
+SINGULAR_START = 1e-5
+"""Paper mode: a point whose smallest kept singular value is below this fraction of the largest
+(``Tolerances.loose``'s default) is taken as singular, its tangent without a direction: a part from it is not
+judged by its turn (:data:`NEAR_CROSSING`)."""
 MAX_CROSSINGS = 64
 """The most sign changes of the test function within one row whose brackets the march hands back (``crossings``
 in its ``out`` tuple). The sign is compared step by step, a paper row's parts included, so that two crossings
@@ -601,6 +609,9 @@ def march(mech, start, steps, corrector, bounds, out):
     # within one row would cancel between its rows): ``tau_last`` at the last point accepted, ``tau_row`` at the
     # row's start (a row taken again starts from it), ``n_cross`` the sign changes in the row so far.
     tau_last, tau_row, n_cross = tau, tau, 0
+    # whether the last point accepted (and the row's start) is singular, its tangent without a direction
+    singular_last = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
+    singular_row = singular_last
     cross_n[0] = 0
     if (
         reach[1] == 0.0
@@ -673,11 +684,15 @@ def march(mech, start, steps, corrector, bounds, out):
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, along, cos_turn, advance)
             elif paper:
-                # An inner part's drive value is the march's own choice, not a row's: one whose tangent turned by
-                # more than an adaptive step may (a part a hair from a crossing, where the corrector with the
-                # drive held lands on either branch: a parallelogram's part 1e-4 rad short of 360 deg went on
-                # along the antiparallelogram's other branch) is taken again in more parts, which moves it.
-                ok = not jumps(u, u_try, periodic) and (part == parts - 1 or turn >= cos_turn)
+                # An inner part's drive value is the march's own choice, not a row's: one that lands next to a
+                # singular point with its tangent turned by more than an adaptive step may (a part a hair from a
+                # crossing, where the corrector with the drive held meets both branches: a parallelogram's part
+                # 1e-5 rad short of 360 deg went on along the other branch) is taken again in more parts, which
+                # moves it. (Sharp turns away from singular points, next to a fold, are the path's own; so is a
+                # turn from a point whose tangent has no direction, a row landed on a crossing.)
+                near = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= NEAR_CROSSING * sig[0]
+                judged = part < parts - 1 and near and not singular_last
+                ok = not jumps(u, u_try, periodic) and (turn >= cos_turn or not judged)
         if not ok:
             if paper:  # the row's step again from its start, in twice as many parts and one
                 if parts >= MAX_PARTS:
@@ -689,7 +704,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 u[:] = u_row
                 t[:] = t_row
                 basis[:, :] = basis_row
-                tau_last, n_cross = tau_row, 0
+                tau_last, n_cross, singular_last = tau_row, 0, singular_row
                 continue
             h *= 0.5
             if h < hmin:
@@ -705,6 +720,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 cross_basis[n_cross, :, :] = basis
             n_cross += 1
         tau_last = tau_new
+        singular_last = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
         # the arclength reported is in the unknowns as they are (lengths in the length unit, as the closed form's)
         s_total += dist if not weighted else plain_length(u, u_try)
         longest = max(longest, dist)
@@ -726,7 +742,7 @@ def march(mech, start, steps, corrector, bounds, out):
         count += 1
         cross_n[0] = n_cross  # the sign changes within the row just written (an even number leaves its sign)
         crossed = -1.0 if n_cross > 0 else 1.0
-        tau_row, n_cross = tau_new, 0
+        tau_row, n_cross, singular_row = tau_new, 0, singular_last
         # ---- events that end the march
         if not paper and count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
             return count, NO_PROGRESS, h

@@ -906,11 +906,12 @@ class BranchMarcher:
         """The end reason a user reads for a chunk's stop code."""
         if chunk.code == StopReason.FAILED:
             if paper:
-                # No fold of the drive was found ahead (that ends as a turning point): the corrector did not
-                # converge at the next equal step, even in parts; an adaptive trace follows the path regardless.
+                # No fold of the drive was found ahead (that ends as a turning point), and the adaptive march that
+                # follows a failed equal step to its row (_follow_row) did not land there either.
                 return (
-                    "corrector failed at a fixed drive step (no turning point of the drive found before it; "
-                    "more equal steps, or an adaptive trace without steps / --steps, may pass)"
+                    "corrector failed at a fixed drive step (no turning point of the drive found before it, and the "
+                    "path not followed to the step's value; an adaptive trace without steps / --steps shows where "
+                    "it goes)"
                 )
             text = f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
             floor = self._closure_floor(chunk)
