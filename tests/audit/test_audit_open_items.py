@@ -23,6 +23,7 @@ import itertools
 from pathlib import Path
 
 import numpy as np
+import pytest
 from audit_reference import FourBar, nearest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
@@ -91,6 +92,21 @@ def test_a_long_paper_step_of_a_goldberg_linkage_is_taken(tmp_path: Path) -> Non
 PROPERTY = settings(deadline=None, max_examples=10, derandomize=True)
 
 
+def on_special_branch(case: FourBar, kind: str, start: float, row: np.ndarray) -> bool:
+    """Whether a row (deg) is on the parallelogram's parallelogram branch (the coupler's direction that of the
+    ground, 0 deg) or the deltoid's folded branch (C on A: the rocker points from D to A, 180 deg): the coupler's
+    direction is its start's plus A's and B's turns, the rocker's its start's minus D's (D turns the ground
+    relative to the rocker)."""
+    pts = case.pts
+    if kind == "parallelogram":
+        c = pts["C"] - pts["B"]
+        angle = np.degrees(np.arctan2(c[1], c[0])) + (row[0] - start) + row[1]
+    else:
+        c = pts["C"] - pts["D"]
+        angle = np.degrees(np.arctan2(c[1], c[0])) - row[3] - 180.0
+    return abs((float(angle) + 180.0) % 360.0 - 180.0) < 1e-6
+
+
 def four_pivots_in_line(case: FourBar, reading: float) -> float:
     """The distance (deg) from a crank reading to the nearest reading with the crank along the ground line, where
     a four-bar's singular configurations are (its four pivots in line)."""
@@ -136,8 +152,7 @@ def test_one_paper_row_over_both_crossings_reports_both(
     for r in rows:  # the rows, as before
         row = dict(zip("ABCD", r, strict=True))
         assert nearest(case.solve("A", row["A"]), row, list("ABCD"), set())[0] < 1e-9
-    invariant = rows[:, 0] + rows[:, 1] - start if kind == "parallelogram" else rows[:, 3]
-    on_special = abs((float(invariant[-1]) + 180.0) % 360.0 - 180.0) < 1e-6
+    on_special = on_special_branch(case, kind, start, rows[-1])
     assert on_special == special, "the row went on along the other branch through a crossing"
     points = [np.degrees(b.angles) for b in trace.bifurcations]
     assert sorted(round(float(p[0]) % 360.0 / 180.0) % 2 for p in points) == [
@@ -277,3 +292,38 @@ def test_one_paper_step_through_a_near_stop_of_the_drive_is_on_the_closed_form(s
     reference = goldberg_readings(np.array(x), alpha, beta, gamma) + shift
     assert wrapped_gap(paper.angles[-1], reference) < 1e-9
     assert wrapped_gap(paper.angles[-1], adaptive.angles[-1]) < 1e-10
+
+
+# ---- still open (found in session 17): strict expected failures, with what a right answer is
+
+
+@pytest.mark.xfail(
+    strict=True, reason="open: a paper row a hair short of a crossing goes on along the other branch"
+)
+@pytest.mark.parametrize(("steps", "row"), [(3, 2), (100, 60)])
+def test_a_paper_row_a_hair_short_of_a_crossing_stays_on_its_branch(
+    tmp_path: Path, steps: int, row: int
+) -> None:
+    """The parallelogram 2 x 1 on its antiparallelogram branch (side 1) from 15 deg, in equal steps whose row
+    ``row`` lands 1e-4 deg short of the crossing at 360 deg: the corrector holding the drive there meets both
+    branches within the prediction's error, and the rows after it went on along the parallelogram branch (the last
+    row 15 deg off the adaptive trace's for 3 steps, 100 deg for 100 steps; 1e-6 deg short as well, and 1e-2 deg
+    in 3 steps; 1e-6 deg past the crossing they stay). The inner parts of a row are retaken where this happens (a
+    part that turns next to a singular point); a row's own value is fixed, so that rule does not apply to it.
+    Right answer: the start's branch to the end."""
+    case = FourBar("parallelogram", 2.0, 1.0, 2.0, 1.0, 15.0, side=1)
+    pts = case.pts
+    assert (
+        np.linalg.norm((pts["C"] - pts["B"]) - (pts["D"] - pts["A"])) > 1e-3
+    )  # the antiparallelogram branch
+    spec = tmp_path / "pg.toml"
+    spec.write_text(case.mech.toml())
+    end = 15.0 + steps * (345.0 - 1e-4) / row
+    trace = lw.trace(lw.load(str(spec)), until=("A", end * RAD), steps=steps)
+    assert trace.stats.unmet is None
+    last = np.degrees(np.asarray(trace.angles))[-1]
+    assert (
+        nearest(case.solve("A", float(last[0])), dict(zip("ABCD", last, strict=True)), list("ABCD"), set())[0]
+        < 1e-9
+    )
+    assert not on_special_branch(case, "parallelogram", 15.0, last)  # still the antiparallelogram
