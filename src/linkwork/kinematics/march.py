@@ -39,13 +39,27 @@ MAX_PARTS = 1024
 a fold of the drive the path moves as the square root of the drive's distance to the fold); beyond, the march
 fails there."""
 PART_SLACK = 1e-9
+"""Paper mode: a drive step longer than ``hmax`` by less than this fraction of it (a step of ``hmax`` to
+round-off) is taken whole, not in two parts."""
 PART_SHIFT = 0.3819660112501051
 """Paper mode: the parts of a row's drive step end this fraction of a part short of the equal division (2 minus the
 golden ratio; the last part is that much longer): a part never lands on a round drive value where a row does not,
 such as a parallelogram's crossing at 180 deg met by the equal parts of 170 -> 190 deg, where the tangent has no
 direction and the next part went on along the other branch (or failed, reported as a turning point)."""
-"""Paper mode: a drive step longer than ``hmax`` by less than this fraction of it (a step of ``hmax`` to
-round-off) is taken whole, not in two parts."""
+NEAR_CROSSING = 1e-2
+"""Paper mode: an inner part of a row that lands where the path's smallest kept singular value is below this
+fraction of the largest (``Tolerances.local_min``'s default: next to a singular point) and whose tangent turned by
+more than an adaptive step may is taken again in more parts (see :func:`march`)."""
+SINGULAR_START = 1e-5
+"""Paper mode: a point whose smallest kept singular value is below this fraction of the largest
+(``Tolerances.loose``'s default) is taken as singular, its tangent without a direction: a part from it is not
+judged by its turn (:data:`NEAR_CROSSING`)."""
+MAX_CROSSINGS = 64
+"""The most sign changes of the test function within one row whose brackets the march hands back (``crossings``
+in its ``out`` tuple). The sign is compared step by step, a paper row's parts included, so that two crossings
+passed within one row (a parallelogram's at 180 and 360 deg in one equal step of 340 deg) do not cancel; every
+bracket, up to this many in a row, is located by the marcher. (A row of a thousand parts of a parallelogram turned
+many times over meets the same two points every turn: they are counted, and the first brackets located.)"""
 
 MECHANISM = ("twists", "loop_joint", "loop_sign", "loop_ptr", "rows", "groups")
 """The members of the mechanism tuple every kernel takes (see :mod:`linkwork.kinematics.kernels`)."""
@@ -60,8 +74,13 @@ MARCH_ARGUMENTS = {
     ),
     "corrector": CORRECTOR,
     "bounds": ("periodic", "lo", "hi", "weight"),
-    "out": ("out_u", "out_t", "out_sigma", "out_res", "out_tau", "out_s"),
+    "out": ("out_u", "out_t", "out_sigma", "out_res", "out_tau", "out_s", "crossings"),
 }  # fmt: skip
+CROSSINGS = ("cross_u", "cross_t", "cross_basis", "cross_n")
+"""The members of ``out``'s last one, the sign changes of the test function within the last row written:
+``cross_u (K, 2, m)`` and ``cross_t (K, 2, m)`` the points and tangents before and after each step (a paper row's
+part, or the row) over which the sign changed, ``cross_basis (K, E, r)`` the oriented range basis before it,
+``cross_n (1,)`` how many there were (``K`` = :data:`MAX_CROSSINGS` at most are written)."""
 """The tuples :func:`march` takes, in order, and their members."""
 
 
@@ -535,8 +554,9 @@ def march(mech, start, steps, corrector, bounds, out):
     :mod:`~linkwork.kinematics.kernels`); ``start = (u0, t0, u_home, basis, reach)``; ``steps = (paper, drive, h0,
     hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length, max_steps, r_path, detect,
     check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi, weight)``;
-    ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s)``, the rows written. numba unpacks each tuple once
-    per call; the inner kernels get the tuples they need.
+    ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s, crossings)``, the rows written and the brackets
+    of the sign changes of the test function within the last row (:data:`CROSSINGS`). numba unpacks each tuple
+    once per call; the inner kernels get the tuples they need.
 
     ``u_home`` is where the path began and ``reach = [far, longest, t_home...]`` how far the path has gone from it,
     its longest step and its tangent there (``2 + m`` zeros for a new path; updated in place), for closed-path
@@ -564,6 +584,7 @@ def march(mech, start, steps, corrector, bounds, out):
     for a in range(u0.shape[0]):
         weighted = weighted or weight[a] != 1.0
     out_u, out_sigma, out_res, out_tau = out[0], out[2], out[3], out[4]
+    cross_u, cross_t, cross_basis, cross_n = out[6]
     loop_ptr, rows, groups = mech[3], mech[4], mech[5]
     m = u0.shape[0]
     E = (loop_ptr.shape[0] - 1) * rows.shape[0]
@@ -584,6 +605,14 @@ def march(mech, start, steps, corrector, bounds, out):
     tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd, weight)
     t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
+    # The test function's sign is compared step by step, every part of a paper row included (two sign changes
+    # within one row would cancel between its rows): ``tau_last`` at the last point accepted, ``tau_row`` at the
+    # row's start (a row taken again starts from it), ``n_cross`` the sign changes in the row so far.
+    tau_last, tau_row, n_cross = tau, tau, 0
+    # whether the last point accepted (and the row's start) is singular, its tangent without a direction
+    singular_last = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
+    singular_row = singular_last
+    cross_n[0] = 0
     if (
         reach[1] == 0.0
     ):  # a new path (no step taken yet): its tangent at the start, for the closure's alignment
@@ -655,7 +684,15 @@ def march(mech, start, steps, corrector, bounds, out):
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, along, cos_turn, advance)
             elif paper:
-                ok = not jumps(u, u_try, periodic)
+                # An inner part's drive value is the march's own choice, not a row's: one that lands next to a
+                # singular point with its tangent turned by more than an adaptive step may (a part a hair from a
+                # crossing, where the corrector with the drive held meets both branches: a parallelogram's part
+                # 1e-5 rad short of 360 deg went on along the other branch) is taken again in more parts, which
+                # moves it. (Sharp turns away from singular points, next to a fold, are the path's own; so is a
+                # turn from a point whose tangent has no direction, a row landed on a crossing.)
+                near = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= NEAR_CROSSING * sig[0]
+                judged = part < parts - 1 and near and not singular_last
+                ok = not jumps(u, u_try, periodic) and (turn >= cos_turn or not judged)
         if not ok:
             if paper:  # the row's step again from its start, in twice as many parts and one
                 if parts >= MAX_PARTS:
@@ -667,12 +704,23 @@ def march(mech, start, steps, corrector, bounds, out):
                 u[:] = u_row
                 t[:] = t_row
                 basis[:, :] = basis_row
+                tau_last, n_cross, singular_last = tau_row, 0, singular_row
                 continue
             h *= 0.5
             if h < hmin:
                 return count, FAILED, h
             continue
         # ---- accept the step
+        if detect and tau_new * tau_last < 0.0:  # a sign change over this step: its bracket, for the locator
+            if n_cross < cross_u.shape[0]:
+                cross_u[n_cross, 0, :] = u
+                cross_u[n_cross, 1, :] = u_try
+                cross_t[n_cross, 0, :] = t
+                cross_t[n_cross, 1, :] = t_new
+                cross_basis[n_cross, :, :] = basis
+            n_cross += 1
+        tau_last = tau_new
+        singular_last = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
         # the arclength reported is in the unknowns as they are (lengths in the length unit, as the closed form's)
         s_total += dist if not weighted else plain_length(u, u_try)
         longest = max(longest, dist)
@@ -692,10 +740,13 @@ def march(mech, start, steps, corrector, bounds, out):
         write_row(out, count, u, t, sig, r, tau_new, s_total)
         recent[count % recent.shape[0]] = dist
         count += 1
+        cross_n[0] = n_cross  # the sign changes within the row just written (an even number leaves its sign)
+        crossed = -1.0 if n_cross > 0 else 1.0
+        tau_row, n_cross, singular_row = tau_new, 0, singular_last
         # ---- events that end the march
         if not paper and count > recent.shape[0] and np.sum(recent) < stall_length * hmax:
             return count, NO_PROGRESS, h
-        code = step_event(u, landing, lo, hi, detect, tau_new * out_tau[count - 2])
+        code = step_event(u, landing, lo, hi, detect, crossed)
         if code != NO_EVENT:
             return count, code, h
         if check_closed:
@@ -753,7 +804,7 @@ def back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
 def write_row(out, row, u, t, sig, r, tau, s):
     """Row ``row`` of the march's outputs ``out``: the point, its tangent, singular values, residual, test value
     and arclength."""
-    out_u, out_t, out_sigma, out_res, out_tau, out_s = out
+    out_u, out_t, out_sigma, out_res, out_tau, out_s = out[0], out[1], out[2], out[3], out[4], out[5]
     out_u[row, :] = u
     out_t[row, :] = t
     out_sigma[row, :] = sig
@@ -774,7 +825,8 @@ def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
 @kernel(inline="always")
 def step_event(u, landing, lo, hi, detect, tau_product):
     """The stop code an accepted step ends the march with (the target reached, a joint limit passed, a sign change
-    of the test function, ``tau_product`` being the product of its last two values), ``NO_EVENT`` for none. A step
+    of the test function within the step, ``tau_product`` negative: -1 when its sign changed at least once over
+    the row's steps or parts, compared one by one), ``NO_EVENT`` for none. A step
     landing on the target over which the test function changed sign ends with the sign change (the bifurcation it
     passed is located; the march then ends on the target it reached, ``BranchMarcher``)."""
     if landing:

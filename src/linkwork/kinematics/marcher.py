@@ -21,6 +21,7 @@ from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
 from linkwork.kinematics.jit import Backend
+from linkwork.kinematics.march import MAX_CROSSINGS
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
@@ -63,7 +64,8 @@ class MarchSettings:
 CYCLE_SLACK = 0.9
 
 #: Paper mode: the adaptive steps of each call of the probe that looks for a fold of the drive past a failed equal
-#: step (it goes on in such calls until it settles: :meth:`BranchMarcher._fold_ahead`).
+#: step, and follows the path to the row's value (it goes on in such calls until it settles:
+#: :meth:`BranchMarcher._follow_row`).
 FOLD_PROBE_STEPS = 60
 
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
@@ -103,6 +105,9 @@ class Chunk:
     code: int
     h: float
     rank: NDArray[np.int64] | None = None  # each row's numerical rank, once the marcher has computed it
+    # Paper mode: the brackets of the sign changes of the test function within the last row, part by part
+    # (march.CROSSINGS: points, tangents, range bases before, count); None for an adaptive march.
+    crossings: tuple[Array, Array, Array, NDArray[np.int64]] | None = None
 
 
 @dataclass
@@ -224,18 +229,26 @@ class BranchMarcher:
         reach: Array,
         before: Array | None = None,
         max_step: float | None = None,
+        towards: float | None = None,
     ) -> Chunk:
         """March at most ``n`` steps from ``(u, t)`` with the compiled kernel (``basis`` updated in place; ``reach
         = [far, longest, t_home...]``: how far the path has gone from ``u_home``, its longest step and its
         tangent there, updated in place; ``before``: the row before ``u`` and its tangent, ``(2, m)``, when the
         call goes on with the path of the one before, so that the rows do not depend on where calls begin;
-        ``max_step``: a cap below the settings' own, for :meth:`_jumped`'s probes)."""
+        ``max_step``: a cap below the settings' own, for :meth:`_jumped`'s probes; ``towards``: a drive value to
+        land on instead of the trace's target, for :meth:`_follow_row`'s probe)."""
         cfg, tol, m = self.cfg, self.cfg.tol, len(u)
         out = Chunk(
             u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
             res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty(n + 1), count=0, code=0, h=h0,
         )  # fmt: skip
         ws = self.ws
+        target = cfg.target if towards is None else towards
+        E, r = basis.shape
+        crossings = (
+            np.empty((MAX_CROSSINGS, 2, m)), np.empty((MAX_CROSSINGS, 2, m)), np.empty((MAX_CROSSINGS, E, r)),
+            np.zeros(1, dtype=np.int64),
+        )  # fmt: skip
         steps = (
             paper,
             cfg.drive,
@@ -243,8 +256,8 @@ class BranchMarcher:
             cfg.min_step,
             cfg.max_step if max_step is None else max_step,
             cfg.cos_turn,
-            0.0 if cfg.target is None else cfg.target,
-            cfg.target is not None,
+            0.0 if target is None else target,
+            target is not None,
             tol.advance,
             tol.stall_steps,
             tol.stall_length,
@@ -255,8 +268,10 @@ class BranchMarcher:
         )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
             ws.kernel_arrays(), (u, t, u_home, basis, reach, self._before(before, m)), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight),
-            (out.u, out.t, out.sigma, out.res, out.tau, out.s),
+            (out.u, out.t, out.sigma, out.res, out.tau, out.s, crossings),
         )  # fmt: skip
+        if paper:
+            out.crossings = crossings
         return out
 
     @staticmethod
@@ -437,13 +452,21 @@ class BranchMarcher:
                 cycle_from = n_steps
                 if paper:  # the steps left evened out onto the target from the closing row
                     chunk.h = self._steps_onto_target(chunk, paper_steps - n_steps)
-            elif (
-                paper
-                and chunk.code == StopReason.FAILED
-                and self._fold_ahead(chunk, basis, branch_id, n_steps)
-            ):
-                # the drive's next equal step is beyond a fold of the drive, located: its turning point
-                return n_steps, StopReason.TURNING, StopReason.TURNING.text, None, None
+            elif paper and chunk.code == StopReason.FAILED and self.budget > 0:
+                followed = self._follow_row(chunk, basis, branch_id, n_steps)
+                if followed is None:  # a fold of the drive before the step's value: its turning point
+                    return n_steps, StopReason.TURNING, StopReason.TURNING.text, None, None
+                if followed.count < 2:  # the path could not be followed to the row's value either
+                    return n_steps, StopReason.FAILED, self._end_reason(chunk, paper), None, None
+                # The row reached along the path, as the adaptive trace reaches it: recorded, and on from there.
+                self._record(followed, branch_id, False, n_steps)
+                n_steps += 1
+                self.budget -= 1
+                if self._on_target(followed):
+                    return n_steps, StopReason.TARGET, StopReason.TARGET.text, None, None
+                u, t, h0 = followed.u[1].copy(), followed.t[1].copy(), chunk.h
+                before = np.array([followed.u[0], followed.t[0]])
+                continue
             elif chunk.code != StopReason.BUDGET or self.budget <= 0:
                 if limit is not None:
                     return n_steps, StopReason.LIMIT, limit[1], limit[0], None
@@ -799,63 +822,96 @@ class BranchMarcher:
             f"{cycle_steps} steps and turns {name} by {per_cycle}), {self.budget} of {self.max_steps} steps left"
         )
 
-    def _fold_ahead(self, chunk: Chunk, basis: Array, branch_id: int, step: int) -> bool:
-        """Paper mode, the chunk's last equal drive step failed (in every number of parts): whether a fold of the
-        drive lies between its last row and the value that step asked for, where equal drive steps cannot go on.
+    def _follow_row(self, chunk: Chunk, basis: Array, branch_id: int, step: int) -> Chunk | None:
+        """Paper mode, the chunk's last equal drive step failed (in every number of parts): the row it asked for,
+        reached by following the path adaptively (arclength steps, as an adaptive trace does) from the last row up
+        to the row's drive value and landing on it exactly; ``None`` when a fold of the drive lies before that
+        value (equal drive steps cannot go on: the fold is located and recorded, the branch's turning point).
 
-        An adaptive march from the last row, towards larger drive values for a positive step, looks for the drive
-        turning back (:meth:`_scan_folds` locates it and records the fold, at step ``step``); its rows are not
-        kept. It goes on in calls of :data:`FOLD_PROBE_STEPS` steps, through sign changes of the test function,
-        until the drive turns back, passes the value the step asked for, the probe comes back round to the row
-        it left (a closed path) or ends otherwise, or it has taken as many steps as the trace has left: however
-        long the equal step (a few steps of 80 deg take dozens of adaptive ones to reach the fold, the other
-        joints turning further than the drive), the fold is found as with short steps. True when a fold was
-        found short of the step's value."""
+        Equal parts of the drive fail where the drive nearly stops: a Goldberg 5R's other joints turn up to 435
+        times as fast as its drive there, so that even a part of 1/1,311 of an 80 deg step moves them 26 deg, far
+        beyond what the tangent's prediction and the corrector with the drive held can follow, though the path
+        is smooth and an adaptive trace follows it. The probe's steps are arclength steps of at most ``max_step``,
+        towards larger drive values for a positive step; it goes on in calls of :data:`FOLD_PROBE_STEPS` steps,
+        locating on the way every sign change of the test function (:meth:`_on_sign_change`: the bifurcation
+        points the row passes are reported and their branches queued, as the march does) and the rank drops
+        without one, until it lands on the row's value (returned: a two-row chunk, the last row and the landed
+        one with its tangent, singular values, residual, test value and arclength; ``basis`` updated in place for
+        the march that goes on), the drive turns back (the fold, recorded at step ``step``, if it is short of the
+        value asked for), or it ends otherwise, comes back round to the row it left, or has taken as many steps
+        as the trace has left (a chunk of one row: the step failed). The probe's own rows are not kept: the rows
+        of a paper trace are its equal drive steps.
+        """
         cfg, d, c = self.cfg, self.cfg.drive, chunk.count - 1
+        failed = Chunk(
+            u=chunk.u[c : c + 1].copy(), t=chunk.t[c : c + 1].copy(), sigma=chunk.sigma[c : c + 1].copy(),
+            res=chunk.res[c : c + 1].copy(), tau=chunk.tau[c : c + 1].copy(), s=np.zeros(1), count=1,
+            code=int(StopReason.FAILED), h=chunk.h,
+        )  # fmt: skip
         if c < 0 or chunk.h == 0.0:
-            return False
+            return failed
         u, t = chunk.u[c].copy(), chunk.t[c].copy()
         if t[d] * chunk.h < 0.0:
             t = -t
         u_start, sign, asked = u.copy(), float(np.sign(chunk.h)), abs(chunk.h)
+        value = float(u_start[d] + chunk.h)  # the row's drive value, as the march computes it
+        if cfg.target is not None and abs(value - cfg.target) < 1e-9 * max(1.0, abs(cfg.target)):
+            value = cfg.target
         h = min(cfg.max_step, asked) / 4.0
         basis_probe, reach = basis.copy(), np.zeros(2 + len(u))
         before: Array | None = None
+        s_total = 0.0
         left = max(self.budget, FOLD_PROBE_STEPS)  # one call at least, else the steps the trace has left
         while True:
+            basis_prev = basis_probe.copy()
             probe = self.march_chunk(
-                u, t, u_start, basis_probe, False, h, min(FOLD_PROBE_STEPS, left), True, reach, before
-            )
+                u, t, u_start, basis_probe, False, h, min(FOLD_PROBE_STEPS, left), True, reach, before,
+                towards=value,
+            )  # fmt: skip
             left -= probe.count - 1
             td = probe.t[: probe.count, d]
             turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
-            if len(turned) > 0:
-                break
-            if float(np.max(sign * (probe.u[: probe.count, d] - u_start[d]))) >= asked:
-                return False  # the drive passes the value asked for without turning back
-            if probe.code not in (StopReason.BUDGET, StopReason.SIGN_CHANGE) or probe.count < 2 or left <= 0:
-                return False  # closed, failed, at a limit or the target, or out of steps: no fold ahead
+            if len(turned) > 0:  # the drive turns back before the row's value (where the probe would land)
+                k = int(turned[0])
+                if float(np.max(sign * (probe.u[k : k + 2, d] - u_start[d]))) >= asked:
+                    return failed  # beyond the row's value, which the probe passed without landing on it
+                probe.count = k + 2  # the fold's step only
+                folds = len(self.folds)
+                self._scan_folds(probe, branch_id, step)
+                return None if len(self.folds) > folds else failed
+            if float(np.max(sign * (probe.u[: probe.count, d] - u_start[d]))) > asked:
+                return failed  # the drive passed the row's value without landing on it
+            self._scan_rank_minima(probe, branch_id, step)
+            if probe.code == StopReason.SIGN_CHANGE:
+                known = self._on_sign_change(probe, basis_prev, branch_id, step)
+                if known is not None:
+                    self._passed(known, probe)
+            s_total += float(probe.s[probe.count - 1])
             last = probe.count - 1
+            if probe.code in (StopReason.TARGET, StopReason.SIGN_CHANGE) and probe.u[last, d] == value:
+                break  # landed on the row's value (a sign change on the landing step was located above)
+            if probe.code not in (StopReason.BUDGET, StopReason.SIGN_CHANGE) or probe.count < 2 or left <= 0:
+                return failed  # closed, failed, at a limit, or out of steps: the row is not reached
             u, t, h = probe.u[last].copy(), probe.t[last].copy(), probe.h
             before = np.array([probe.u[last - 1], probe.t[last - 1]])
-        k = int(turned[0])
-        reach_fold = np.max(sign * (probe.u[k : k + 2, d] - u_start[d]))
-        if reach_fold >= asked:  # the drive turns back beyond the value asked for: not what stopped the step
-            return False
-        probe.count = k + 2  # the fold's step only
-        known = len(self.folds)
-        self._scan_folds(probe, branch_id, step)
-        return len(self.folds) > known
+        basis[:, :] = basis_probe
+        return Chunk(
+            u=np.array([chunk.u[c], probe.u[last]]), t=np.array([chunk.t[c], probe.t[last]]),
+            sigma=np.array([chunk.sigma[c], probe.sigma[last]]), res=np.array([chunk.res[c], probe.res[last]]),
+            tau=np.array([chunk.tau[c], probe.tau[last]]), s=np.array([0.0, s_total]), count=2,
+            code=int(StopReason.BUDGET), h=chunk.h,
+        )  # fmt: skip
 
     def _end_reason(self, chunk: Chunk, paper: bool) -> str:
         """The end reason a user reads for a chunk's stop code."""
         if chunk.code == StopReason.FAILED:
             if paper:
-                # No fold of the drive was found ahead (that ends as a turning point): the corrector did not
-                # converge at the next equal step, even in parts; an adaptive trace follows the path regardless.
+                # No fold of the drive was found ahead (that ends as a turning point), and the adaptive march that
+                # follows a failed equal step to its row (_follow_row) did not land there either.
                 return (
-                    "corrector failed at a fixed drive step (no turning point of the drive found before it; "
-                    "more equal steps, or an adaptive trace without steps / --steps, may pass)"
+                    "corrector failed at a fixed drive step (no turning point of the drive found before it, and the "
+                    "path not followed to the step's value; an adaptive trace without steps / --steps shows where "
+                    "it goes)"
                 )
             text = f"corrector failed (step halved below {self.cfg.min_step:.1e} without converging)"
             floor = self._closure_floor(chunk)
@@ -1000,15 +1056,42 @@ class BranchMarcher:
             self.folds.append(Fold(branch_id, base + int(k), float(angles[joint]), angles))
 
     def _on_sign_change(self, chunk: Chunk, basis_prev: Array, branch_id: int, step: int) -> int | None:
-        """Locate the zero of the test function in the chunk's last step; returns the id if already known."""
+        """Locate every zero of the test function over the chunk's last row; returns the id of the point located
+        when it was already known (an adaptive step's one sign change; a paper row's known points are noted as
+        passed here, as it goes on through them).
+
+        An adaptive step is the bracket. A paper row's sign is compared part by part in the march, which hands
+        back the bracket of each part over which it changed (``chunk.crossings``): two crossings inside one row
+        (a parallelogram's at 180 and 360 deg in one equal step from 30 to 370 deg) leave the row's sign as it
+        was, and are each located and reported."""
+        c = chunk.count
+        if chunk.crossings is None:
+            basis_a = self._basis_before(chunk.u[c - 2], chunk.t[c - 2], basis_prev)
+            bracket = (chunk.u[c - 2], chunk.t[c - 2], basis_a, chunk.u[c - 1], chunk.t[c - 1])
+            return self._locate_crossing(chunk, bracket, branch_id, step)
+        cross_u, cross_t, cross_basis, cross_n = chunk.crossings
+        for k in range(min(int(cross_n[0]), MAX_CROSSINGS)):
+            bracket = (cross_u[k, 0], cross_t[k, 0], cross_basis[k], cross_u[k, 1], cross_t[k, 1])
+            known = self._locate_crossing(chunk, bracket, branch_id, step)
+            if known is not None:  # through a known point and on: the arcs on both sides are traced
+                self._arrived(known, cross_u[k, 1] - cross_u[k, 0])
+                self._arrived(known, cross_u[k, 0] - cross_u[k, 1])
+        return None
+
+    def _locate_crossing(
+        self, chunk: Chunk, bracket: tuple[Array, Array, Array, Array, Array], branch_id: int, step: int
+    ) -> int | None:
+        """Locate the zero of the test function in ``bracket = (u_a, t_a, basis_a, u_b, t_b)``, a step (or a
+        paper row's part) of the chunk's last row, ``basis_a`` the oriented range basis at ``u_a``; classify and
+        keep a new point (its branches queued), and put the chunk's last two rows onto it when they are on it.
+        Returns the id if already known."""
         cfg, c = self.cfg, chunk.count
-        passed = self._known_on_step(chunk.u[c - 2], chunk.u[c - 1])
+        u_a, t_a, basis_a, u_b, t_b = bracket
+        passed = self._known_on_step(u_a, u_b)
         if passed is not None:
             return passed
-        basis_a = self._basis_before(chunk.u[c - 2], chunk.t[c - 2], basis_prev)
         u_star, width = locate(
-            self.ws, chunk.u[c - 2], chunk.t[c - 2], basis_a, chunk.u[c - 1], chunk.t[c - 1],
-            cfg.r_path, cfg.tol, cfg.n_sigma, self.weight,
+            self.ws, u_a, t_a, basis_a, u_b, t_b, cfg.r_path, cfg.tol, cfg.n_sigma, self.weight,
         )  # fmt: skip
         known = self._match(u_star)
         if known is None:
@@ -1017,15 +1100,7 @@ class BranchMarcher:
                 # No rank drop where the test function vanishes: next to a bifurcation opened by an imperfection
                 # (an over-constrained loop written with rounded numbers) the path turns sharply and the test
                 # function changes sign there, while the rank drops at the nearest approach, within the step.
-                u_min, r_min = locate_minimum(
-                    self.ws,
-                    chunk.u[c - 2],
-                    chunk.t[c - 2],
-                    chunk.u[c - 1],
-                    chunk.t[c - 1],
-                    cfg.r_path,
-                    cfg.tol,
-                )
+                u_min, r_min = locate_minimum(self.ws, u_a, t_a, u_b, t_b, cfg.r_path, cfg.tol)
                 if r_min <= cfg.tol.loose and self._match(u_min) is None:
                     bif = classify_point(
                         self.mech, self.ws, len(self.found), branch_id, step, u_min, 0.0, cfg
@@ -1035,7 +1110,7 @@ class BranchMarcher:
                     1  # the test function changed sign without a rank drop: not a point to report
                 )
             else:
-                self._add_point(bif, branch_id, chunk.t[c - 2])
+                self._add_point(bif, branch_id, t_a)
                 for row in (c - 2, c - 1):
                     self._onto_point(chunk, row, bif)
         return known
