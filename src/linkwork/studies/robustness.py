@@ -127,7 +127,7 @@ def prepare(
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
     weights = weights_along(mech, trace.angles[first], scale.length)
-    G, normal = sensitivity_maps(mech, u_path, lines, weights)
+    G, normal = sensitivity_maps(mech, u_path, lines, weights, scale.length)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
