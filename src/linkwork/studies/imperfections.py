@@ -98,7 +98,7 @@ class HingeLines:
         ``e1`` points from the line towards ``centre`` (along their common normal) and ``e2 = direction x e1``,
         so that errors drawn in this basis do not depend on where the linkage stands or how it is turned; a line
         through the centre (or a prismatic joint) takes ``e1`` normal to it towards the direction of its nearest
-        non-parallel neighbour in loop order (:func:`_normal_towards_neighbours`), which turns with it too.
+        non-parallel neighbour in the joints' order (:func:`_normal_towards_neighbours`), which turns with it too.
         """
         w = mech.twists[:, :3]
         revolute = np.einsum("ij,ij->i", w, w) > 0.5
@@ -117,8 +117,8 @@ class HingeLines:
 
 def _normal_towards_neighbours(directions: Array) -> Array:
     """``(n, 3)`` per joint a vector normal to its direction, built from the linkage itself: the part normal to
-    it of the direction of the nearest joint in loop order (the next, the one before, then further) that is not
-    parallel to it; the coordinate axis the direction is most nearly normal to only if every joint is parallel.
+    it of the direction of the nearest joint in the order the joints are written (the next, the one before, then
+    further, round the list as round a loop) that is not parallel to it; the coordinate axis the direction is most nearly normal to only if every joint is parallel.
 
     This is the basis of the lines through the centre (a spherical linkage's) and of prismatic joints, so that
     their errors, too, turn with the linkage when it is moved or turned (a coordinate axis does not: a turned
