@@ -65,7 +65,12 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
 
 
 def sensitivity_maps(
-    mech: Mechanism, u_path: Array, lines: HingeLines, T: Array, length: float = 1.0
+    mech: Mechanism,
+    u_path: Array,
+    lines: HingeLines,
+    T: Array,
+    length: float = 1.0,
+    cycles: Array | None = None,
 ) -> tuple[Array, Array]:
     """Per path point: the map ``G_k = N_k^T T_k B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
     space), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's tangent (the last
@@ -75,15 +80,18 @@ def sensitivity_maps(
     "Normal" is measured with a slider's travel in the linkage's length ``length`` (the misfit's ``L``) and the
     angles in radians, so that the plane, and with it the misfit beyond first order, does not depend on the length
     unit the linkage is written in (the tangent itself does not; the plane normal to it in raw unknowns did, for a
-    linkage with a prismatic joint)."""
+    linkage with a prismatic joint). ``cycles`` combine the loops' rows as the misfit does
+    (:func:`linkwork.studies.scale.loop_weights`; none: as they are)."""
     K = u_path.shape[0]
     E = mech.n_equations
     m = mech.n_unknowns
     G = np.zeros((K, E, 4 * mech.n_joints))
     normal = np.zeros((K, m, m - 1))
     metric = unknown_metric(mech, length)
+    mix = np.eye(E) if cycles is None else np.kron(cycles, np.eye(len(mech.rows)))
     for k in range(K):
         J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T[k] if T.ndim == 3 else T)
+        J, B = mix @ J, mix @ B
         U, sigma, Vt = np.linalg.svd(J, full_matrices=True)
         rank = numerical_rank(sigma)
         if np.all(metric == 1.0):

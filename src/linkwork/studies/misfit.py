@@ -177,24 +177,51 @@ def _log_jacobian(r: np.ndarray, J: np.ndarray, T: np.ndarray, rows: np.ndarray,
                 J[base + e, a] = z[rows[e]]
 
 
+@kernel(inline="always")
+def _mix_loops(
+    r: np.ndarray, J: np.ndarray, cycles: np.ndarray, nrows: int, rb: np.ndarray, Jb: np.ndarray
+) -> None:
+    """``r``, ``J`` with their loop blocks combined by ``cycles`` (:func:`linkwork.studies.scale.loop_weights`), in
+    place: the loops' rows made orthonormal over the cycle space, so that the stacked residual's size does not
+    depend on which cycle basis (which ground body) the body graph gave. Nothing to do for one loop."""
+    n_loops = cycles.shape[0]
+    if n_loops < 2:
+        return
+    for e in range(r.shape[0]):
+        loop, row = e // nrows, e % nrows
+        acc = 0.0
+        for other in range(n_loops):
+            acc += cycles[loop, other] * r[other * nrows + row]
+        rb[e] = acc
+        for a in range(J.shape[1]):
+            acc = 0.0
+            for other in range(n_loops):
+                acc += cycles[loop, other] * J[other * nrows + row, a]
+            Jb[e, a] = acc
+    for e in range(r.shape[0]):
+        r[e] = rb[e]
+        for a in range(J.shape[1]):
+            J[e, a] = Jb[e, a]
+
+
 @kernel()
 def misfit_along_path(
     mech: tuple[np.ndarray, ...],
-    path: tuple[np.ndarray, np.ndarray],
+    path: tuple[np.ndarray, np.ndarray, np.ndarray],
     T: np.ndarray,
     max_iter: int,
     out: np.ndarray,
 ) -> None:
     """Misfit ``out (K,)`` of one imperfect mechanism ``mech`` (the mechanism tuple of
     :mod:`~linkwork.kinematics.kernels`, with its perturbed twists) at every nominal path point of ``path =
-    (u_path (K, m), normal)``.
+    (u_path (K, m), normal, cycles)`` (the loops' rows combined by ``cycles``: :func:`_mix_loops`).
 
     At point ``k`` the unknowns move in the plane normal to the nominal path, ``u = u_k + Q_k y`` with
     ``normal[k] = Q_k (m, m - 1)`` orthonormal: the drive held wherever it parameterises the path, and still a
     well-posed problem at a fold of the drive. ``T (K, 6, 6)`` is the weight at every point (its centre moves with
     the linkage: :func:`linkwork.studies.scale.weights_along`).
     """
-    u_path, normal = path
+    u_path, normal, cycles = path
     loop_ptr, rows, groups = mech[3], mech[4], mech[5]
     K, m = u_path.shape
     p = normal.shape[2]
@@ -211,6 +238,8 @@ def misfit_along_path(
     y_old = np.zeros(p)
     u = np.empty(m)
     log_work = np.empty((3, 6))
+    mixed_r = np.empty(E)
+    mixed_J = np.empty((E, m))
     offsets = np.zeros((3, m))  # the solutions' offsets from the path at the last three points, newest first
     for k in range(K):
         if k > 0:
@@ -224,6 +253,7 @@ def misfit_along_path(
             expand(u, groups, q)
             closure_pass(mech, q, T[k], r, J, matrices, vectors)
             _log_jacobian(r, J, T[k], rows, log_work)
+            _mix_loops(r, J, cycles, rows.shape[0], mixed_r, mixed_J)
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and gain <= 1e-6 * best * best:
                 break  # a step predicted to gain next to nothing came out worse: round-off; best is the minimum
@@ -268,13 +298,13 @@ def misfit_along_path(
 @kernel(nogil=True)  # nogil: a Dask worker keeps talking to its scheduler while a chunk computes
 def misfit_batch(
     twists: np.ndarray,
-    path: tuple[np.ndarray, np.ndarray],
+    path: tuple[np.ndarray, np.ndarray, np.ndarray],
     loops: tuple[np.ndarray, ...],
     T: np.ndarray,
     max_iter: int,
 ) -> np.ndarray:
     """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path ``path =
-    (u_path, normal)``; ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
+    (u_path, normal, cycles)`` (``cycles`` the loops' weights, :func:`linkwork.studies.scale.loop_weights`); ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
     its twists); weights ``T (K, 6, 6)``, one per point."""
     S = twists.shape[0]
     out = np.empty((S, path[0].shape[0]))
