@@ -113,7 +113,9 @@ def inversion(case: FourBar | SliderCrank, body: str) -> Mech:
         SliderCrank("offset-slider-crank", 1.0, 3.0, 0.4, 40.0),
     ],
 )
-def test_every_inversion_traces_the_same_rows_with_its_own_singular_values(tmp_path: Path, case) -> None:  # type: ignore[no-untyped-def]
+def test_every_inversion_traces_the_same_rows_with_its_own_singular_values(
+    tmp_path: Path, case: FourBar | SliderCrank
+) -> None:
     base = None
     for body in case.mech.bodies:
         ref = inversion(case, body)

@@ -118,7 +118,8 @@ class HingeLines:
 def _normal_towards_neighbours(directions: Array) -> Array:
     """``(n, 3)`` per joint a vector normal to its direction, built from the linkage itself: the part normal to
     it of the direction of the nearest joint in the order the joints are written (the next, the one before, then
-    further, round the list as round a loop) that is not parallel to it; the coordinate axis the direction is most nearly normal to only if every joint is parallel.
+    further, round the list as round a loop) that is not parallel to it; the coordinate axis the direction is
+    most nearly normal to only if every joint is parallel.
 
     This is the basis of the lines through the centre (a spherical linkage's) and of prismatic joints, so that
     their errors, too, turn with the linkage when it is moved or turned (a coordinate axis does not: a turned

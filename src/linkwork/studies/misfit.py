@@ -304,7 +304,8 @@ def misfit_batch(
     max_iter: int,
 ) -> np.ndarray:
     """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path ``path =
-    (u_path, normal, cycles)`` (``cycles`` the loops' weights, :func:`linkwork.studies.scale.loop_weights`); ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
+    (u_path, normal, cycles)`` (``cycles`` the loops' weights, :func:`linkwork.studies.scale.loop_weights`);
+    ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
     its twists); weights ``T (K, 6, 6)``, one per point."""
     S = twists.shape[0]
     out = np.empty((S, path[0].shape[0]))
