@@ -21,7 +21,7 @@ def test_misfit_is_the_least_residual_in_the_normal_plane() -> None:
     errors = hinge_errors(sample_seeds(4, 0, 2), setup.mech, setup.model, setup.lines)
     twists = perturbed_twists(errors, setup.lines)
     path_args, loops, weights = setup.kernel_args()
-    u_path, normal = path_args
+    u_path, normal, _ = path_args  # one loop: its weight is 1
     misfit = misfit_batch(twists, path_args, loops, weights, MAX_ITER)
     for s in range(len(twists)):
         imperfect = lw.Mechanism.single_loop("imperfect", mech.joint_names, twists[s])

@@ -212,6 +212,13 @@ class Mechanism:
         """Whether the mechanism is planar however it is written (:meth:`plane_normal`)."""
         return self.plane_normal() is not None
 
+    @property
+    def moves_in_xy(self) -> bool:
+        """Whether the mechanism moves in the x-y plane however it is written (a ``planar`` mechanism, a ``dh``
+        loop with zero twists, parallel hinge lines along z): what the drawings and the viewer show from above."""
+        normal = self.plane_normal()
+        return normal is not None and abs(float(normal[2])) > 1.0 - 1e-12
+
     def index(self, joint: str | int) -> int:
         """Index of a joint given by name or index; a clear :class:`SpecError` for an unknown one."""
         if isinstance(joint, int | np.integer):

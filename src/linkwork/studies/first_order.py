@@ -64,24 +64,56 @@ def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -
     return J @ mech.coupling_matrix(), B.reshape(mech.n_equations, 4 * n)
 
 
-def sensitivity_maps(mech: Mechanism, u_path: Array, lines: HingeLines, T: Array) -> tuple[Array, Array]:
+def sensitivity_maps(
+    mech: Mechanism,
+    u_path: Array,
+    lines: HingeLines,
+    T: Array,
+    length: float = 1.0,
+    cycles: Array | None = None,
+) -> tuple[Array, Array]:
     """Per path point: the map ``G_k = N_k^T T_k B_k`` padded to ``(K, E, 4n)`` (zero rows beyond the left null
     space), and ``(K, m, m - 1)`` an orthonormal basis ``Q_k`` of the plane normal to the path's tangent (the last
     right singular vector), in which the misfit is minimised. ``T`` is one weight ``(6, 6)`` or one per point
-    ``(K, 6, 6)`` (:func:`linkwork.studies.scale.weights_along`)."""
+    ``(K, 6, 6)`` (:func:`linkwork.studies.scale.weights_along`).
+
+    "Normal" is measured with a slider's travel in the linkage's length ``length`` (the misfit's ``L``) and the
+    angles in radians, so that the plane, and with it the misfit beyond first order, does not depend on the length
+    unit the linkage is written in (the tangent itself does not; the plane normal to it in raw unknowns did, for a
+    linkage with a prismatic joint). ``cycles`` combine the loops' rows as the misfit does
+    (:func:`linkwork.studies.scale.loop_weights`; none: as they are)."""
     K = u_path.shape[0]
     E = mech.n_equations
     m = mech.n_unknowns
     G = np.zeros((K, E, 4 * mech.n_joints))
     normal = np.zeros((K, m, m - 1))
+    metric = unknown_metric(mech, length)
+    mix = np.eye(E) if cycles is None else np.kron(cycles, np.eye(len(mech.rows)))
     for k in range(K):
         J, B = linearised_closure(mech, mech.q_from_u(u_path[k]), lines, T[k] if T.ndim == 3 else T)
+        J, B = mix @ J, mix @ B
         U, sigma, Vt = np.linalg.svd(J, full_matrices=True)
         rank = numerical_rank(sigma)
-        normal[k] = Vt[: m - 1].T
+        if np.all(metric == 1.0):
+            normal[k] = Vt[: m - 1].T
+        else:
+            # the plane {x : t . M x = 0} (M = metric^2, t the tangent) in an orthonormal basis of its own
+            _, _, Wt = np.linalg.svd((metric**2 * Vt[m - 1])[None, :], full_matrices=True)
+            normal[k] = Wt[1:].T
         N = U[:, rank:]
         G[k, : N.shape[1], :] = N.T @ B
     return G, normal
+
+
+def unknown_metric(mech: Mechanism, length: float) -> Array:
+    """``(m,)`` the size of one unit of each unknown in the linkage's own measure: 1 for an angle (radians),
+    ``1 / length`` for a slider's travel (a length)."""
+    metric = np.ones(mech.n_unknowns)
+    for j, kind in enumerate(mech.joint_types):
+        group = int(mech.groups[j])
+        if kind == "P" and group >= 0:
+            metric[group] = 1.0 / length
+    return metric
 
 
 @kernel(fastmath=True)

@@ -34,7 +34,7 @@ from linkwork.studies.imperfections import (
     sample_seeds,
 )
 from linkwork.studies.misfit import misfit_batch
-from linkwork.studies.scale import MisfitScale, misfit_scale, weights_along
+from linkwork.studies.scale import MisfitScale, loop_weights, misfit_scale, weights_along
 
 Array = NDArray[np.float64]
 
@@ -67,13 +67,18 @@ class RobustnessSetup:
     weights: Array
     G: Array
     ratio_normalised: Array
+    cycles: Array
     keep_tol: float
 
     def kernel_args(self) -> tuple[Any, ...]:
         """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists: ``(path, loops, weight)``."""
         joint, sign, ptr = self.mech.loop_arrays()
         rows = np.array(self.mech.rows, dtype=np.int64)
-        return (self.u_path, self.normal), (joint, sign, ptr, rows, self.mech.groups), self.weights
+        return (
+            (self.u_path, self.normal, self.cycles),
+            (joint, sign, ptr, rows, self.mech.groups),
+            self.weights,
+        )
 
 
 @dataclass
@@ -127,7 +132,8 @@ def prepare(
     scale = misfit_scale(mech)
     lines = HingeLines.of(mech, scale.centre)
     weights = weights_along(mech, trace.angles[first], scale.length)
-    G, normal = sensitivity_maps(mech, u_path, lines, weights)
+    cycles = loop_weights(mech)
+    G, normal = sensitivity_maps(mech, u_path, lines, weights, scale.length, cycles)
     comp = component_scale(mech, model, lines)
     tol_size = float(comp[:, 2:].max(initial=0.0) + scale.length * comp[:, :2].max(initial=0.0))
     return RobustnessSetup(
@@ -144,6 +150,7 @@ def prepare(
         weights=weights,
         G=G,
         ratio_normalised=trace.condition()[first],
+        cycles=cycles,
         keep_tol=1e-6 * tol_size + 1e-12 * scale.length,
     )
 

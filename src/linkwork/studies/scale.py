@@ -114,3 +114,19 @@ def centre_and_length(mech: Mechanism) -> tuple[Array, float]:
         return centre, float(length)
     size = float(np.sqrt(np.mean(np.sum((hinge_pivots(mech)[revolute] - centre) ** 2, axis=1))))
     return centre, size if size > 1e-12 * spread else 1.0
+
+
+def loop_weights(mech: Mechanism) -> Array:
+    """``(loops, loops)`` the weights that combine the loops' residuals before their size is taken:
+    ``sqrt(n / l) (Z Z^T)^(-1/2)`` for the signed loop-joint incidence ``Z`` (``l`` loops over ``n`` joints in some
+    loop; :func:`linkwork.kinematics.normalization.cycle_metric`), the loops made orthonormal over the cycle space.
+
+    Another body held as the ground gives the body graph another cycle basis ``Z' = M Z`` (a six-bar's two loops,
+    or one of them and their sum), whose residuals are combined by ``M`` to first order; these weights give the
+    stacked residual the same size in every basis, so the misfit does not depend on the ground. The factor makes
+    them 1 for a single loop (its misfit is its own residual, as before).
+    """
+    from linkwork.kinematics.normalization import cycle_metric
+
+    in_loops = {j for loop in mech.loops for j in loop.joints}
+    return np.ascontiguousarray(np.sqrt(len(in_loops) / len(mech.loops)) * cycle_metric(mech))

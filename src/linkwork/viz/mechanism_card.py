@@ -48,7 +48,7 @@ def summary(mech: Mechanism) -> str:
         f"{joints} joints ({names})",
         f"{len(mech.bodies)} bodies",
         loops,
-        "planar" if mech.planar else "spatial",
+        "planar" if mech.moves_in_plane else "spatial",
     ]
     name = mech.name if len(mech.name) <= MAX_NAME else mech.name[: MAX_NAME - 3] + "..."
     return f"<Mechanism {name!r}: " + "; ".join(parts + extra) + ">"
@@ -119,8 +119,9 @@ def _body_joints(mech: Mechanism, body: str) -> list[str]:
 
 
 def _projected(mech: Mechanism, points: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Drawing coordinates: x, y for a planar mechanism, an isometric view (from (1, -1, 1)) otherwise."""
-    if mech.planar:
+    """Drawing coordinates: x, y for a mechanism moving in that plane, an isometric view (from (1, -1, 1))
+    otherwise."""
+    if mech.moves_in_xy:
         return points[:, :2].copy()
     c, s = math.cos(math.radians(30.0)), math.sin(math.radians(30.0))
     x, y, z = points.T
@@ -163,7 +164,7 @@ def drawing(mech: Mechanism, points: NDArray[np.float64] | None = None) -> str:
             f"<text x='{px[j, 0] + 6:.1f}' y='{px[j, 1] - 6:.1f}' font-size='11' font-family='sans-serif'>"
             f"{html.escape(name)}</text>"
         )
-    view = "planar, x right, y up" if mech.planar else "isometric view"
+    view = "planar, x right, y up" if mech.moves_in_xy else "isometric view"
     return (
         f"<svg xmlns='http://www.w3.org/2000/svg' width='{DRAWING_PX}' height='{DRAWING_PX}' "
         f"viewBox='0 0 {DRAWING_PX} {DRAWING_PX}' role='img'><title>{html.escape(mech.name)} at its start "

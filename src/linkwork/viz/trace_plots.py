@@ -216,6 +216,6 @@ def write_trace_figures(trace: Trace, out: Path) -> list[Path]:
         plot_angles(trace, out / "angles.png"),
         plot_singular_values(trace, out / "singular_values.png"),
     ]
-    if trace.mechanism.planar or trace.mechanism.meta.get("points"):
+    if trace.mechanism.moves_in_xy or trace.mechanism.meta.get("points"):
         figures.append(plot_points(trace, out / "points.png"))
     return figures

@@ -294,7 +294,7 @@ def trace_viewer_data(
         "title": title or mech.name,
         "mechanism": mech.name,
         "drive": mech.index(trace.drive) if trace.drive in mech.joint_names else 0,
-        "planar": bool(mech.planar),
+        "planar": bool(mech.moves_in_xy),
         "joints": _joint_entries(mech, joint_labels(mech, parts)),
         "bodies": list(mech.bodies),
         "parts": [_part_entry(p) for p in parts],
