@@ -131,6 +131,45 @@ def _ad(w: np.ndarray, v: np.ndarray, z: np.ndarray, out: np.ndarray) -> None:
 
 
 @kernel(inline="always")
+def _log_gradient(r: np.ndarray, T: np.ndarray, rows: np.ndarray, work: np.ndarray, rg: np.ndarray) -> None:
+    """``rg = M^T r`` per loop, ``M = T (I - ad_X / 2) T^-1`` the map :func:`_log_jacobian` applies to the columns
+    (``X = T^-1 r``): ``J^T rg`` is then the gradient of ``|T log P|^2 / 2`` that :func:`_log_jacobian`'s columns
+    give (``(M J)^T r``), from one vector a loop instead of every column. Gauss-Newton with the twist columns'
+    normal matrix and this gradient stops where the true gradient is zero, the least residual, as
+    :func:`_log_jacobian` does (the normal matrix errs by ``O(|X|)``: the steps converge linearly at that rate,
+    and ``|X|`` is the misfit itself). Used where the loops are not mixed (one loop: the Monte Carlo's hexagon),
+    where ``J`` is then left as it is. ``T^T = [[L I, T21^T], [0, I]]``, ``ad_X^T y = (-(w x y_w) - v x y_v, -(w
+    x y_v))``, ``T^-T = [[I / L, -T21^T / L], [0, I]]``."""
+    x, z, z1 = work[0], work[1], work[2]
+    nrows = rows.shape[0]
+    length = T[0, 0]
+    for loop in range(r.shape[0] // nrows):
+        base = loop * nrows
+        z[:] = 0.0
+        for e in range(nrows):
+            z[rows[e]] = r[base + e]
+        for i in range(3):  # X = T^-1 r
+            x[i] = z[i] / length
+        for i in range(3):
+            x[3 + i] = z[3 + i] - (T[3 + i, 0] * x[0] + T[3 + i, 1] * x[1] + T[3 + i, 2] * x[2])
+        w, v = x[0:3], x[3:6]
+        for i in range(3):  # z1 = T^T r
+            z1[i] = length * z[i] + T[3, i] * z[3] + T[4, i] * z[4] + T[5, i] * z[5]
+            z1[3 + i] = z[3 + i]
+        for i in range(6):  # z = (I - ad_X / 2)^T z1 = z1 + (w x z1_w + v x z1_v, w x z1_v) / 2
+            z[i] = 0.0
+        _cross_add(w, z1[0:3], z, 0)
+        _cross_add(v, z1[3:6], z, 0)
+        _cross_add(w, z1[3:6], z, 3)
+        for i in range(6):
+            z[i] = z1[i] + 0.5 * z[i]
+        for i in range(3):  # T^-T z
+            z[i] = (z[i] - (T[3, i] * z[3] + T[4, i] * z[4] + T[5, i] * z[5])) / length
+        for e in range(nrows):
+            rg[base + e] = z[rows[e]]
+
+
+@kernel(inline="always")
 def _log_jacobian(r: np.ndarray, J: np.ndarray, T: np.ndarray, rows: np.ndarray, work: np.ndarray) -> None:
     """Turn ``J`` (the loop's twist columns, weighted: the derivative of ``T log P`` only where ``P = I``) into the
     derivative of ``T log P`` itself, in place: ``T dexp^-1_X T^-1 J`` with ``X = log P = T^-1 r`` per loop and
@@ -240,6 +279,8 @@ def misfit_along_path(
     log_work = np.empty((3, 6))
     mixed_r = np.empty(E)
     mixed_J = np.empty((E, m))
+    rg = np.empty(E)  # the residual the step's gradient is taken of (see _log_gradient)
+    mixed = cycles.shape[0] >= 2
     offsets = np.zeros((3, m))  # the solutions' offsets from the path at the last three points, newest first
     for k in range(K):
         if k > 0:
@@ -252,8 +293,12 @@ def misfit_along_path(
             _on_plane(u_path, normal, k, y, u)
             expand(u, groups, q)
             closure_pass(mech, q, T[k], r, J, matrices, vectors)
-            _log_jacobian(r, J, T[k], rows, log_work)
-            _mix_loops(r, J, cycles, rows.shape[0], mixed_r, mixed_J)
+            if mixed:  # the loops' columns mapped one by one, then combined
+                _log_jacobian(r, J, T[k], rows, log_work)
+                _mix_loops(r, J, cycles, rows.shape[0], mixed_r, mixed_J)
+                rg[:] = r
+            else:  # the same gradient from one vector a loop
+                _log_gradient(r, T[k], rows, log_work, rg)
             norm = np.sqrt(np.sum(r * r))
             if norm > best * (1.0 + 1e-10) and gain <= 1e-6 * best * best:
                 break  # a step predicted to gain next to nothing came out worse: round-off; best is the minimum
@@ -271,7 +316,7 @@ def misfit_along_path(
             if converged or norm == 0.0:
                 break
             _in_plane(J, normal, k, Jy)
-            _solve_normal(Jy, r, dy, A, b)
+            _solve_normal(Jy, rg, dy, A, b)
             # The step lowers |r|^2 by |Jy dy|^2 to first order: when that is below 1e-8 |r|^2 the misfit is
             # known to 1e-8 relative already, and a further evaluation would not change it.
             gain = _predicted_gain(Jy, dy)
