@@ -131,6 +131,22 @@ def _ad(w: np.ndarray, v: np.ndarray, z: np.ndarray, out: np.ndarray) -> None:
 
 
 @kernel(inline="always")
+def _loop_twist(
+    r: np.ndarray, base: int, T: np.ndarray, rows: np.ndarray, x: np.ndarray, z: np.ndarray
+) -> None:
+    """The loop's weighted residual (rows ``base ..`` of ``r``) into ``z`` (6 entries, the rows not kept zero) and
+    its twist ``X = T^-1 z`` into ``x``: ``omega = z_w / L``, ``v = z_v - T21 omega``."""
+    length = T[0, 0]
+    z[:] = 0.0
+    for e in range(rows.shape[0]):
+        z[rows[e]] = r[base + e]
+    for i in range(3):
+        x[i] = z[i] / length
+    for i in range(3):
+        x[3 + i] = z[3 + i] - (T[3 + i, 0] * x[0] + T[3 + i, 1] * x[1] + T[3 + i, 2] * x[2])
+
+
+@kernel(inline="always")
 def _log_gradient(r: np.ndarray, T: np.ndarray, rows: np.ndarray, work: np.ndarray, rg: np.ndarray) -> None:
     """``rg = M^T r`` per loop, ``M = T (I - ad_X / 2) T^-1`` the map :func:`_log_jacobian` applies to the columns
     (``X = T^-1 r``): ``J^T rg`` is then the gradient of ``|T log P|^2 / 2`` that :func:`_log_jacobian`'s columns
@@ -145,13 +161,7 @@ def _log_gradient(r: np.ndarray, T: np.ndarray, rows: np.ndarray, work: np.ndarr
     length = T[0, 0]
     for loop in range(r.shape[0] // nrows):
         base = loop * nrows
-        z[:] = 0.0
-        for e in range(nrows):
-            z[rows[e]] = r[base + e]
-        for i in range(3):  # X = T^-1 r
-            x[i] = z[i] / length
-        for i in range(3):
-            x[3 + i] = z[3 + i] - (T[3 + i, 0] * x[0] + T[3 + i, 1] * x[1] + T[3 + i, 2] * x[2])
+        _loop_twist(r, base, T, rows, x, z)
         w, v = x[0:3], x[3:6]
         for i in range(3):  # z1 = T^T r
             z1[i] = length * z[i] + T[3, i] * z[3] + T[4, i] * z[4] + T[5, i] * z[5]
@@ -188,14 +198,7 @@ def _log_jacobian(r: np.ndarray, J: np.ndarray, T: np.ndarray, rows: np.ndarray,
     length = T[0, 0]
     for loop in range(r.shape[0] // nrows):
         base = loop * nrows
-        # X = T^-1 (weighted residual): omega = x_w / L, v = v_w - T21 omega
-        z[:] = 0.0
-        for e in range(nrows):
-            z[rows[e]] = r[base + e]
-        for i in range(3):
-            x[i] = z[i] / length
-        for i in range(3):
-            x[3 + i] = z[3 + i] - (T[3 + i, 0] * x[0] + T[3 + i, 1] * x[1] + T[3 + i, 2] * x[2])
+        _loop_twist(r, base, T, rows, x, z)  # X = T^-1 (weighted residual)
         w, v = x[0:3], x[3:6]
         for a in range(J.shape[1]):
             z[:] = 0.0
