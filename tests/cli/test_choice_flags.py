@@ -27,6 +27,6 @@ def test_robustness_refuses_an_unknown_distribution(tmp_path: Path, word: str) -
     assert result.exit_code == 2, result.output
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and "--distribution" in lines[0], result.output
-    assert all(name in lines[0] for name in DISTRIBUTIONS) or word == "", result.output
+    assert all(f'"{name}"' in lines[0] for name in DISTRIBUTIONS) or word == "", result.output
     assert "Traceback" not in result.output
     assert not out.exists()

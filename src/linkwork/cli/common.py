@@ -160,6 +160,14 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, Any]:
     return out
 
 
+def check_word(flag: str, value: str, words: Sequence[str]) -> None:
+    """Refuse a flag's value that is not one of ``words`` (the few words the flag takes), with one ``error:`` line
+    naming the flag, the value and the words, as a file's key is refused (``expected one of "a", "b", got "x"``)."""
+    if value not in words:
+        quoted = ", ".join(f'"{word}"' for word in words)
+        raise fail(f"{flag}: expected one of {quoted}, got {show(value)}")
+
+
 def check_range(
     flag: str, value: float, low: float, high: float, what: str, *, open_low: bool = False
 ) -> None:

@@ -10,7 +10,7 @@ import typer
 
 from linkwork.cli import help
 from linkwork.cli import options as opt
-from linkwork.cli.common import friendly_errors, parse_assignments
+from linkwork.cli.common import check_word, friendly_errors, parse_assignments
 from linkwork.outputs.staging import check_output_file, console
 
 if TYPE_CHECKING:
@@ -117,7 +117,6 @@ def dxf(
     from linkwork.export.files import write_whole
     from linkwork.export.trace_folder import read_trace_folder
     from linkwork.io.profiles import LENGTH_UNITS
-    from linkwork.messages import show
 
     check_output_file(out)
     path = Path(spec)
@@ -125,8 +124,8 @@ def dxf(
         from linkwork.io.readback import read_chain
 
         units = read_chain(path / "chain.json").get("units")
-    if units is not None and units not in LENGTH_UNITS:
-        raise SpecError(f"--units: expected one of {', '.join(LENGTH_UNITS)}, got {show(units)}")
+    if units is not None:
+        check_word("--units", units, tuple(LENGTH_UNITS))
     if (path / "path.csv").is_file():
         if set_:
             raise SpecError("--set applies to built-in linkages only, not to a trace folder", key="--set")

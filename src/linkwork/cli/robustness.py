@@ -10,6 +10,7 @@ from rich.text import Text
 
 from linkwork.cli import options as opt
 from linkwork.cli.common import (
+    check_word,
     check_workers,
     fail,
     friendly_errors,
@@ -20,7 +21,6 @@ from linkwork.cli.common import (
     until_in_api_units,
 )
 from linkwork.cli.out_folder import out_help, run_folder, spec_label
-from linkwork.messages import show
 from linkwork.outputs.staging import console
 from linkwork.studies.imperfections import DISTRIBUTIONS
 
@@ -102,8 +102,7 @@ def robustness(
             f"--steps {steps}: expected at most {MAX_PATH_POINTS - 1} for a robustness study (the nominal path's "
             "points each keep per-point histograms in memory)"
         )
-    if distribution not in DISTRIBUTIONS:
-        raise fail(f"--distribution {show(distribution)}: expected {' or '.join(DISTRIBUTIONS)}")
+    check_word("--distribution", distribution, DISTRIBUTIONS)
     target = parse_until(until)
     if out is None:
         out = run_folder("robustness", spec_label(spec, parse_assignments(set_, "--set")))

@@ -14,9 +14,9 @@ from typing import Annotated, Any
 import typer
 
 from linkwork.cli import mechanize_flags as mf
-from linkwork.cli.common import fail, friendly_errors, progress_bar
+from linkwork.cli.common import check_word, fail, friendly_errors, progress_bar
 from linkwork.cli.out_folder import out_help, problem_label, run_folder
-from linkwork.errors import RequestNotMetError, SpecError
+from linkwork.errors import RequestNotMetError
 from linkwork.interrupts import exit_code, held_signals
 from linkwork.outputs.staging import check_output_folder, console, have_matplotlib, staged_output
 
@@ -86,8 +86,7 @@ def synth(
     if out is None:
         out = run_folder("synth", problem_label(problem))
     check_output_folder(out, ["chain.json", "target_profiles.csv", "outline.svg", "outline.dxf"])
-    if search not in ("paper", "refined"):
-        raise SpecError(f"--search {search!r}: expected 'paper' or 'refined'")
+    check_word("--search", search, ("paper", "refined"))
     from linkwork.data import problem_file
 
     problem = problem_file(problem)
