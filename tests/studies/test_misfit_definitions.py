@@ -148,6 +148,30 @@ def test_a_four_bar_with_parallel_axes_is_planar_however_written(turn: bool) -> 
     assert (spatial.misfit_max > 1e-6).all()  # tilted out of the plane it binds: the test can fail
 
 
+@pytest.mark.parametrize("turn", [False, True], ids=["dh-zero-twists", "axes-along-x"])
+def test_the_python_default_errors_are_the_command_lines(turn: bool) -> None:
+    """``ImperfectionModel``'s default decides by the mechanism as ``linkwork robustness`` does: a planar four-bar
+    (however written) gets in-plane errors and stays a four-bar, the same samples as ``spatial=False``; a Bennett
+    loop gets spatial errors, the same samples as ``spatial=True``. (The default was ``spatial=True``: every
+    planar linkage studied from Python bound.)"""
+    mech = along_x(dh_four_bar()) if turn else dh_four_bar()
+    path = lw.trace(mech, until=("A", float(mech.offsets[0] + 40 * DEG)), steps=20)
+    default = robustness(mech, path, ImperfectionModel(1e-2, 0.5 * DEG), 30, seed=4, workers=0)
+    in_plane = robustness(
+        mech, path, ImperfectionModel(1e-2, 0.5 * DEG, spatial=False), 30, seed=4, workers=0
+    )
+    np.testing.assert_array_equal(default.misfit_max, in_plane.misfit_max)
+    assert default.misfit_max.max() < 1e-10 and default.mobility_kept.all()
+    bennett = lw.load("bennett")
+    path = lw.trace(bennett, until=("A", float(bennett.offsets[0]) + 60 * DEG), steps=10)
+    default = robustness(bennett, path, ImperfectionModel(1e-3, 0.05 * DEG), 20, seed=4, workers=0)
+    spatial = robustness(
+        bennett, path, ImperfectionModel(1e-3, 0.05 * DEG, spatial=True), 20, seed=4, workers=0
+    )
+    np.testing.assert_array_equal(default.misfit_max, spatial.misfit_max)
+    assert (default.misfit_max > 1e-6).all()
+
+
 def test_a_spatial_loop_is_not_planar() -> None:
     assert lw.load("bennett").plane_normal() is None
     assert lw.load("four-bar").plane_normal() is not None

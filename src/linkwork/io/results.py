@@ -31,6 +31,40 @@ def file_units(mech: Mechanism, values: np.ndarray) -> np.ndarray:
     return out
 
 
+@trace_keyword
+def file_arclength(trace: Trace) -> np.ndarray:
+    """``Trace.arclength`` (radians, and lengths for prismatic unknowns) in file units: along each branch, the
+    arclength in the unknowns measured in degrees for revolute unknowns and in the length unit for prismatic ones
+    (``path.csv``'s ``s``, the viewer's arclength axis).
+
+    Without a prismatic unknown this is ``degrees(arclength)``. With one, each step's increment is rescaled by
+    its chord: ``ds_file = ds * |du_file| / |du|`` with ``du`` the unknowns' change over the step (so a curved
+    step keeps its excess over the chord) and ``du_file`` the same change in file units. A branch starts where
+    ``Trace.arclength`` starts it (0).
+    """
+    s = np.asarray(trace.arclength, dtype=float)
+    mech = trace.mechanism
+    prismatic = np.array(
+        [any(mech.joint_types[j] == "P" for j in members) for members in mech.group_members()], dtype=bool
+    )
+    if not prismatic.any() or len(s) == 0:
+        return np.degrees(s)
+    u = mech.u_from_q(np.asarray(trace.angles, dtype=float))
+    in_file = np.where(prismatic, 1.0, np.degrees(1.0))
+    out = np.empty_like(s)
+    for branch in np.unique(trace.branch):
+        rows = np.flatnonzero(trace.branch == branch)
+        rows = rows[np.argsort(trace.step[rows], kind="stable")]
+        du = np.diff(u[rows], axis=0)
+        chord = np.linalg.norm(du, axis=1)
+        chord_file = np.linalg.norm(du * in_file, axis=1)
+        ds = np.diff(s[rows])
+        safe = np.where(chord > 0.0, chord, 1.0)
+        step = np.where(chord > 0.0, ds * chord_file / safe, np.degrees(ds))
+        out[rows] = np.concatenate([[np.degrees(s[rows[0]])], np.degrees(s[rows[0]]) + np.cumsum(step)])
+    return out
+
+
 def _display(trace: Trace, values: np.ndarray) -> np.ndarray:
     """Joint values of ``trace``'s mechanism in file units (:func:`file_units`)."""
     return file_units(trace.mechanism, values)
@@ -45,7 +79,7 @@ def path_rows(trace: Trace) -> tuple[list[str], list[list[Any]]]:
     k = trace.sigma.shape[1]
     header = ["branch", "step", "s", *names, *[f"sigma_{i + 1}" for i in range(k)], "residual"]
     angles = _display(trace, trace.angles)
-    s_deg = np.degrees(trace.arclength)
+    s_deg = file_arclength(trace)
     rows = []
     for i in range(len(trace.branch)):
         rows.append(
@@ -106,7 +140,10 @@ def report_dict(
         "name": mech.name,
         "joints": names,
         "joint_types": list(mech.joint_types),
-        "units": {"angles": "deg", "s": "deg (arclength in the unknowns)"},
+        "units": {
+            "angles": "deg",
+            "s": "deg (arclength in the unknowns; prismatic unknowns in the length unit)",
+        },
         "drive": trace.drive,
         "mode": trace.stats.mode,
         "unknowns": mech.n_unknowns,

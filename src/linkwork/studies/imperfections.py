@@ -45,12 +45,16 @@ class ImperfectionModel:
     standard deviation of each of the two error components normal to the hinge line, so the error's size exceeds
     it for ``exp(-1/2)``, 61 %, of the hinges (:attr:`fraction_beyond`); ``uniform`` makes it a hard bound, the
     error uniform in the disc (shift) or cone (tilt) of that radius.
+
+    ``spatial``: whether the hinges of a mechanism that moves in a plane also tilt and shift out of it. ``None``
+    (the default) decides by the mechanism, as ``linkwork robustness`` does without ``--spatial-errors``: in-plane
+    errors for a planar mechanism (however it is written, :meth:`Mechanism.plane_normal`), spatial ones otherwise.
     """
 
     position_tol: float
     direction_tol: float
     distribution: str = "normal"
-    spatial: bool = True
+    spatial: bool | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.position_tol) and self.position_tol >= 0.0):

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from linkwork.deprecation import trace_keyword
 from linkwork.geometry.angles import wrap
-from linkwork.io.results import file_units
+from linkwork.io.results import file_arclength, file_units
 from linkwork.kinematics.closure import body_poses
 from linkwork.viz.palette import TAB10
 from linkwork.viz.synthesis_viewer import (
@@ -312,7 +312,7 @@ def trace_viewer_data(
         "sigma": packed_array(trace.sigma[keep], "f8"),
         "rank": packed_array(trace.rank[keep], "i4"),
         "step": packed_array(trace.step[keep], "i4"),
-        "arclength": packed_array(np.degrees(trace.arclength[keep]), "f4"),
+        "arclength": packed_array(file_arclength(trace)[keep], "f4"),
         "residual": packed_array(trace.residual[keep], "f4"),
         "unknowns": mech.n_unknowns,
         "branches": _branch_entries(trace, per_branch),
