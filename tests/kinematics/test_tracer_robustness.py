@@ -118,6 +118,23 @@ def test_play_in_a_hinge_is_traced_within_the_closure_tolerance() -> None:
     assert strict.branches[0].end_reason != "closed path"
 
 
+@pytest.mark.parametrize("play", [0.1, 0.5, 1.0, 1e3, 1e12])
+def test_a_large_play_keeps_the_rank_test_meaningful(four_bar: lw.Mechanism, play: float) -> None:
+    """``--closure-tol`` from 0.1 to its bound 1e12 on the exact crank-rocker: the rank test's levels stop at a
+    hundredth and a thousandth of ``sigma_1`` (:data:`~linkwork.kinematics.rank.MAX_LOOSE`, ``MAX_FLOOR``), so the
+    start has rank 3 (a four-bar's three planar equations, independent off its singular points), the rocker swings
+    over the triangles' range and the crank turns once. (From 0.1 the rank test failed with a ValueError: no
+    singular value was sure; from 1, every one was below the floor and the start was 'mobility 4'.)"""
+    tol = Tolerances().with_closure(play)
+    assert tol.floor <= tol.loose < 1.0 and numerical_rank([2.0, 1.0, 0.5], tol) == 3
+    tr = trace(four_bar, closure_tol=play)
+    assert tr.stats.start_rank == 3 and tr.branches[0].end_reason == "closed path"
+    assert np.ptp(tr.angles[:, four_bar.index("A")]) == pytest.approx(2 * np.pi, abs=1e-9)
+    lo, hi = rocker_range_deg()
+    swing = np.degrees(np.ptp(tr.angles[:, four_bar.index("D")]))
+    assert hi - lo - 0.01 < swing <= hi - lo + 1e-9
+
+
 def test_the_corrector_cannot_pull_a_step_back() -> None:
     """Near A = 123 deg a minimum-norm corrector pulled every step of the trihedral Bricard loop back (5000 steps of
     1e-9 that advanced nothing, caught by the advance test); the hyperplane corrector keeps each step's advance

@@ -18,6 +18,7 @@ from linkwork.io.readback import path_columns
 from linkwork.io.readback import points_columns as csv_stems
 from linkwork.io.writer import json_text, require_finite
 from linkwork.kinematics.deployment import Deployment
+from linkwork.kinematics.extremes import joint_ranges
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, Trace
 
@@ -108,18 +109,15 @@ def write_path_csv(trace: Trace, file: Path) -> None:
 
 
 @trace_keyword
-def branch_range(trace: Trace, branch: int) -> dict[str, list[float]]:
-    """``{joint: [min, max]}`` over one branch, in file units (degrees, or lengths for prismatic joints); the
-    located folds of the drive count, so the drive's range is exact to ``Tolerances.locate``."""
-    on_branch = [
-        trace.angles[trace.branch == branch],
-        *[f.angles[None, :] for f in trace.folds if f.branch == branch],
-    ]
-    values = _display(trace, np.concatenate(on_branch))
-    return {
-        name: [float(values[:, j].min()), float(values[:, j].max())]
-        for j, name in enumerate(trace.mechanism.joint_names)
-    }
+def branch_range(trace: Trace, branch: int | None) -> dict[str, list[float]]:
+    """``{joint: [min, max]}`` over one branch (``None``: every branch), in file units (degrees, or lengths for
+    prismatic joints): the rows, the drive's located folds and every joint's located turning points
+    (:func:`linkwork.kinematics.extremes.joint_ranges`), so each joint's range is its swing to
+    ``Tolerances.locate``, not only what the rows sampled."""
+    ranges = joint_ranges(trace, branch)
+    names = trace.mechanism.joint_names
+    values = _display(trace, np.array([[ranges[name][side] for name in names] for side in (0, 1)]))
+    return {name: [float(values[0, j]), float(values[1, j])] for j, name in enumerate(names)}
 
 
 @trace_keyword

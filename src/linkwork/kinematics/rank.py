@@ -94,21 +94,31 @@ class Tolerances:
         and the corrector's ``truncate`` are raised to at least ``closure``: a loop whose parameters are off by
         that much is read as the mobile loop it was meant to be, and Gauss-Newton does not chase the misfit
         along the direction it would have been mobile in. A tolerance below ``exact`` tightens ``exact`` too.
+
+        The rank test's levels are ratios to ``sigma_1`` and stop at :data:`MAX_FLOOR` and :data:`MAX_LOOSE`:
+        a larger play (``--closure-tol 0.5`` on a loop of unit size) still leaves ``sigma_1`` a sure non-zero
+        value (with ``loose`` at 1 or above no value was sure, and the rank test failed).
         """
         if not closure > 0.0:
             raise ValueError(f"closure tolerance {closure!r}: expected a positive number")
-        floor = max(self.floor, closure)
+        floor = min(max(self.floor, closure), max(self.floor, MAX_FLOOR))
         return replace(
             self,
             closure=closure,
             exact=min(self.exact, closure),
             floor=floor,
-            loose=max(self.loose, 10.0 * floor),
+            loose=max(self.loose, min(10.0 * floor, MAX_LOOSE)),
             truncate=max(self.truncate, floor),
         )
 
 
 DEFAULT = Tolerances()
+
+MAX_FLOOR = 1e-3
+"""The highest ``floor`` a closure tolerance raises (:meth:`Tolerances.with_closure`): singular values below a
+thousandth of ``sigma_1`` are zero at most, whatever play is accepted."""
+MAX_LOOSE = 1e-2
+"""The highest ``loose`` a closure tolerance raises: a value above a hundredth of ``sigma_1`` is always non-zero."""
 
 
 def numerical_rank(sigma: ArrayLike, tol: Tolerances = DEFAULT) -> int:

@@ -21,6 +21,8 @@ from numpy.typing import NDArray
 from linkwork.errors import LinkworkError, SpecError
 from linkwork.interrupts import stop_text
 from linkwork.kinematics import kernels
+from linkwork.kinematics.bifurcation import branch_tangents
+from linkwork.kinematics.classify import component_dimension
 from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
@@ -257,7 +259,7 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
             raise LinkworkError(
                 f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first"
             )
-        r_path = _path_rank(mech, s0, mech.n_unknowns, tol, backend.compiled)
+        r_path = _path_rank(mech, s0, mech.n_unknowns, tol, backend)
         basis = np.ascontiguousarray(U0[:, :r_path])
         basis.flags.writeable = False
         lo, hi = _limits_in_unknowns(mech, None)
@@ -385,10 +387,11 @@ def _joint(mech: Mechanism, joint: str | int) -> tuple[int, int, np.float64]:
     return mech.derived(("joint", joint), build) if isinstance(joint, str) else build()
 
 
-def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, compiled: bool) -> int:
-    """Rank of the Jacobian at the start (its singular values ``sigma``, by the ``compiled`` kernels or not: once
-    per mechanism, backend and tolerances); refuses a rigid start or one of mobility above one."""
-    r_path = mech.derived(("start rank", compiled, tol), lambda: numerical_rank(sigma, tol))
+def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: Backend) -> int:
+    """Rank of the Jacobian at the start (its singular values ``sigma``, by the ``backend``'s kernels: once per
+    mechanism, backend and tolerances); refuses a rigid start or one of mobility above one (saying so when the
+    start is a singular point of one-parameter branches, where the rank drops but the linkage has mobility one)."""
+    r_path = mech.derived(("start rank", backend.compiled, tol), lambda: numerical_rank(sigma, tol))
     mobility = m - r_path
     if mobility == 0:
         raise LinkworkError(
@@ -397,12 +400,37 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, compiled:
             "to move: give its parameters to full precision, or accept play in the hinges (closure_tol / "
             "--closure-tol)"
         )
+    lines = _start_lines(mech, backend, tol, m) if mobility > 1 else None
+    if lines == 0:
+        raise LinkworkError(
+            f"{mech.name}: the start is rigid, an isolated configuration (Jacobian rank {r_path} here, {m} "
+            "unknowns, but no direction along which the loop stays closed to second order): it cannot move "
+            "from there"
+        )
+    if lines is not None and lines >= 2:
+        raise LinkworkError(
+            f"{mech.name}: the start is a singular point where {lines} one-parameter branches cross (Jacobian "
+            f"rank {r_path} here, {r_path + 1} beside it; mobility one, not {mobility}); a trace starts on one "
+            "branch: give a start a little away from it (one joint moved by a degree, e.g. --set theta=...) "
+            "and the path is traced through this point, located as a bifurcation"
+        )
     if mobility > 1:
         raise LinkworkError(
             f"{mech.name}: mobility {mobility} at the start (rank {r_path}, {m} unknowns); the tracer follows "
             "one-parameter paths: couple or fix joints (couple=..., fixed=... / --couple A=C=E)"
         )
     return r_path
+
+
+def _start_lines(mech: Mechanism, backend: Backend, tol: Tolerances, m: int) -> int | None:
+    """At a start whose rank says mobility above one: ``None`` where the configuration space has dimension 2 or
+    more there (a mobility the tracer cannot follow), else how many one-parameter branches pass through it (its
+    real branch tangents: 0 for an isolated, rigid point; 2 or more where branches cross)."""
+    ws = Workspace.of(mech, backend)
+    u = np.zeros(m)
+    if component_dimension(ws, u, tol) >= 2:
+        return None
+    return len(branch_tangents(mech, ws, u, tol)[0])
 
 
 def _limits_in_unknowns(

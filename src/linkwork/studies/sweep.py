@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from linkwork.errors import LinkworkError, RequestNotMetError, SpecError
+from linkwork.io.results import branch_range
 from linkwork.io.toml_reader import TomlReader
 from linkwork.messages import escape_line, show
 from linkwork.names import NameMap, csv_columns
@@ -124,10 +125,9 @@ def _linkage_row(study: Study, mech: Any, path: Any, row: Row, budget: PointBudg
     row["mobility"] = int(path.mobility[0])
     row["points"] = int(path.angles.shape[0])
     stems = joint_columns(mech.joint_names, study.grid)
-    for j, name in enumerate(mech.joint_names):
-        deg = np.degrees(path.angles[:, j]) if mech.joint_types[j] == "R" else path.angles[:, j]
-        row[f"{stems[name]}_min"] = float(deg.min())
-        row[f"{stems[name]}_max"] = float(deg.max())
+    for name, (low, high) in branch_range(path, None).items():  # every branch, folds and turning points
+        row[f"{stems[name]}_min"] = low
+        row[f"{stems[name]}_max"] = high
     row["bifurcations"] = len(path.bifurcations)
     row["ratio_max"] = float(path.max_condition_raw)  # the paper's Sec. 5 ratio, raw
     row["end"] = path.branches[0].end_reason if path.branches else ""

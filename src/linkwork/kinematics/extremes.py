@@ -1,0 +1,121 @@
+"""Every joint's extremes along a traced branch, located on the path, so that a branch's ``range`` is each joint's
+true swing and not only what its rows sampled.
+
+The tracer locates the folds of the drive (``Trace.folds``): where the drive turns back. Any other joint turns back
+between rows too (a crank-rocker's rocker, every coupler angle), and its extreme value lies between two rows: the
+rows of a 2-degree trace miss it by up to about ``h^2 / 8`` times the joint's curvature along the path (a rocker's
+swing 7e-4 deg short). Here each joint's turning points are found where its increment from row to row changes
+sign, and located as a fold of that joint (:func:`linkwork.kinematics.classify.locate_fold`, the bisection the
+tracer's folds use: each trial point corrected onto the path, the tangent's component of the joint's unknown
+changing sign across the bracket). A point that cannot be corrected onto the path leaves the rows' extreme as it
+was, so a range is never narrower than its rows'.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from linkwork.kinematics.classify import locate_fold
+from linkwork.kinematics.jit import select_backend
+from linkwork.kinematics.normalization import length_scale
+from linkwork.kinematics.rank import DEFAULT, Tolerances
+from linkwork.kinematics.trace_result import Trace
+from linkwork.kinematics.workspace import Workspace
+
+Array = NDArray[np.float64]
+
+NOISE = 1e-9
+"""Increments of an unknown below this times its largest along the branch, or below :data:`STILL` (radians, or
+the linkage's own length), are round-off, not motion: their sign changes are not turning points."""
+STILL = 1e-10
+LONGEST = 0.5
+"""The longest bracket located (two rows' distance in the step's metric, radians: 29 deg): between rows further
+apart (a few long equal steps) a trial point's hyperplane may meet the path more than once, and the rows' extreme
+is kept."""
+
+
+def branch_rows(trace: Trace, branch: int) -> NDArray[np.int64]:
+    """The row indices of ``branch`` in the order of its steps."""
+    rows = np.flatnonzero(trace.branch == branch)
+    return rows[np.argsort(trace.step[rows], kind="stable")]
+
+
+def joint_extremes(trace: Trace, branch: int) -> Array:
+    """``(K, n)`` joint values (radians, or lengths) at the located turning points of every free joint on
+    ``branch``, strictly between its first and last rows (the drive's folds too: ``Trace.folds`` has them)."""
+    mech = trace.mechanism
+    rows = branch_rows(trace, branch)
+    n = mech.n_joints
+    if len(rows) < 3 or mech.n_unknowns == 0:
+        return np.zeros((0, n))
+    u = mech.u_from_q(mech.q_from_angles(trace.angles[rows]))
+    du = np.diff(u, axis=0)
+    backend = select_backend()
+    ws: Workspace | None = None
+    prismatic = np.array(
+        [any(mech.joint_types[j] == "P" for j in members) for members in mech.group_members()], dtype=bool
+    )
+    weight = np.where(prismatic, 1.0 / length_scale(mech, kernels=backend), 1.0) if prismatic.any() else None
+    tol = _tolerances(trace)
+    found = []
+    for g in range(mech.n_unknowns):
+        step = du[:, g]
+        big = float(np.max(np.abs(step), initial=0.0))
+        if big == 0.0:
+            continue
+        scale = 1.0 if weight is None else 1.0 / weight[g]
+        sign = np.where(np.abs(step) > max(NOISE * big, STILL * scale), np.sign(step), 0.0)
+        moving = np.flatnonzero(sign != 0.0)
+        # consecutive moving increments of opposite signs: the joint turned back between them
+        turns = moving[1:][sign[moving[1:]] * sign[moving[:-1]] < 0.0]
+        for k in turns:
+            before = int(moving[np.searchsorted(moving, k) - 1])  # the moving increment before it
+            a, b = (
+                before,
+                k + 1,
+            )  # rows of the bracket: the joint moved one way after a, the other way before b
+            chord = u[b] - u[a]
+            if float(np.linalg.norm(chord if weight is None else chord * weight)) > LONGEST:
+                continue
+            ws = ws if ws is not None else Workspace.of(mech, backend)
+            t_a, t_b = _tangent(ws, u[a], chord), _tangent(ws, u[b], chord)
+            if t_a is None or t_b is None or np.sign(t_a[g]) == np.sign(t_b[g]):
+                continue
+            point = locate_fold(ws, u[a], t_a, u[b], t_b, g, tol, weight)
+            # the turning point is beyond every row of its bracket, by less than the bracket's length
+            inner = u[a : b + 1, g]
+            beyond = (point[g] - inner.max()) if sign[before] > 0 else (inner.min() - point[g])
+            if point is not u[a] and -1e-12 * big <= beyond <= float(np.abs(chord).sum()):
+                found.append(mech.angles_from_q(mech.q_from_u(point)))
+    return np.array(found).reshape(-1, n)
+
+
+def joint_ranges(trace: Trace, branch: int | None = None) -> dict[str, tuple[float, float]]:
+    """``{joint: (min, max)}`` over ``branch`` (radians, or lengths; ``None``: every branch): its rows, the drive's
+    folds and every joint's located turning points (:func:`joint_extremes`)."""
+    ids = np.unique(trace.branch) if branch is None else [branch]
+    parts = [trace.angles[np.isin(trace.branch, ids)]]
+    parts += [f.angles[None, :] for f in trace.folds if f.branch in ids]
+    parts += [joint_extremes(trace, int(b)) for b in ids]
+    values = np.concatenate(parts)
+    return {
+        name: (float(values[:, j].min()), float(values[:, j].max()))
+        for j, name in enumerate(trace.mechanism.joint_names)
+    }
+
+
+def _tolerances(trace: Trace) -> Tolerances:
+    """The tolerances of the trace's corrector: the defaults, with its closure tolerance (play) if it had one."""
+    closure = trace.stats.closure_tol
+    return DEFAULT if closure <= DEFAULT.closure else DEFAULT.with_closure(closure)
+
+
+def _tangent(ws: Workspace, u: Array, along: Array) -> Array | None:
+    """The path's unit tangent at ``u`` oriented along ``along``; ``None`` where it is not one line."""
+    _, _, jac = ws.evaluate(u)
+    _, s, vt = np.linalg.svd(jac)
+    if vt.shape[0] - np.count_nonzero(s > 1e-10 * max(float(s[0]), 1e-300)) != 1:
+        return None
+    t = vt[-1]
+    return t if float(t @ along) >= 0.0 else -t
