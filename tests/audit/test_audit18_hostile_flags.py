@@ -46,7 +46,7 @@ def test_a_small_closure_tolerance_traces_the_exact_four_bar_as_before(tmp_path:
 @pytest.mark.xfail(
     strict=True, reason="open (audit18): --closure-tol >= 0.1 crashes numerical_rank (traceback, exit 1)"
 )
-@pytest.mark.parametrize("tol", ["0.1", "0.5", "1"])
+@pytest.mark.parametrize("tol", ["0.1", "0.3", "0.5"])
 def test_a_large_closure_tolerance_within_its_bound_is_not_a_traceback(tmp_path: Path, tol: str) -> None:
     """``linkwork trace four-bar --closure-tol 0.1`` (the help allows 0 < --closure-tol <= 1e12). Got: exit 1 and
     an 85-line traceback ending 'ValueError: operands could not be broadcast together with shapes (0,) (2,)' (or
@@ -54,7 +54,7 @@ def test_a_large_closure_tolerance_within_its_bound_is_not_a_traceback(tmp_path:
     the crank turns once and the path closes) or the value is refused up front in one line, exit 2. Cause:
     kinematics/rank.py: ``Tolerances.with_closure`` raises ``loose`` to 10 x closure >= 1, so in
     ``numerical_rank`` no singular value is 'sure' (``sure = 0``) and ``padded[sure - 1 : candidates]`` is the
-    empty slice ``padded[-1:candidates]``. (From about 3 up, every singular value is below the raised floor and the
+    empty slice ``padded[-1:candidates]``. (From 1 up, every singular value is below the raised floor and the
     start is refused as 'mobility 4 at the start (rank 0, 4 unknowns)', exit 2: one line, but not what is wrong.)"""
     out = tmp_path / "o"
     result = CliRunner().invoke(
