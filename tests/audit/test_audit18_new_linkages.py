@@ -458,3 +458,76 @@ def test_mjcf_welds_close_along_the_trace(tmp_path: Path, name: str) -> None:
         mujoco.mj_forward(model, data)
         residual = data.efc_pos[data.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY]
         assert len(residual) > 0 and np.abs(residual).max() < 1e-11
+
+
+# ----------------------------------------------------------------------------------------- an eight-bar (3 loops)
+
+#: Theo Jansen's "holy numbers" (a ... m): ground pivots O (crank) and A = (-a, -l); crank m.
+JANSEN = dict(
+    a=38.0, b=41.5, c=39.3, d=40.1, e=55.8, f=39.4, g=36.7, h=65.7, i=49.0, j=50.0, k=61.9, l=7.8, m=15.0
+)
+
+
+def jansen_points(theta: float) -> dict[str, np.ndarray]:
+    """Every pivot and the foot F of Jansen's leg at crank angle ``theta`` (radians), by circle intersections in
+    the leg's usual assembly (B above, C below, D, E outside, F the lowest)."""
+    from audit_reference import circles
+
+    p = JANSEN
+    a_, m_ = (
+        np.array([-p["a"], -p["l"], 0.0]),
+        np.array([p["m"] * np.cos(theta), p["m"] * np.sin(theta), 0.0]),
+    )
+
+    def meet(
+        c1: np.ndarray, r1: float, c2: np.ndarray, r2: float, key: Callable[[np.ndarray], float]
+    ) -> np.ndarray:
+        return min((np.r_[x, 0.0] for x in circles(c1, r1, c2, r2)), key=key)
+
+    b = meet(m_, p["j"], a_, p["b"], lambda x: -x[1])
+    c = meet(m_, p["k"], a_, p["c"], lambda x: x[1])
+    d = meet(a_, p["d"], b, p["e"], lambda x: x[0])
+    e = meet(d, p["f"], c, p["g"], lambda x: x[0])
+    f = meet(e, p["h"], c, p["i"], lambda x: x[1])
+    return dict(O=np.zeros(3), M=m_, A=a_, B=b, C=c, D=d, E=e, F=f)
+
+
+def test_jansens_leg_draws_its_foot_curve(tmp_path: Path) -> None:
+    """Jansen's leg as a planar [mechanism] (8 bodies, 10 revolute joints, 3 loops) with its foot as a named point:
+    a full crank turn adaptive and in 36 and 360 equal steps. Every row closes the reference to 1e-11 (lengths of
+    about 60), its singular values are numpy's to 1e-13 relative, and the foot in ``positions`` is the circle
+    intersections' foot to 1e-10."""
+    from linkwork.kinematics.points import positions
+
+    start = jansen_points(30 * RAD)
+    joints = [
+        ("O", ["ground", "crank"], "O"),
+        ("M1", ["crank", "lj"], "M"),
+        ("M2", ["crank", "lk"], "M"),
+        ("B", ["lj", "tri1"], "B"),
+        ("A1", ["tri1", "ground"], "A"),
+        ("C1", ["lk", "lc"], "C"),
+        ("A2", ["lc", "ground"], "A"),
+        ("D", ["tri1", "lf"], "D"),
+        ("E", ["lf", "tri2"], "E"),
+        ("C2", ["tri2", "lc"], "C"),
+    ]
+    ref = Mech(
+        "jansen",
+        [dict(name=n, bodies=b, point=list(start[p]), value=30.0 if n == "O" else 0.0) for n, b, p in joints],
+        planar=True,
+    )
+    foot = start["F"]
+    text = (
+        ref.toml()
+        + f'\n[[points]]\nname = "foot"\nbody = "tri2"\nposition = [{float(foot[0])!r}, {float(foot[1])!r}, 0.0]\n'
+    )
+    mech = load(tmp_path, "jansen", text)
+    for steps in (None, 36, 360):
+        tr = lw.trace(mech, drive="O", until=("O", 390 * RAD), steps=steps)
+        assert tr.branches[0].end_kind == lw.StopReason.TARGET
+        closure, sigma = check_rows(ref, tr, every=6)
+        assert closure < 1e-11 and sigma < 1e-13
+        _, points = positions(mech, tr.angles)
+        feet = np.array([jansen_points(t)["F"] for t in tr.angles[:, 0]])
+        assert np.abs(points[:, 0, :2] - feet[:, :2]).max() < 1e-10
