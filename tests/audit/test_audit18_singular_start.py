@@ -6,6 +6,9 @@ coupler stays parallel to the ground (C = B + (2, 0), the coupler's turn relativ
 on the antiparallelogram branch C is the other intersection of the circles |C - B| = 2, |C - D| = 1. The flat
 start A = 0 is the crossing of the two branches: the Jacobian loses one rank there, and the mechanism has
 mobility 1 on each branch (a single loop of four hinges: Gruebler 3 (4 - 1) - 2 x 4 = 1).
+
+Also a start at a fold of the drive: a slider-crank (crank 1, rod 3) at its top dead centre driven by its slider,
+against the law of cosines.
 """
 
 from __future__ import annotations
@@ -69,3 +72,39 @@ def test_a_parallelogram_drawn_flat_is_traced_from_its_crossing() -> None:
     a, b = np.degrees(tr.angles[:, 0]), np.degrees(tr.angles[:, 1])
     on_parallelogram = np.abs((b + a + 180.0) % 360.0 - 180.0) < 1e-9
     assert on_parallelogram.any() and (~on_parallelogram).any()
+
+
+def crank_at(x: float, r: float = 1.0, rod: float = 3.0) -> float:
+    """The crank angle (deg, in [0, 180]) of a slider-crank without offset whose slider pin is at ``x`` (law of
+    cosines in the triangle crank pivot, crank pin, slider pin)."""
+    return float(np.degrees(np.arccos((x * x + r * r - rod * rod) / (2 * x * r))))
+
+
+def test_a_slider_started_at_its_dead_centre_reaches_a_target_adaptively() -> None:
+    """Holds: the built-in slider-crank (crank 1, rod 3, no offset) at theta = 0, its slider D at the top dead
+    centre x = 4, driven by D to 3: reached, the crank at arccos(1/6) = 80.4059 deg (1e-9)."""
+    mech = lw.load("slider-crank", crank=1.0, rod=3.0, offset=0.0, theta=0.0)
+    tr = lw.trace(mech, drive="D", until=("D", 3.0))
+    assert tr.stats.unmet is None
+    assert abs(abs(np.degrees(tr.angles[-1, 0])) - crank_at(3.0)) < 1e-9
+
+
+@pytest.mark.xfail(
+    strict=True, reason="open (audit18): paper mode from a start at a fold of the drive never moves"
+)
+@pytest.mark.parametrize("steps", [1, 10])
+def test_a_slider_started_at_its_dead_centre_reaches_a_target_in_equal_steps(steps: int) -> None:
+    """``linkwork trace slider-crank --set theta=0 --drive D --until D=3 --steps 10`` (or 1). Got: no step, 'drive
+    turning point', exit 3: 'D never reaches 3 on this path (it turns back near 4): its range is [4, 4]' (the
+    elliptic trammel started at X = 2, its extreme, the same), while the adaptive trace reaches D = 3. Right:
+    equal steps of D from 4 to 3, every row's crank at the law of cosines' angle (1e-9 deg), the target reached:
+    at a fold the drive can only move one way, towards the target, on either side of the start. Suspected cause:
+    the start's tangent has no drive component there, so its orientation towards the target (kinematics/tracer.py:
+    ``t_start`` from the sign of ``start.components[d_unknown]``) is arbitrary and the paper march's first step
+    reads as the drive turning back."""
+    mech = lw.load("slider-crank", crank=1.0, rod=3.0, offset=0.0, theta=0.0)
+    tr = lw.trace(mech, drive="D", until=("D", 3.0), steps=steps)
+    assert tr.stats.unmet is None
+    np.testing.assert_allclose(tr.angles[:, 3], np.linspace(4.0, 3.0, steps + 1), rtol=0, atol=1e-12)
+    for row in tr.angles:
+        assert abs(abs(np.degrees(row[0])) - crank_at(row[3])) < 1e-9
