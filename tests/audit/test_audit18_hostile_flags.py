@@ -43,9 +43,6 @@ def test_a_small_closure_tolerance_traces_the_exact_four_bar_as_before(tmp_path:
     assert np.degrees(np.ptp(tr.angles[:, 0])) == pytest.approx(360.0, abs=1e-9)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): --closure-tol >= 0.1 crashes numerical_rank (traceback, exit 1)"
-)
 @pytest.mark.parametrize("tol", ["0.1", "0.3", "0.5"])
 def test_a_large_closure_tolerance_within_its_bound_is_not_a_traceback(tmp_path: Path, tol: str) -> None:
     """``linkwork trace four-bar --closure-tol 0.1`` (the help allows 0 < --closure-tol <= 1e12). Got: exit 1 and

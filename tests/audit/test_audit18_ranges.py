@@ -100,7 +100,6 @@ def test_report_json_holds_the_cranks_extremes(
     assert abs(lo - ref[0]) < 1e-7 and abs(hi - ref[1]) < 1e-7
 
 
-@pytest.mark.xfail(strict=True, reason="open (audit18): sweep.csv's drive range misses its folds")
 def test_sweep_csv_holds_the_same_crank_range_as_the_trace(tmp_path: Path) -> None:
     """Got (sweep.csv): A_min, A_max = 28.95513, 117.27922 (triple rocker) and 22.33274, 337.66818 (non-Grashof),
     where the law of cosines (and report.json of the same trace) give 28.95502, 117.27961 and 22.33165, 337.66835:
@@ -119,9 +118,6 @@ def test_sweep_csv_holds_the_same_crank_range_as_the_trace(tmp_path: Path) -> No
         assert abs(float(row["A_max"]) - ref[1]) < 1e-7
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): a non-drive joint's range is the rows' range, not its extremes"
-)
 def test_report_json_holds_the_rockers_swing(tmp_path: Path) -> None:
     """The crank-rocker (crank 1, coupler 2.5, rocker 2: Grashof, the crank turns fully). The rocker D's reading is
     the turn of the ground relative to the rocker (joint D's bodies are [rocker, ground]), so its swing is the

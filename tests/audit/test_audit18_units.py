@@ -52,9 +52,6 @@ def test_the_closing_rows_s_counts_the_step_to_it(tmp_path: Path) -> None:
     assert abs(ratio[-1] - 1.0) < 1e-9
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): path.csv's s counts a slider's travel in length x 180/pi"
-)
 def test_s_counts_a_sliders_travel_in_lengths(tmp_path: Path) -> None:
     """The built-in slider-crank (crank 1, rod 3; slider D a prismatic joint). Got: the increments of s are up to
     1.23 times the chords in degrees and lengths (step 1: s grows by 0.5225 for a chord of 0.4866), because
