@@ -116,25 +116,27 @@ def test_frames_that_move_close_on_the_audits_own_lines(tmp_path: Path, faces: s
     np.testing.assert_allclose(tr.sigma[0], ref[: tr.sigma.shape[1]], rtol=0, atol=1e-13)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): rows off the loop (residual 6e-11) recorded on a shaky frame"
-)
 @pytest.mark.parametrize("source", ["audit-lines", "built-in"])
-def test_a_shaky_frame_records_no_row_off_its_loop(tmp_path: Path, source: str) -> None:
-    """Got: the trace (built-in ``rect-frame cuts=NS faces=oiiooi`` or the audit's lines) reports 'rank 5 /
-    mobility 1 at the start', records 8 rows that creep 0.00063 deg from the start with closure residuals 3.7e-11
-    to 6.1e-11 (report.json max_residual 6.1e-11 against closure_tol 1e-12; the audit's product of exponentials
-    agrees that they do not close), ends 'corrector failed' and the command line exits 0. Right: only rows on the
-    loop (residual <= closure_tol = 1e-12), i.e. the start alone, and an end that says the start does not move
-    (mobility 1 to first order only). Suspected cause: the corrector's round-off acceptance (Tolerances.roundoff:
-    a residual that stalls below 100 x closure is accepted as the round-off floor of a long loop,
-    kinematics/rank.py and the corrector in kinematics/march.py) takes the least-squares points next to a
-    shaky start, where no solution exists, for points on the loop."""
+def test_a_shaky_frame_is_refused_as_rigid(tmp_path: Path, source: str) -> None:
+    """Was: the trace (built-in ``rect-frame cuts=NS faces=oiiooi`` or the audit's lines) reported 'rank 5 /
+    mobility 1 at the start', recorded 8 rows that crept 0.00063 deg from the start with closure residuals 3.7e-11
+    to 6.1e-11 (against closure_tol 1e-12; the audit's product of exponentials agreed that they do not close),
+    ended 'corrector failed' and the command line exited 0. Now the start is refused as rigid to second order
+    (the obstruction the reference above measures), in one line, exit 2, nothing written; with play in the hinges
+    (``--closure-tol``) it is traced as before."""
+    from typer.testing import CliRunner
+
+    from linkwork.cli import app
+
     mech = (
         lw.load("rect-frame", cuts="NS", faces="oiiooi") if source == "built-in" else spec(tmp_path, "oiiooi")
     )
-    tr = lw.trace(mech, max_steps=200)
-    lines = hinge_lines("oiiooi")
+    with pytest.raises(lw.LinkworkError, match="rigid to second order"):
+        lw.trace(mech, max_steps=200)
+    args = ["rect-frame", "--set", "cuts=NS", "--set", "faces=oiiooi"]
     if source == "audit-lines":
-        assert max(closure(lines, row) for row in tr.angles) < 1e-12
-    assert float(np.max(tr.residual)) <= 1e-12
+        args = [str(tmp_path / "frame-oiiooi.toml")]
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["trace", *args, "-o", str(out), "--no-plots"])
+    assert result.exit_code == 2 and len(result.stderr.strip().splitlines()) == 1
+    assert "rigid to second order" in result.stderr and not (out / "path.csv").exists()

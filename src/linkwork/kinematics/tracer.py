@@ -23,6 +23,7 @@ from linkwork.interrupts import stop_text
 from linkwork.kinematics import kernels
 from linkwork.kinematics.bifurcation import branch_tangents
 from linkwork.kinematics.classify import component_dimension
+from linkwork.kinematics.closure import hessian, reduce
 from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
@@ -260,6 +261,16 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
                 f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first"
             )
         r_path = _path_rank(mech, s0, mech.n_unknowns, tol, backend)
+        if (
+            tol.closure <= DEFAULT.closure
+        ):  # (with play in the hinges a small obstruction is what play takes up)
+            obstruction = _second_order_obstruction(mech, U0, Vt0, r_path)
+            if obstruction > SHAKY:
+                raise LinkworkError(
+                    f"{mech.name}: the start is rigid to second order, a shaky structure (Jacobian rank {r_path}: "
+                    f"mobility 1 to first order, but along that motion the loops open at second order, "
+                    f"{obstruction:.2g} of the Hessian's scale): it cannot move from there"
+                )
         basis = np.ascontiguousarray(U0[:, :r_path])
         basis.flags.writeable = False
         lo, hi = _limits_in_unknowns(mech, None)
@@ -420,6 +431,32 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: 
             "one-parameter paths: couple or fix joints (couple=..., fixed=... / --couple A=C=E)"
         )
     return r_path
+
+
+SHAKY = 1e-6
+"""A start whose second-order obstruction (:func:`_second_order_obstruction`) is above this is rigid: the
+built-ins' (over-constrained loops that move) are below 1e-15, a shaky frame's (Guest's ``rect-frame`` with faces
+``oiiooi``) 0.6."""
+
+
+def _second_order_obstruction(mech: Mechanism, U0: Array, Vt0: Array, r_path: int) -> float:
+    """How far a start of mobility one to first order is from moving at second order: ``max_l |l^T H(t, t)|``
+    over the left null vectors ``l`` of the Jacobian (rows ``U0[:, r_path:]``) with ``t`` its null vector and
+    ``H`` the closure's Hessian in the unknowns (:func:`~linkwork.kinematics.closure.hessian`, exact at a
+    closed point), relative to ``H``'s largest entry; 0 where the Jacobian has full row rank (no condition).
+
+    A curve ``u(s) = s t + s^2 w / 2 + ...`` through the start keeps the loops closed to second order only if
+    ``J w + H(t, t) = 0``, which has a solution only if ``H(t, t)`` is in the range of ``J``: its part along
+    the left null space is the obstruction (Connelly and Servatius, shaky frameworks; the second-order test of
+    :func:`~linkwork.kinematics.bifurcation.branch_tangents` on one direction)."""
+    if r_path >= U0.shape[0] or mech.n_unknowns - r_path != 1:
+        return 0.0
+    H = reduce(mech, hessian(mech, np.zeros(mech.n_joints)))
+    scale = float(np.abs(H).max(initial=0.0))
+    if scale == 0.0:
+        return 0.0
+    t = Vt0[-1]
+    return float(np.abs(np.einsum("el,eab,a,b->l", U0[:, r_path:], H, t, t)).max()) / scale
 
 
 def _start_lines(mech: Mechanism, backend: Backend, tol: Tolerances, m: int) -> int | None:
