@@ -583,7 +583,7 @@ def march(mech, start, steps, corrector, bounds, out):
     weighted = False  # a prismatic unknown, measured in the linkage's own length (weight 1 / L)
     for a in range(u0.shape[0]):
         weighted = weighted or weight[a] != 1.0
-    out_u, out_sigma, out_res, out_tau = out[0], out[2], out[3], out[4]
+    out_sigma = out[2]
     cross_u, cross_t, cross_basis, cross_n = out[6]
     loop_ptr, rows, groups = mech[3], mech[4], mech[5]
     m = u0.shape[0]
@@ -760,7 +760,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 align /= weighted_norm(t, weight) * weighted_norm(t_home, weight)
             aligned = align > 2.0 * cos_turn * cos_turn - 1.0  # within two steps' largest turn of the start's
             if aligned and back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
-                close_path(u, u_home, periodic, count - 1, out_u, out_sigma, out_res, out_tau)
+                close_path(u, u_home, periodic, count - 1, out)
                 return count, CLOSED, h
         # ---- step control: grow an easy adaptive step (judged in the unknowns, so that it does not depend on the
         # length unit or where the linkage stands: the corrector moved the point by under a tenth of the step)
@@ -826,25 +826,32 @@ def step_acceptable(turn, dist, ahead, step, cos_turn, advance):
 def step_event(u, landing, lo, hi, detect, tau_product):
     """The stop code an accepted step ends the march with (the target reached, a joint limit passed, a sign change
     of the test function within the step, ``tau_product`` negative: -1 when its sign changed at least once over
-    the row's steps or parts, compared one by one), ``NO_EVENT`` for none. A step
+    the row's steps or parts, compared one by one), ``NO_EVENT`` for none. A joint limit passed comes first, also
+    on the step that lands on the target (the branch ends on the limit, short of the target: a limit is a stop the
+    user set, and the target beyond it is not reached). A step
     landing on the target over which the test function changed sign ends with the sign change (the bifurcation it
     passed is located; the march then ends on the target it reached, ``BranchMarcher``)."""
+    for a in range(u.shape[0]):
+        if u[a] < lo[a] or u[a] > hi[a]:
+            return LIMIT
     if landing:
         if detect and tau_product < 0.0:
             return SIGN_CHANGE
         return TARGET
-    for a in range(u.shape[0]):
-        if u[a] < lo[a] or u[a] > hi[a]:
-            return LIMIT
     if detect and tau_product < 0.0:
         return SIGN_CHANGE
     return NO_EVENT
 
 
 @kernel(inline="always")
-def close_path(u, u_home, periodic, row, out_u, out_sigma, out_res, out_tau):
-    """Make row ``row`` the start again (in ``u``'s continuous angles, see :func:`snap_home`): the path closed."""
+def close_path(u, u_home, periodic, row, out):
+    """Make row ``row`` of the outputs ``out`` the start again (in ``u``'s continuous angles, see
+    :func:`snap_home`): the path closed. Its arclength is the row before's plus the chord to the start (the step
+    that came near it was longer or shorter)."""
+    out_u, out_sigma, out_res, out_tau, out_s = out[0], out[2], out[3], out[4], out[5]
     snap_home(u, u_home, periodic, out_u[row])
     out_sigma[row, :] = out_sigma[0, :]
     out_res[row] = out_res[0]
     out_tau[row] = out_tau[0]
+    if row > 0:
+        out_s[row] = out_s[row - 1] + plain_length(out_u[row - 1], out_u[row])
