@@ -54,6 +54,10 @@ SINGULAR_START = 1e-5
 """Paper mode: a point whose smallest kept singular value is below this fraction of the largest
 (``Tolerances.loose``'s default) is taken as singular, its tangent without a direction: a part from it is not
 judged by its turn (:data:`NEAR_CROSSING`)."""
+MAX_CLOSES = 64
+"""Paper mode: the most closing parts a row's own drive value is approached in, from the same side, where its
+landing next to a singular point turned the tangent (see :func:`march`); beyond, the row is taken again in more
+parts."""
 MAX_CROSSINGS = 64
 """The most sign changes of the test function within one row whose brackets the march hands back (``crossings``
 in its ``out`` tuple). The sign is compared step by step, a paper row's parts included, so that two crossings
@@ -420,6 +424,15 @@ def step_geometry(u, t, u_try, t_new, weight, weighted):
 
 
 @kernel(inline="always")
+def cosine(a, b, weight):
+    """The cosine of the angle between ``a`` and ``b`` in the step's metric (``weight``, :func:`weighted_norm`)."""
+    acc = 0.0
+    for i in range(a.shape[0]):
+        acc += a[i] * b[i] * (weight[i] * weight[i])
+    return acc / (weighted_norm(a, weight) * weighted_norm(b, weight))
+
+
+@kernel(inline="always")
 def plain_length(u, u_try):
     """The Euclidean length of the step from ``u`` to ``u_try`` in the unknowns as they are (the reported
     arclength's; the step control's is weighted, :func:`weighted_norm`)."""
@@ -603,14 +616,18 @@ def march(mech, start, steps, corrector, bounds, out):
     r0 = evaluate_in(mech, u, work)
     svd = svd_work(E, m)  # the tangent's SVD work arrays; its right singular vectors carried from row to row
     tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd, weight)
-    t[:] = t_new
+    if not (paper and singular_at(sig, r_path) and cosine(t, t_new, weight) < cos_turn):
+        # (paper mode: a start on a singular point, a row landed on a crossing, goes on along the tangent it came
+        # in with: its null vector is any of a plane's. An adaptive start there, such as a point of a
+        # higher-dimensional component, takes the null vector the SVD gives, as before)
+        t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0)
     # The test function's sign is compared step by step, every part of a paper row included (two sign changes
     # within one row would cancel between its rows): ``tau_last`` at the last point accepted, ``tau_row`` at the
     # row's start (a row taken again starts from it), ``n_cross`` the sign changes in the row so far.
     tau_last, tau_row, n_cross = tau, tau, 0
     # whether the last point accepted (and the row's start) is singular, its tangent without a direction
-    singular_last = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
+    singular_last = singular_at(sig, r_path)
     singular_row = singular_last
     cross_n[0] = 0
     if (
@@ -633,6 +650,11 @@ def march(mech, start, steps, corrector, bounds, out):
     base = min(MAX_PARTS, max(1, int(np.ceil(abs(h) * weight[drive] / hmax - PART_SLACK)))) if paper else 1
     parts, part = base, 0
     u_row, t_row, basis_row = u.copy(), t.copy(), basis.copy()
+    # Paper mode: a row's own drive value landed next to a singular point with the tangent turned is approached
+    # again from the same side (see the acceptance below): ``close_frac`` the fraction of the drive's distance
+    # left that the next closing part goes (0: the next step is no closing part), ``closes`` the closing parts
+    # tried in this row, ``approached`` those accepted (the row's landing is then predicted from the last one).
+    close_frac, closes, approached = 0.0, 0, 0
     while count <= max_steps:
         # ---- predictor (Sec. 4.1)
         first = count == 1 and part == 0
@@ -643,7 +665,22 @@ def march(mech, start, steps, corrector, bounds, out):
             return count, TURNING, h
         # a part's drive value from the row's, not a running sum of parts (which drifts over many rows); the last
         # part ends on the row's value, the target when it is there
-        if paper and parts > 1:
+        closing = close_frac > 0.0
+        if paper and (closing or approached > 0):
+            # closing in on the row's value: a closing part goes ``close_frac`` of the drive's distance left, and
+            # the landing follows from the last point reached, each predicted along the tangent from there
+            value = u_row[drive] + h
+            landing = False
+            if has_target and abs(value - target) < 1e-9 * max(1.0, abs(target)):
+                value = target
+                landing = not closing
+            goal = u[drive] + close_frac * (value - u[drive]) if closing else value
+            step = (goal - u[drive]) / t[drive]
+            along = step * tn
+            for a in range(m):
+                u_try[a] = u[a] + step * t[a]
+            u_try[drive] = goal
+        elif paper and parts > 1:
             landing = False
             if part < parts - 1:
                 u_try[drive] = u_row[drive] + (part + 1 - PART_SHIFT) * (h / parts)
@@ -652,7 +689,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 if has_target and abs(u_try[drive] - target) < 1e-9 * max(1.0, abs(target)):
                     landing = True
                     u_try[drive] = target
-        if (
+        elif (
             paper and parts == 1
         ):  # the last two points and their tangents predict better than the tangent alone
             if count >= 2:
@@ -681,18 +718,49 @@ def march(mech, start, steps, corrector, bounds, out):
             basis_try[:, :] = basis
             tau_new = tangent_and_test_in(jac, t, basis_try, r_path, t_new, sig, svd, weight)
             turn, dist, ahead = step_geometry(u, t, u_try, t_new, weight, weighted)
+            # A step from a point whose tangent has a direction that lands next to a singular point with its tangent
+            # turned by more than an adaptive step may has likely met the other branch: the corrector with the
+            # drive held meets both within the prediction's error there (a parallelogram's part 1e-5 rad short of
+            # 360 deg, or a row 1e-4 deg short of it, went on along the other branch). (Sharp turns away from
+            # singular points, next to a fold, are the path's own; so is a turn from a point whose tangent has no
+            # direction, a row landed on a crossing.)
+            turned = (
+                turn < cos_turn
+                and not singular_last
+                and r_path >= 1
+                and r_path <= sig.shape[0]
+                and sig[r_path - 1] <= NEAR_CROSSING * sig[0]
+            )
             if not paper and not landing and h > hmin:
                 ok = step_acceptable(turn, dist, ahead, along, cos_turn, advance)
-            elif paper:
-                # An inner part's drive value is the march's own choice, not a row's: one that lands next to a
-                # singular point with its tangent turned by more than an adaptive step may (a part a hair from a
-                # crossing, where the corrector with the drive held meets both branches: a parallelogram's part
-                # 1e-5 rad short of 360 deg went on along the other branch) is taken again in more parts, which
-                # moves it. (Sharp turns away from singular points, next to a fold, are the path's own; so is a
-                # turn from a point whose tangent has no direction, a row landed on a crossing.)
-                near = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= NEAR_CROSSING * sig[0]
-                judged = part < parts - 1 and near and not singular_last
-                ok = not jumps(u, u_try, periodic) and (turn >= cos_turn or not judged)
+            elif not paper:
+                # a landing on the target (or a step of the least length): a landing that turned is approached again
+                # in shorter steps, from the same side
+                ok = not (turned and landing and h > hmin)
+            elif (
+                turned
+                and not jumps(u, u_try, periodic)
+                and (closing or part == parts - 1)
+                and closes < MAX_CLOSES
+            ):
+                # The row's own drive value is fixed (retaking the row in more parts lands on it from the same
+                # distance as before): it is approached again from this point in closing parts, each a fraction of
+                # the distance left, until the landing from the last of them is short enough to keep to its branch
+                # (its prediction's error below the branches' gap there) or starts from a point whose tangent has
+                # no direction (the row then lands on the crossing, to round-off). A closing part that turned
+                # too goes half as far.
+                close_frac = (1.0 - PART_SHIFT) if not closing else 0.5 * close_frac
+                closes += 1
+                continue
+            else:
+                # An inner part's drive value is the march's own choice, not a row's: one that turned is taken
+                # again in more parts, which moves it.
+                ok = not jumps(u, u_try, periodic) and not turned
+        if ok and (paper or landing) and turn < cos_turn and singular_at(sig, r_path):
+            # Landed on a singular point, to round-off (a row on a crossing): its null vector is any of a plane's,
+            # so the path goes on along the tangent it came in with, the branch it came along.
+            for a in range(m):
+                t_new[a] = t[a]
         if not ok:
             if paper:  # the row's step again from its start, in twice as many parts and one
                 if parts >= MAX_PARTS:
@@ -701,6 +769,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 # change-point four-bar's crossing at 180 deg, met exactly by the parts of 60 -> 190 deg in 65,
                 # 130, 260, ... parts) is not met exactly again, where doubling met it every time.
                 parts, part = 2 * parts + 1, 0
+                close_frac, closes, approached = 0.0, 0, 0
                 u[:] = u_row
                 t[:] = t_row
                 basis[:, :] = basis_row
@@ -720,7 +789,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 cross_basis[n_cross, :, :] = basis
             n_cross += 1
         tau_last = tau_new
-        singular_last = r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
+        singular_last = singular_at(sig, r_path)
         # the arclength reported is in the unknowns as they are (lengths in the length unit, as the closed form's)
         s_total += dist if not weighted else plain_length(u, u_try)
         longest = max(longest, dist)
@@ -729,11 +798,16 @@ def march(mech, start, steps, corrector, bounds, out):
             u[a] = u_try[a]
             t[a] = t_new[a]
         basis[:, :] = basis_try
+        if closing:  # a closing part: the row's value is landed on from here next
+            close_frac = 0.0
+            approached += 1
+            continue
         if paper and part < parts - 1:  # a part of the row's step: on to the next, no row
             part += 1
             continue
         if paper:
             parts, part = base, 0
+            closes, approached = 0, 0
             u_row[:] = u
             t_row[:] = t
             basis_row[:, :] = basis
@@ -767,6 +841,13 @@ def march(mech, start, steps, corrector, bounds, out):
         if not paper and easy and turn > np.sqrt(cos_turn):
             h = min(h * 1.5, hmax)
     return count, BUDGET, h
+
+
+@kernel(inline="always")
+def singular_at(sig, r_path):
+    """Whether a point with singular values ``sig`` is singular (:data:`SINGULAR_START`): its path's smallest kept
+    singular value ``sig[r_path - 1]`` below that fraction of the largest, its tangent without a direction."""
+    return r_path >= 1 and r_path <= sig.shape[0] and sig[r_path - 1] <= SINGULAR_START * sig[0]
 
 
 @kernel(inline="always")

@@ -21,7 +21,7 @@ from linkwork.geometry.angles import wrap
 from linkwork.kinematics.bifurcation import correct_on_plane, locate, locate_minimum
 from linkwork.kinematics.classify import classify_point, locate_fold
 from linkwork.kinematics.jit import Backend
-from linkwork.kinematics.march import MAX_CROSSINGS
+from linkwork.kinematics.march import MAX_CROSSINGS, MAX_PARTS, PART_SLACK
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
@@ -690,26 +690,23 @@ class BranchMarcher:
         then the new point with its tangent, singular values, residual and test value), ``basis`` updated in place
         for the march that goes on; None when the corrector does not converge.
 
-        Paper mode moves the drive by the fixed step with the drive held, as the march does; adaptive mode takes
-        the march's step length along the tangent and corrects in the hyperplane normal to it, halving the step
-        on failure. A target on the step is landed on (code ``TARGET``)."""
+        Paper mode moves the drive by the fixed step with the drive held, as the march does, in the march's parts
+        (no longer than ``max_step`` each, the tangent taken again after each: one linear prediction over a row of
+        172 deg landed a whole turn of the coupler off); adaptive mode takes the march's step length along the
+        tangent and corrects in the hyperplane normal to it, halving the step on failure. A target on the step is
+        landed on (code ``TARGET``)."""
         cfg, ws, tol = self.cfg, self.ws, self.cfg.tol
         c, d = chunk.count, cfg.drive
         u_k = chunk.u[c - 1]
         h = chunk.h
         u_next: Array | None = None
+        on_target = False
         while u_next is None and abs(h) >= cfg.min_step:
             if paper:
-                if abs(tangent[d]) < 1e-12:
+                u_next = self._paper_row_from(u_k, tangent, h, basis_prev)
+                if u_next is None:
                     return None
-                guess = u_k + (h / tangent[d]) * tangent
-                guess[d] = u_k[d] + h
-                ok, _, _ = ws.kernels.correct(
-                    ws.kernel_arrays(), guess, d, ws.corrector(tol), ws.q, ws.res, ws.jac
-                )
-                if not ok:
-                    return None
-                u_next = guess
+                on_target = cfg.target is not None and float(u_next[d]) == cfg.target
             else:
                 guess, _, ok = correct_on_plane(ws, u_k + h * tangent, tangent, tol)
                 if ok and float(tangent @ (guess - u_k)) > tol.advance * h:
@@ -731,9 +728,50 @@ class BranchMarcher:
             tau=np.array([chunk.tau[c - 1], tau]), s=np.array([0.0, float(np.linalg.norm(u_next - u_k))]),
             count=2, code=StopReason.BUDGET, h=h,
         )  # fmt: skip
-        if cfg.target is not None and self._target_on_last_step(across) and self._land(across, d, cfg.target):
+        if on_target or (
+            not paper
+            and cfg.target is not None
+            and self._target_on_last_step(across)
+            and self._land(across, d, cfg.target)
+        ):
             across.code = StopReason.TARGET
         return across
+
+    def _paper_row_from(self, u_k: Array, tangent: Array, h: float, basis_prev: Array) -> Array | None:
+        """Paper mode: the row one equal drive step ``h`` on from the singular point ``u_k``, along ``tangent``
+        (the branch it was reached on), in parts no longer than ``max_step`` in the step's metric (as the march's,
+        :data:`~linkwork.kinematics.march.PART_SLACK`), the drive held at each part's value and the tangent taken
+        again after each; the row's value is the target when it is that to ``1e-9`` (as in the march). ``None``
+        when a corrector fails, the drive turns back, or a part turns a revolute joint by more than a quarter turn
+        (the corrector went to another part of the path)."""
+        cfg, ws, tol, d = self.cfg, self.ws, self.cfg.tol, self.cfg.drive
+        value = float(u_k[d] + h)
+        if cfg.target is not None and abs(value - cfg.target) < 1e-9 * max(1.0, abs(cfg.target)):
+            value = cfg.target
+        parts = min(MAX_PARTS, max(1, math.ceil(abs(h) * float(self.weight[d]) / cfg.max_step - PART_SLACK)))
+        u, t = u_k.copy(), tangent.copy()
+        basis = basis_prev.copy()
+        for i in range(1, parts + 1):
+            if t[d] * h <= 0.0 or abs(t[d]) < 1e-12:
+                return None
+            goal = value if i == parts else float(u_k[d] + h * i / parts)
+            guess = u + ((goal - u[d]) / t[d]) * t
+            guess[d] = goal
+            ok, _, _ = ws.kernels.correct(
+                ws.kernel_arrays(), guess, d, ws.corrector(tol), ws.q, ws.res, ws.jac
+            )
+            step = guess - u
+            if not ok or np.any(np.abs(step[cfg.periodic]) > 0.5 * np.pi):
+                return None
+            if i < parts:
+                _, _, jac = ws.evaluate(guess)
+                t_next = np.empty_like(t)
+                ws.kernels.tangent_and_test(
+                    jac, t.copy(), basis, cfg.r_path, t_next, np.empty(cfg.n_sigma), self.weight
+                )
+                t = t_next
+            u = guess
+        return u
 
     def _on_target(self, chunk: Chunk) -> bool:
         """Whether the chunk's last row is on the drive's target (a step that lands there holds the drive at the
