@@ -17,12 +17,21 @@ not:
 * **Loop rows orthonormal over the cycle space** (:func:`cycle_metric`): a mechanism of several loops gives the
   same singular values whichever cycle basis its body graph (and so the order of its joints) produced.
 
-``c`` and ``L`` are taken from the hinge lines at the configuration itself (the joint axes in the base frame
-there), so that fixing another body as the base (relabelling the joints of a loop) also leaves the ratio
-unchanged. Under a rigid motion ``g = [R, t]`` every column becomes ``Ad(g) xi``, ``c`` becomes ``g c`` and ``L``
-is kept, so the normalised columns become ``(R w, R v_c / L)``: an orthogonal map of the rows, and the singular
-values are unchanged. Scaling every length by ``s`` scales ``v_c`` and ``L`` alike. Relabelling permutes columns
-(and may change the cycle basis, see above).
+Every loop is measured in one frame, the ground's (:mod:`linkwork.kinematics.ground_frame`): a loop that does not
+pass through the ground body is taken from the ground, so its columns are its joints' axes where they are, not
+where the motion of the loop's own first body has carried them back to. ``c`` and ``L`` are taken from the hinge
+lines at the configuration itself (the joint axes in the ground's frame there), so that holding another body as
+the ground (relabelling the joints of a loop, or naming another body of a multi-loop mechanism ``ground``) also
+leaves the ratio unchanged: the frames of two grounds differ by the rigid motion between those bodies, the same for
+every loop, and the cycle bases by a unimodular ``M`` (above). Under a rigid motion ``g = [R, t]`` every column
+becomes ``Ad(g) xi``, ``c`` becomes ``g c`` and ``L`` is kept, so the normalised columns become ``(R w, R v_c /
+L)``: an orthogonal map of the rows, and the singular values are unchanged. Scaling every length by ``s`` scales
+``v_c`` and ``L`` alike. Relabelling permutes columns (and may change the cycle basis, see above). Tests:
+``tests/studies/test_every_body_as_ground.py`` (random Watt and Stephenson six-bars, planar and spherical, and
+Goldberg's two Bennett loops, with every body as the ground).
+
+The trace's own rows (``Trace.sigma``, path.csv) are the singular values of the loops as the tracer takes them,
+each from its own first body; only the normalised ratio reads them in the ground's frame.
 """
 
 from __future__ import annotations
@@ -33,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from linkwork.kinematics.ground_frame import ground_frame_closure, joint_axes
 from linkwork.kinematics.jit import Backend, select_backend
 from linkwork.kinematics.mechanism import Array, Mechanism
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank
@@ -72,32 +82,24 @@ def hinge_centre(axes: ArrayLike, joint_types: Sequence[str]) -> tuple[Array, fl
 
 
 def _full_jacobians(mech: Mechanism, q: Array, kernels: Backend | None = None) -> Array:
-    """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)``, by ``kernels`` (default:
-    chosen now; a trace passes the backend it chose for the whole call)."""
+    """Unreduced closure Jacobians ``(N, 6 * loops, n)`` at displacements ``q (N, n)``, every loop in the ground's
+    frame (:func:`linkwork.kinematics.ground_frame.ground_frame_closure`), by ``kernels`` (default: chosen now;
+    a trace passes the backend it chose for the whole call)."""
+    return ground_frame_closure(mech, q, kernels)[1]
+
+
+def _tracer_jacobian(mech: Mechanism, q: Array) -> Array:
+    """The unreduced closure Jacobian ``(6 * loops, n)`` at displacements ``q (n,)`` of the loops as the tracer
+    takes them (each from its own first body: :attr:`Mechanism.kernel_arrays`), all six rows."""
     joints, signs, ptr = mech.loop_arrays()
     n = mech.n_joints
-    E = 6 * len(mech.loops)
-    out = np.zeros((len(q), E, n))
-    residual = np.zeros(E)
-    rows = np.arange(6, dtype=np.int64)
-    groups = np.arange(n, dtype=np.int64)
-    twists = np.ascontiguousarray(mech.twists)
-    # compiled, or its plain-Python twin while the cache is cold
-    kernel = (kernels if kernels is not None else select_backend()).closure_jacobian
-    for k, qk in enumerate(q):
-        kernel((twists, joints, signs, ptr, rows, groups), np.ascontiguousarray(qk), n, residual, out[k])
-    return out
-
-
-def _axes(jac: Array, n_loops: int) -> Array:
-    """``(N, n, 6)`` each joint's axis in the base frame: its first non-zero loop column (sign irrelevant)."""
-    N, _, n = jac.shape
-    blocks = jac.reshape(N, n_loops, 6, n)
-    axes = np.zeros((N, n, 6))
-    for k in range(n_loops):
-        empty = ~np.any(axes != 0.0, axis=2)
-        axes[empty] = np.swapaxes(blocks[:, k], 1, 2)[empty]
-    return axes
+    jac = np.zeros((6 * len(mech.loops), n))
+    rows, groups = np.arange(6, dtype=np.int64), np.arange(n, dtype=np.int64)
+    mechanism = (np.ascontiguousarray(mech.twists), joints, signs, ptr, rows, groups)
+    select_backend().closure_jacobian(
+        mechanism, np.ascontiguousarray(q, dtype=float), n, np.zeros(len(jac)), jac
+    )
+    return jac
 
 
 def cycle_metric(mech: Mechanism) -> Array:
@@ -120,7 +122,7 @@ def normalized_jacobians(mech: Mechanism, angles: ArrayLike) -> Array:
     values = np.atleast_2d(np.asarray(angles, dtype=float))
     jac = _full_jacobians(mech, values - mech.offsets)
     n_loops = len(mech.loops)
-    c, L = hinge_centres(_axes(jac, n_loops), mech.joint_types)
+    c, L = hinge_centres(joint_axes(mech, jac), mech.joint_types)
     N, _, n = jac.shape
     blocks = jac.reshape(N, n_loops, 6, n)
     w, v = blocks[:, :, :3, :], blocks[:, :, 3:, :]
@@ -134,7 +136,8 @@ def normalized_jacobians(mech: Mechanism, angles: ArrayLike) -> Array:
 
 
 def normalized_jacobian(mech: Mechanism, angles: ArrayLike) -> Array:
-    """The reduced closure Jacobian ``(n_equations, n_unknowns)`` at joint values ``angles`` (radians), normalised.
+    """The reduced closure Jacobian ``(n_equations, n_unknowns)`` at joint values ``angles`` (radians), normalised,
+    every loop in the ground's frame (:mod:`linkwork.kinematics.ground_frame`).
 
     Moments about :func:`hinge_centre` of the joint axes there, lengths in its scale ``L``; the rows kept and the
     coupling reduction are those of the raw Jacobian (:func:`linkwork.kinematics.closure.jacobian`).
@@ -144,11 +147,12 @@ def normalized_jacobian(mech: Mechanism, angles: ArrayLike) -> Array:
 
 def hinge_centres_along(mech: Mechanism, angles: ArrayLike) -> tuple[Array, Array]:
     """Centre ``c (N, 3)`` and length scale ``L (N,)`` of the revolute hinge lines at every row of joint values
-    ``angles (N, n)`` (:func:`hinge_centres` of the joint axes in the base frame there): the same physical point
-    whichever body is the base, since the axes there are carried by that body's pose."""
+    ``angles (N, n)`` (:func:`hinge_centres` of the joint axes in the ground's frame there,
+    :func:`linkwork.kinematics.ground_frame.joint_axes`): the same physical point whichever body is the ground,
+    since the axes there are carried by the poses of their bodies."""
     values = np.atleast_2d(np.asarray(angles, dtype=float))
     jac = _full_jacobians(mech, values - mech.offsets)
-    return hinge_centres(_axes(jac, len(mech.loops)), mech.joint_types)
+    return hinge_centres(joint_axes(mech, jac), mech.joint_types)
 
 
 def length_scale(mech: Mechanism, angles: ArrayLike | None = None, kernels: Backend | None = None) -> float:
@@ -159,7 +163,7 @@ def length_scale(mech: Mechanism, angles: ArrayLike | None = None, kernels: Back
     """
     values = mech.offsets if angles is None else np.asarray(angles, dtype=float)
     jac = _full_jacobians(mech, np.atleast_2d(values - mech.offsets), kernels)
-    return float(hinge_centres(_axes(jac, len(mech.loops)), mech.joint_types)[1][0])
+    return float(hinge_centres(joint_axes(mech, jac), mech.joint_types)[1][0])
 
 
 def robustness_ratio(sigma: ArrayLike, rank: int) -> float:
@@ -221,6 +225,6 @@ def near_mobility(
     C = mech.coupling_matrix()
     motion = C @ Vt[m - 1] / np.max(np.abs(C @ Vt[m - 1]))  # the near-motion, largest joint moving 1 rad
     joints = tuple(name for name, x in zip(mech.joint_names, motion, strict=True) if abs(x) > 0.1)
-    jac = _full_jacobians(mech, np.atleast_2d(values - mech.offsets))[0]
+    jac = _tracer_jacobian(mech, values - mech.offsets)
     raw = jac.reshape(len(mech.loops), 6, -1)[:, list(mech.rows), :].reshape(-1, mech.n_joints)
     return NearMobility(float(s[m - 1] / s[0]), float(np.linalg.norm(raw @ motion)), joints)

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from linkwork.geometry import adjoint, exp_se3
 from linkwork.kernel_cache import kernel
+from linkwork.kinematics.ground_frame import ground_frame_loops
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import numerical_rank
 from linkwork.studies.imperfections import HingeLines
@@ -45,14 +46,16 @@ def hinge_derivative_twists(lines: HingeLines) -> Array:
 
 
 def linearised_closure(mech: Mechanism, q: Array, lines: HingeLines, T: Array) -> tuple[Array, Array]:
-    """Weighted Jacobian ``T J`` ``(E, m)`` (unknowns) and hinge-error matrix ``T B`` ``(E, 4n)`` at ``q``."""
+    """Weighted Jacobian ``T J`` ``(E, m)`` (unknowns) and hinge-error matrix ``T B`` ``(E, 4n)`` at ``q``, every
+    loop taken from the ground (:func:`linkwork.kinematics.ground_frame.ground_frame_loops`: a joint on a loop's
+    tree path adds to it twice, and its two terms cancel where the loops close)."""
     rows = list(mech.rows)
     r = len(rows)
     n = mech.n_joints
     dtw = hinge_derivative_twists(lines)
     J = np.zeros((mech.n_equations, n))
     B = np.zeros((mech.n_equations, n, 4))
-    for k, loop in enumerate(mech.loops):
+    for k, loop in enumerate(ground_frame_loops(mech)):
         g = np.eye(4)
         for j, s in zip(loop.joints, loop.signs, strict=True):
             ad_g = adjoint(g)

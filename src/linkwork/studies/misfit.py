@@ -6,7 +6,10 @@ tangent: where the drive parameterises the path this is the drive held, to first
 annihilates the tangent, so every plane transverse to it gives the same least residual to first order), and unlike
 holding the drive it stays well posed at a fold of the drive, where the path turns back; ``r`` is the stacked loop logarithm (closure residual, Eq. (23) in twist form) and ``T`` the weight
 of :mod:`linkwork.studies.scale` at point ``k`` (moments about the centre of the hinge lines there), so the misfit is
-a length in the linkage's units, whichever body is the ground. It is solved by Gauss-Newton
+a length in the linkage's units, whichever body is the ground. Every loop is taken in the ground's frame, the
+frame of that centre (the loops of :func:`linkwork.kinematics.ground_frame.ground_frame_arrays`: a loop that does
+not pass through the ground is conjugated by its tree path from it, ``log(A P A^-1) = Ad_A log P``, and its
+columns, the exact derivative of that product, are its joints' axes where they are). It is solved by Gauss-Newton
 (normal equations, Cholesky, with backtracking), warm-started along the path from the solutions' offsets from the
 nominal path at the last three drive values, extrapolated (each refined by its last, unevaluated Gauss-Newton
 step): one evaluation usually ends a solve. The compiled batch kernel runs many samples and all drive values in
@@ -354,7 +357,8 @@ def misfit_batch(
     """``(S, K)`` misfits of ``S`` imperfect mechanisms ``twists (S, n, 6)`` along the nominal path ``path =
     (u_path, normal, cycles)`` (``cycles`` the loops' weights, :func:`linkwork.studies.scale.loop_weights`);
     ``loops = (loop_joint, loop_sign, loop_ptr, rows, groups)`` (the mechanism tuple without
-    its twists); weights ``T (K, 6, 6)``, one per point."""
+    its twists, its loops taken from the ground: :func:`linkwork.kinematics.ground_frame.ground_frame_arrays`);
+    weights ``T (K, 6, 6)``, one per point."""
     S = twists.shape[0]
     out = np.empty((S, path[0].shape[0]))
     loop_joint, loop_sign, loop_ptr, rows, groups = loops

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from linkwork.deprecation import trace_keyword
 from linkwork.errors import SpecError
+from linkwork.kinematics.ground_frame import ground_frame_arrays
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.trace_result import Trace
 from linkwork.limits import MAX_PATH_POINTS
@@ -71,8 +72,10 @@ class RobustnessSetup:
     keep_tol: float
 
     def kernel_args(self) -> tuple[Any, ...]:
-        """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists: ``(path, loops, weight)``."""
-        joint, sign, ptr = self.mech.loop_arrays()
+        """Arguments of :func:`linkwork.studies.misfit.misfit_batch` after the twists: ``(path, loops, weight)``,
+        the loops taken from the ground (:func:`linkwork.kinematics.ground_frame.ground_frame_arrays`: the frame of
+        the weights' centre, whichever loop it is)."""
+        joint, sign, ptr = ground_frame_arrays(self.mech)
         rows = np.array(self.mech.rows, dtype=np.int64)
         return (
             (self.u_path, self.normal, self.cycles),

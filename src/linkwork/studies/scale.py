@@ -43,8 +43,10 @@ def weight(centre: Array, length: float) -> Array:
 
 def weights_along(mech: Mechanism, angles: Array, length: float) -> Array:
     """``(K, 6, 6)`` the weight at every row of joint values ``angles (K, n)``: moments about the centre of the
-    hinge lines in that configuration (a point that moves with the linkage, so the measure does not depend on
-    which body is held still as the ground), lengths in the linkage's scale ``length`` (from the start)."""
+    hinge lines in that configuration, in the ground's frame where the misfit takes every loop
+    (:func:`linkwork.kinematics.normalization.hinge_centres_along`; a point that moves with the linkage, so the
+    measure does not depend on which body is held still as the ground), lengths in the linkage's scale ``length``
+    (from the start)."""
     from linkwork.kinematics.normalization import hinge_centres_along
 
     centres, _ = hinge_centres_along(mech, angles)
