@@ -31,6 +31,16 @@ class AssemblyError(LinkworkError):
         super().__init__(message)
 
 
+class RigidStartError(LinkworkError):
+    """A start configuration that cannot move: rigid to first order (the Jacobian's rank is the number of
+    unknowns, ``order`` 1) or to second order (an isolated point, or a shaky structure: mobile to first order
+    only, ``order`` 2)."""
+
+    def __init__(self, message: str, *, order: int) -> None:
+        self.order = order
+        super().__init__(message)
+
+
 class ConvergenceError(LinkworkError):
     """A corrector or optimiser that failed: says where and why."""
 

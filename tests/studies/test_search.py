@@ -224,9 +224,10 @@ def test_a_search_over_hundreds_of_members_completes_with_table_and_gallery(tmp_
 
 
 def test_stalled_members_are_mobile_to_first_order_only() -> None:
-    """The members the search fails with "the path stops" are rigid to second order: with t the Jacobian's null
-    vector at the flat start and w its left null vector, w . H(t, t) != 0 (H the closure Hessian), so no curve
-    leaves the start; the members it traces have w . H(t, t) = 0. Over the 36 mobile face choices of Guest's cuts."""
+    """The members the search fails as "rigid to second order" (before: "the path stops", after rows off the
+    loop) are: with t the Jacobian's null vector at the flat start and w its left null vector, w . H(t, t) != 0 (H
+    the closure Hessian, computed here from kinematics.closure), so no curve leaves the start; the members it
+    traces have w . H(t, t) = 0. Over the 36 mobile face choices of Guest's cuts."""
     import itertools
 
     from linkwork.kinematics.closure import hessian
@@ -246,7 +247,7 @@ def test_stalled_members_are_mobile_to_first_order_only() -> None:
             continue  # rigid
         second = abs(u[:, -1] @ np.einsum("eij,i,j->e", hessian(mech, np.zeros(6)), vt[-1], vt[-1]))
         row = evaluate(search_study, {"faces": faces}).row
-        if row["reason"].startswith("mobility: the path stops"):
+        if row["reason"].startswith("mobility: rigid to second order"):
             stalled += 1
             assert second > 1e-3, faces
         else:

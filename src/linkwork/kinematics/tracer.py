@@ -18,7 +18,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from linkwork.errors import LinkworkError, SpecError
+from linkwork.errors import LinkworkError, RigidStartError, SpecError
 from linkwork.interrupts import stop_text
 from linkwork.kinematics import kernels
 from linkwork.kinematics.bifurcation import branch_tangents
@@ -266,10 +266,11 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
         ):  # (with play in the hinges a small obstruction is what play takes up)
             obstruction = _second_order_obstruction(mech, U0, Vt0, r_path)
             if obstruction > SHAKY:
-                raise LinkworkError(
+                raise RigidStartError(
                     f"{mech.name}: the start is rigid to second order, a shaky structure (Jacobian rank {r_path}: "
                     f"mobility 1 to first order, but along that motion the loops open at second order, "
-                    f"{obstruction:.2g} of the Hessian's scale): it cannot move from there"
+                    f"{obstruction:.2g} of the Hessian's scale): it cannot move from there",
+                    order=2,
                 )
         basis = np.ascontiguousarray(U0[:, :r_path])
         basis.flags.writeable = False
@@ -405,18 +406,20 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: 
     r_path = mech.derived(("start rank", backend.compiled, tol), lambda: numerical_rank(sigma, tol))
     mobility = m - r_path
     if mobility == 0:
-        raise LinkworkError(
+        raise RigidStartError(
             f"{mech.name}: the start is rigid (Jacobian rank {r_path} = number of unknowns, smallest singular "
             f"value {sigma[-1] / sigma[0]:.2e} of the largest); an over-constrained loop needs its exact geometry "
             "to move: give its parameters to full precision, or accept play in the hinges (closure_tol / "
-            "--closure-tol)"
+            "--closure-tol)",
+            order=1,
         )
     lines = _start_lines(mech, backend, tol, m) if mobility > 1 else None
     if lines == 0:
-        raise LinkworkError(
+        raise RigidStartError(
             f"{mech.name}: the start is rigid, an isolated configuration (Jacobian rank {r_path} here, {m} "
             "unknowns, but no direction along which the loop stays closed to second order): it cannot move "
-            "from there"
+            "from there",
+            order=2,
         )
     if lines is not None and lines >= 2:
         raise LinkworkError(

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from linkwork.errors import LinkworkError, SpecError
+from linkwork.errors import LinkworkError, RigidStartError, SpecError
 from linkwork.io.toml_reader import TomlReader
 from linkwork.limits import plain_number
 from linkwork.progress import Progress
@@ -223,6 +223,7 @@ def evaluate(search: SearchStudy, params: dict[str, Any]) -> Candidate:
     row.update(dict.fromkeys(MEASURE_COLUMNS))
     traced = dep = None
     error = ""
+    rigid_order = 0
     try:
         mech = resolve_spec(study.target, params).mechanism
         sigma = np.linalg.svd(
@@ -247,11 +248,13 @@ def evaluate(search: SearchStudy, params: dict[str, Any]) -> Candidate:
             points=len(traced.angles),
             end=traced.branches[0].end_reason if traced.branches else "",
         )
+    except RigidStartError as exc:
+        error, rigid_order = str(exc), exc.order
     except LinkworkError as exc:
         error = str(exc)
     except (np.linalg.LinAlgError, FloatingPointError) as exc:  # a numerical failure ends this candidate only
         error = f"{type(exc).__name__}: {exc}"
-    passes, reason, shortfall = judge(search.criteria, row, error)
+    passes, reason, shortfall = judge(search.criteria, row, error, rigid_order)
     row.update(passes=passes, reason=reason, shortfall=shortfall, error=error)
     return Candidate(row, traced, dep)
 
@@ -264,11 +267,12 @@ def _in_api_units(mech: Any, target: tuple[str, float] | None) -> tuple[str, flo
     return target[0], float(np.radians(target[1]) if mech.joint_types[j] == "R" else target[1])
 
 
-def judge(criteria: Criteria, row: Row, error: str = "") -> tuple[bool, str, float]:
+def judge(criteria: Criteria, row: Row, error: str = "", rigid_order: int = 0) -> tuple[bool, str, float]:
     """``(passes, reason, shortfall)`` of a candidate's row.
 
     ``reason`` is the first criterion failed (in :data:`CRITERIA` order), with the value and the limit, or the
-    error that stopped its trace; ``shortfall`` is how far it is from passing: the sum over the failed criteria
+    error that stopped its trace (``rigid_order`` 2: its start was refused as rigid to second order, mobile to
+    first order only, :class:`~linkwork.errors.RigidStartError`); ``shortfall`` is how far it is from passing: the sum over the failed criteria
     of the excess, relative to the limit for a measure (``(value - limit) / limit``, or ``value - limit`` for a
     limit of 0), in whole units for the mobility (``|mobility at start - wanted| + excess along the path``) and
     the bifurcations; ``inf`` when the trace failed before the measure could be taken.
@@ -282,6 +286,8 @@ def judge(criteria: Criteria, row: Row, error: str = "") -> tuple[bool, str, flo
         elif m_max is not None and m_max > want:
             failed.append((f"mobility: rises to {m_max} on the path (wanted {want})", float(m_max - want)))
     end = str(row.get("end") or "")
+    if criteria.mobility is not None and not failed and rigid_order == 2:
+        failed.append(("mobility: rigid to second order (mobile to first order only)", 1.0))
     if criteria.mobility is not None and not failed and end.startswith(STALLED):
         # A rank-deficient start the tracer cannot follow: mobile to first order only, or stuck at once.
         failed.append((f"mobility: the path stops after {row['points']} points ({end.split(' (')[0]})", 1.0))
