@@ -89,9 +89,6 @@ def test_a_slider_started_at_its_dead_centre_reaches_a_target_adaptively() -> No
     assert abs(abs(np.degrees(tr.angles[-1, 0])) - crank_at(3.0)) < 1e-9
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): paper mode from a start at a fold of the drive never moves"
-)
 @pytest.mark.parametrize("steps", [1, 10])
 def test_a_slider_started_at_its_dead_centre_reaches_a_target_in_equal_steps(steps: int) -> None:
     """``linkwork trace slider-crank --set theta=0 --drive D --until D=3 --steps 10`` (or 1). Got: no step, 'drive

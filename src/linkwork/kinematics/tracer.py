@@ -26,7 +26,7 @@ from linkwork.kinematics.classify import component_dimension
 from linkwork.kinematics.closure import hessian, reduce
 from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
-from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
+from linkwork.kinematics.marcher import FOLD_START, BranchMarcher, MarchSettings, leading_sign
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.own_frame import arguments_in_own_frame, own_frame, trace_from_own_frame, twin
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
@@ -125,7 +125,7 @@ def trace(
     if target is not None:
         sign = 1.0 if target >= 0 else -1.0
     # A fresh array either way (the kept tangent is read-only and shared; the kernels get a writeable one).
-    t_start = -start.tangent if start.components[d_unknown] * sign < 0 else start.tangent.copy()
+    t_start = start.tangent * _start_direction(start.components, d_unknown, sign)
     lo, hi = _limits_in_unknowns(mech, limits) if limits else (start.lo, start.hi)
     cos_turn = _COS_MAX_TURN if max_turn is _MAX_TURN else float(np.cos(max_turn))
     settings = record(
@@ -173,6 +173,19 @@ def trace(
         marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
     marcher.follow_queue()
     return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+
+
+def _start_direction(components: tuple[float, ...], drive: int, sign: float) -> float:
+    """+1 or -1: the way to leave the start along its unit null vector ``components``, so that the drive moves
+    towards ``sign`` (its target's side).
+
+    At a fold of the drive (its component below :data:`~linkwork.kinematics.marcher.FOLD_START`: a slider-crank's
+    slider at a dead centre) the drive stays put to first order and moves the same way in both directions, so
+    neither is towards the target; the one taken is then the one along which the first unknown that moves
+    increases (:func:`~linkwork.kinematics.marcher.leading_sign`: the SVD's sign is round-off's)."""
+    if abs(components[drive]) < FOLD_START:
+        return float(leading_sign(np.array(components), drive, FOLD_START))
+    return -1.0 if components[drive] * sign < 0 else 1.0
 
 
 def _trace_in_own_frame(
