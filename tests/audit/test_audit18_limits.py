@@ -93,9 +93,6 @@ def test_a_limit_met_before_the_last_step_ends_the_branch(trammel: lw.Mechanism,
     assert abs(tr.angles[-1, 0] - np.sqrt(LENGTH**2 - 0.5**2)) < 1e-12
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): a limit crossed by the step that lands on the target is ignored"
-)
 @pytest.mark.parametrize(
     ("steps", "target", "limits", "joint"),
     [
@@ -130,7 +127,6 @@ def test_a_limit_crossed_by_the_landing_step_ends_the_branch(
     assert tr.stats.unmet is not None
 
 
-@pytest.mark.xfail(strict=True, reason="open (audit18): --limit ignored on the step that lands on --until")
 def test_the_command_line_stops_a_crank_at_its_limit(tmp_path: Path) -> None:
     """``linkwork trace four-bar --until A=100 --steps 4 --limit A=0:90``: the crank A starts at 60 deg, equal
     steps of 10 deg land on 90 and then on 100. Got: exit 0, 'reached target', A = 100 in path.csv's last row

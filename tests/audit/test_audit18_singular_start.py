@@ -53,9 +53,6 @@ def test_the_parallelogram_next_to_its_flat_point_traces_both_closed_forms() -> 
     assert len(tr.bifurcations) == 1
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): a four-bar started at its change point is refused as 'mobility 2'"
-)
 def test_a_parallelogram_drawn_flat_is_traced_from_its_crossing() -> None:
     """``linkwork trace four-bar --set crank=1 --set coupler=2 --set rocker=1 --set theta=0`` (and the same four-bar
     written as a ``[mechanism]`` with its four points on a line). Got: 'four-bar: mobility 2 at the start (rank 2,

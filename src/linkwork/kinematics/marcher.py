@@ -1317,7 +1317,6 @@ class BranchMarcher:
     # ---- the queued branches
     def follow_queue(self) -> None:
         """Trace every queued branch (breadth first) while the step budget lasts."""
-        cfg = self.cfg
         while self.queue and self.budget > 0:
             if (
                 self.stop_requested()
@@ -1328,34 +1327,49 @@ class BranchMarcher:
                 self.retraced += 1
                 continue
             bid = len(self.branches)
-            h = cfg.max_step / 4.0
-            u1, _r, ok = correct_on_plane(self.ws, job.u + h * job.tangent, job.tangent, cfg.tol)
-            if not ok:
+            left = self.leave_point(bid, job.u, job.tangent, job.bifurcation)
+            if left is None:
                 end = self.end(StopReason.NOT_LEFT, StopReason.NOT_LEFT.text, job.u, None, job.bifurcation)
                 self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, 0, end))
                 continue
-            _, _, jac1 = self.ws.evaluate(u1)
-            U1, _, Vt1 = np.linalg.svd(jac1)
-            t1 = Vt1[-1] if Vt1[-1] @ job.tangent > 0 else -Vt1[-1]
-            # Record the bifurcation point itself as the branch's first point, then march on.
-            r_star, _, jst = self.ws.evaluate(job.u)
-            sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
-            self.rows.add_point(job.u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
-            s_off = float(np.linalg.norm(u1 - job.u))
-            start_len = len(self.rows.u)
-            basis = np.ascontiguousarray(U1[:, : cfg.r_path])
-            opened_at = (job.u, Home(sigma_star, float(r_star), 0.0))
-            nb, end = self.run_branch(
-                bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1, opened_at=opened_at
-            )
-            for i in range(start_len, len(self.rows.u)):
-                self.rows.s[i] = self.rows.s[i] + s_off
-                self.rows.step[i] = self.rows.step[i] + 1
-            if (
-                end.kind == StopReason.CLOSED
-            ):  # back round to where it left its point: a closed mode through it
-                block = self.rows.u[-1]
-                step = block[-1] - (block[-2] if len(block) > 1 else self.rows.u[-2][-1])
-                step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
-                self._arrived(job.bifurcation, step)
-            self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, nb + 1, end))
+            nb, end = left
+            self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, nb, end))
+
+    def start_at_point(self, point: Bifurcation, incoming: Array) -> None:
+        """Keep the start, a located singular point (a crossing of branches), as point 0; with branch switching,
+        its branch tangents other than ``incoming`` (the one branch 0 leaves along) are queued."""
+        self._add_point(point, 0, incoming)
+
+    def leave_point(self, bid: int, u: Array, tangent: Array, point: int) -> tuple[int, End] | None:
+        """March branch ``bid`` from the located point ``u`` (id ``point``) along the branch tangent ``tangent``
+        (adaptive steps, stopping at known points): the point is its first row, then one step of a quarter of
+        ``max_step`` corrected on the plane normal to the tangent, then the march. Returns (steps, end), or
+        ``None`` when that first step does not converge (the branch could not be left)."""
+        cfg = self.cfg
+        h = cfg.max_step / 4.0
+        u1, _r, ok = correct_on_plane(self.ws, u + h * tangent, tangent, cfg.tol)
+        if not ok:
+            return None
+        _, _, jac1 = self.ws.evaluate(u1)
+        U1, _, Vt1 = np.linalg.svd(jac1)
+        t1 = Vt1[-1] if Vt1[-1] @ tangent > 0 else -Vt1[-1]
+        # Record the point itself as the branch's first point, then march on.
+        r_star, _, jst = self.ws.evaluate(u)
+        sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
+        self.rows.add_point(u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
+        s_off = float(np.linalg.norm(u1 - u))
+        start_len = len(self.rows.u)
+        basis = np.ascontiguousarray(U1[:, : cfg.r_path])
+        opened_at = (u, Home(sigma_star, float(r_star), 0.0))
+        nb, end = self.run_branch(
+            bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1, opened_at=opened_at
+        )
+        for i in range(start_len, len(self.rows.u)):
+            self.rows.s[i] = self.rows.s[i] + s_off
+            self.rows.step[i] = self.rows.step[i] + 1
+        if end.kind == StopReason.CLOSED:  # back round to where it left its point: a closed mode through it
+            block = self.rows.u[-1]
+            step = block[-1] - (block[-2] if len(block) > 1 else self.rows.u[-2][-1])
+            step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
+            self._arrived(point, step)
+        return nb + 1, end
