@@ -11,7 +11,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import pytest
 from typer.testing import CliRunner
 
 from linkwork.cli import app
@@ -41,7 +40,6 @@ def test_s_is_the_arclength_in_degrees_for_revolute_joints(tmp_path: Path) -> No
     assert np.abs(ratio[:-1] - 1.0).max() < 1e-9
 
 
-@pytest.mark.xfail(strict=True, reason="open (audit18): the closing row's s is not the arclength to it")
 def test_the_closing_rows_s_counts_the_step_to_it(tmp_path: Path) -> None:
     """The same four-bar's path closes (its last row snapped onto the start plus a crank turn). Got: the last step's
     increment of s is 0.597 of the chord from the row before to that closing row (every other step: 1 to 7.5e-14),
