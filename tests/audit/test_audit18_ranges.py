@@ -158,9 +158,6 @@ def _triple_rocker_args() -> list[str]:
     return ["trace", "four-bar", "--set", "crank=1.5", "--set", "coupler=1", "--set", "rocker=2"]
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): a paper-mode fold's step is the march's count, not a row"
-)
 @pytest.mark.parametrize("steps", [10, 45, 200])
 def test_a_paper_folds_step_is_the_row_just_before_it(tmp_path: Path, steps: int) -> None:
     """``Fold.step`` is 'the step of the branch just before it' (kinematics/trace_result.py), report.json's

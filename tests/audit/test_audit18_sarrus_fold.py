@@ -67,9 +67,6 @@ def test_an_adaptive_trace_crosses_the_fold_to_its_target() -> None:
     assert abs(np.degrees(point.angles[0] - B)) < 1e-8 and point.kind == "component"
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): a paper step landing on the Sarrus fold ends the path there"
-)
 @pytest.mark.parametrize(("steps", "target"), [(1, B), (2, 2 * B), (200, 2 * B)])
 def test_paper_steps_landing_on_the_fold_go_on_to_the_target(steps: int, target: float) -> None:
     """Equal steps of A of which one lands exactly on A = b. Got: the branch ends there, 'entered a 2-dimensional
@@ -85,9 +82,6 @@ def test_paper_steps_landing_on_the_fold_go_on_to_the_target(steps: int, target:
     assert np.abs(tr.angles - np.outer(tr.angles[:, 0], RATIO)).max() < 1e-9
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): paper steps that straddle the Sarrus fold do not record it"
-)
 @pytest.mark.parametrize("steps", [5, 7])
 def test_paper_steps_straddling_the_fold_record_it(steps: int) -> None:
     """5 or 7 equal steps to A = 2b straddle A = b. Got: the target reached with no point recorded

@@ -53,9 +53,6 @@ def test_the_parallelogram_next_to_its_flat_point_traces_both_closed_forms() -> 
     assert len(tr.bifurcations) == 1
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): a four-bar started at its change point is refused as 'mobility 2'"
-)
 def test_a_parallelogram_drawn_flat_is_traced_from_its_crossing() -> None:
     """``linkwork trace four-bar --set crank=1 --set coupler=2 --set rocker=1 --set theta=0`` (and the same four-bar
     written as a ``[mechanism]`` with its four points on a line). Got: 'four-bar: mobility 2 at the start (rank 2,
@@ -89,9 +86,6 @@ def test_a_slider_started_at_its_dead_centre_reaches_a_target_adaptively() -> No
     assert abs(abs(np.degrees(tr.angles[-1, 0])) - crank_at(3.0)) < 1e-9
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18): paper mode from a start at a fold of the drive never moves"
-)
 @pytest.mark.parametrize("steps", [1, 10])
 def test_a_slider_started_at_its_dead_centre_reaches_a_target_in_equal_steps(steps: int) -> None:
     """``linkwork trace slider-crank --set theta=0 --drive D --until D=3 --steps 10`` (or 1). Got: no step, 'drive

@@ -20,11 +20,49 @@ from linkwork.errors import LinkworkError
 DEG = np.pi / 180.0
 
 
-def test_a_parallelogram_laid_flat_is_a_crossing_of_two_branches() -> None:
-    mech = lw.load("four-bar", ground=2.0, crank=1.0, coupler=2.0, rocker=1.0, theta=0.0)
-    with pytest.raises(LinkworkError, match=r"2 one-parameter branches cross .*mobility one, not 2"):
-        lw.trace(mech)
-    # a degree away it is traced through that point, which is located as a bifurcation
+def flat_parallelogram_rows(angles: np.ndarray, a: float, g: float) -> tuple[float, np.ndarray]:
+    """The largest closure mismatch of the parallelogram four-bar (crank and rocker ``a``, coupler and ground ``g``,
+    laid flat at the start: every joint reads 0 there) at each row, by circle intersection written here (B on the
+    crank circle at angle A, C = B + g (cos, sin) of the coupler's angle A + B, then |C - D| = a with D = (g, 0)),
+    and whether each row is on the parallelogram branch (B = -A, wrapped)."""
+    ang_a, ang_b = angles[:, 0], angles[:, 1]
+    pb = a * np.stack([np.cos(ang_a), np.sin(ang_a)], axis=1)
+    pc = pb + g * np.stack([np.cos(ang_a + ang_b), np.sin(ang_a + ang_b)], axis=1)
+    mismatch = float(np.abs(np.linalg.norm(pc - np.array([g, 0.0]), axis=1) - a).max())
+    return mismatch, np.abs((ang_b + ang_a + np.pi) % (2 * np.pi) - np.pi) < 1e-9
+
+
+@pytest.mark.parametrize(("a", "g"), [(1.0, 2.0), (0.5, 3.0), (2.0, 2.5), (3.0, 1.2)])
+@pytest.mark.parametrize(
+    ("kw", "parallelogram_only"),
+    [
+        ({}, True),
+        ({"until": ("A", 90 * DEG)}, True),
+        ({"until": ("A", -120 * DEG), "steps": 12}, True),
+        ({"branches": True, "max_steps": 3000}, False),
+    ],
+)
+def test_a_parallelogram_laid_flat_is_traced_from_its_crossing(
+    a: float, g: float, kw: dict, parallelogram_only: bool
+) -> None:
+    """The flat start is the crossing of the parallelogram and antiparallelogram branches (rank 2 there, 3
+    beside it): traced from it, branch 0 along the branch tangent that moves the crank most (the parallelogram
+    branch, B = -A), the start bifurcation 0; with branches the antiparallelogram is traced too. Every row closes
+    the circle |C - D| = a (1e-9 of the size)."""
+    mech = lw.load("four-bar", ground=g, crank=a, coupler=g, rocker=a, theta=0.0)
+    trace = lw.trace(mech, **kw)
+    assert trace.stats.unmet is None
+    mismatch, on_parallelogram = flat_parallelogram_rows(trace.angles, a, g)
+    assert mismatch < 1e-9 * max(a, g)
+    assert on_parallelogram[trace.branch == 0].all()
+    assert on_parallelogram.all() == parallelogram_only
+    assert trace.bifurcations[0].kind == "bifurcation" and np.abs(trace.bifurcations[0].angles).max() < 1e-12
+    if "until" in kw:
+        assert abs(trace.angles[-1, 0] - kw["until"][1]) < 1e-12
+
+
+def test_a_parallelogram_a_degree_from_flat_is_traced_through_it() -> None:
+    """A degree away the path passes through the flat point, which is located as a bifurcation."""
     near = lw.load("four-bar", ground=2.0, crank=1.0, coupler=2.0, rocker=1.0, theta=1 * DEG)
     trace = lw.trace(near, until=("A", 361 * DEG))
     off = [abs((np.degrees(b.angles[0]) + 180.0) % 360.0 - 180.0) for b in trace.bifurcations]

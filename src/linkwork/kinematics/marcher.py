@@ -71,6 +71,15 @@ FOLD_PROBE_STEPS = 60
 #: A fold of the drive is looked for only where its tangent component moves by more than this on one side: on a
 #: branch along which the drive stays put (to round-off) that component only changes sign by noise.
 FOLD_MOVING = 1e-8
+#: Paper rows longer than ``max_step``: a local minimum of ``sigma_r / sigma_1`` lower than its higher neighbour by
+#: more than this fraction is looked into for a rank drop (:meth:`BranchMarcher._scan_rank_minima`).
+MINIMUM_DIP = 1e-6
+
+#: A start whose unit tangent's drive component is below this is at a fold of the drive: the paper march cannot
+#: take an equal drive step along it (march.predict's own bound), so its first row is reached by following the path
+#: (:meth:`BranchMarcher._follow_row`), in the direction :func:`linkwork.kinematics.tracer.trace` chose.
+FOLD_START = 1e-9
+
 # A step over which the test function changes sign is taken again from its start in steps of 1/JUMP_SHRINK of its
 # length, down to JUMP_LEVELS times: where the smaller steps follow the path without a sign change, the step had
 # jumped across a narrow gap to another branch (next to an imperfect bifurcation, e.g. a four-bar a hair from
@@ -408,8 +417,8 @@ class BranchMarcher:
                 if ended is not None:
                     kind, text, point = ended
                     return n_steps, kind, text, None, point
-            self._scan_rank_minima(chunk, branch_id, base)
-            self._scan_folds(chunk, branch_id, base)
+            self._scan_rank_minima(chunk, branch_id, base, chunk.h if paper else 0.0)
+            self._scan_folds(chunk, branch_id, base, first=first)
             first = False
             if self.progress:
                 self.progress(self.max_steps - self.budget, self.max_steps)
@@ -452,8 +461,14 @@ class BranchMarcher:
                 cycle_from = n_steps
                 if paper:  # the steps left evened out onto the target from the closing row
                     chunk.h = self._steps_onto_target(chunk, paper_steps - n_steps)
-            elif paper and chunk.code == StopReason.FAILED and self.budget > 0:
-                followed = self._follow_row(chunk, basis, branch_id, n_steps)
+            elif (
+                paper
+                and self.budget > 0
+                and (chunk.code == StopReason.FAILED or self._fold_start(chunk, n_steps))
+            ):
+                followed = self._follow_row(
+                    chunk, basis, branch_id, n_steps + step_offset, from_fold=chunk.code == StopReason.TURNING
+                )
                 if followed is None:  # a fold of the drive before the step's value: its turning point
                     return n_steps, StopReason.TURNING, StopReason.TURNING.text, None, None
                 if followed.count < 2:  # the path could not be followed to the row's value either
@@ -635,7 +650,7 @@ class BranchMarcher:
                 self._arrived(known, u_k - chunk.u[c - 2])
                 return (StopReason.KNOWN_POINT, f"reached bifurcation {known}", known), None
             self._passed(known, chunk)
-        if point.kind == "component":
+        if point.kind == "component" and not self._crosses(chunk, c - 1):
             dim = point.dimension
             text = f"entered a {dim}-dimensional component (mobility {dim}) at point {point.id}"
             return (StopReason.COMPONENT, text, point.id), None
@@ -652,6 +667,21 @@ class BranchMarcher:
         tangent *= 1.0 if tangent @ t_in >= 0.0 else -1.0
         chunk.t[c - 1] = tangent
         return None, tangent
+
+    def _crosses(self, chunk: Chunk, row: int) -> bool:
+        """Whether the path, landed on a point of a higher-dimensional component at the chunk's row ``row``,
+        crosses it rather than entering it: the row before it has the path's rank (mobility 1), so the step
+        landed on a single singular point of the path (equal drive steps landing on Sarrus's folded
+        configuration, where a two-dimensional component meets the path), which the branch passes through as
+        the adaptive trace does, along the incoming tangent projected on the null space there. A branch enters
+        a component where :attr:`Tolerances.component_points` rows in a row have mobility 2 or more
+        (:meth:`_component_entry`), and a path that lands on one again from a singular row ends there."""
+        if row < 1:
+            return False
+        ranks = chunk.rank
+        if ranks is None:
+            ranks = numerical_ranks(chunk.sigma[: chunk.count], self.cfg.tol, self.ws.kernels.compiled)
+        return bool(ranks[row - 1] >= self.cfg.r_path)
 
     def _onto_point(self, chunk: Chunk, row: int, point: Bifurcation) -> None:
         """Put the chunk's row ``row``, a step that landed on the singular point ``point``, onto the located point.
@@ -860,7 +890,20 @@ class BranchMarcher:
             f"{cycle_steps} steps and turns {name} by {per_cycle}), {self.budget} of {self.max_steps} steps left"
         )
 
-    def _follow_row(self, chunk: Chunk, basis: Array, branch_id: int, step: int) -> Chunk | None:
+    def _fold_start(self, chunk: Chunk, n_steps: int) -> bool:
+        """Paper mode: whether the chunk is the branch's first, stopped as a turning point before any step because
+        its start is a fold of the drive (the drive's tangent component below :data:`FOLD_START`), from which the
+        first equal step is followed along the path instead (:meth:`_follow_row`)."""
+        return (
+            n_steps == 0
+            and chunk.count == 1
+            and chunk.code == StopReason.TURNING
+            and abs(float(chunk.t[0, self.cfg.drive])) < FOLD_START * float(np.linalg.norm(chunk.t[0]))
+        )
+
+    def _follow_row(
+        self, chunk: Chunk, basis: Array, branch_id: int, step: int, from_fold: bool = False
+    ) -> Chunk | None:
         """Paper mode, the chunk's last equal drive step failed (in every number of parts): the row it asked for,
         reached by following the path adaptively (arclength steps, as an adaptive trace does) from the last row up
         to the row's drive value and landing on it exactly; ``None`` when a fold of the drive lies before that
@@ -879,6 +922,10 @@ class BranchMarcher:
         value asked for), or it ends otherwise, comes back round to the row it left, or has taken as many steps
         as the trace has left (a chunk of one row: the step failed). The probe's own rows are not kept: the rows
         of a paper trace are its equal drive steps.
+
+        ``from_fold``: the last row is the branch's start, at a fold of the drive (:meth:`_fold_start`): the probe
+        leaves along the start's tangent as oriented (the drive moves the same way either way), and the start is
+        not a fold the probe meets; ``None`` (a turning point) when the drive moves away from the row's value.
         """
         cfg, d, c = self.cfg, self.cfg.drive, chunk.count - 1
         failed = Chunk(
@@ -889,7 +936,7 @@ class BranchMarcher:
         if c < 0 or chunk.h == 0.0:
             return failed
         u, t = chunk.u[c].copy(), chunk.t[c].copy()
-        if t[d] * chunk.h < 0.0:
+        if t[d] * chunk.h < 0.0 and not from_fold:
             t = -t
         u_start, sign, asked = u.copy(), float(np.sign(chunk.h)), abs(chunk.h)
         value = float(u_start[d] + chunk.h)  # the row's drive value, as the march computes it
@@ -907,7 +954,13 @@ class BranchMarcher:
                 towards=value,
             )  # fmt: skip
             left -= probe.count - 1
-            td = probe.t[: probe.count, d]
+            td = probe.t[: probe.count, d].copy()
+            if from_fold:  # the start: a fold of the drive, its tangent component round-off
+                if probe.count >= 2 and sign * (probe.u[1, d] - u_start[d]) < 0.0:
+                    return (
+                        None  # the drive moves away from the row's value either way: the start turns it back
+                    )
+                td[0], from_fold = 0.0, False
             turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
             if len(turned) > 0:  # the drive turns back before the row's value (where the probe would land)
                 k = int(turned[0])
@@ -915,7 +968,7 @@ class BranchMarcher:
                     return failed  # beyond the row's value, which the probe passed without landing on it
                 probe.count = k + 2  # the fold's step only
                 folds = len(self.folds)
-                self._scan_folds(probe, branch_id, step)
+                self._scan_folds(probe, branch_id, step, at=step)
                 return None if len(self.folds) > folds else failed
             if float(np.max(sign * (probe.u[: probe.count, d] - u_start[d]))) > asked:
                 return failed  # the drive passed the row's value without landing on it
@@ -1044,15 +1097,26 @@ class BranchMarcher:
         dim = self.found[known].dimension
         return known, f"entered a {dim}-dimensional component (mobility {dim}) at point {known}"
 
-    def _scan_rank_minima(self, chunk: Chunk, branch_id: int, base: int) -> None:
-        """Rank drops where the test function keeps its sign: local minima of ``sigma_r / sigma_1``."""
+    def _scan_rank_minima(self, chunk: Chunk, branch_id: int, base: int, row_step: float = 0.0) -> None:
+        """Rank drops where the test function keeps its sign: local minima of ``sigma_r / sigma_1``.
+
+        A minimum is looked into where the ratio is below ``Tolerances.local_min`` at a row (the locator then
+        keeps it where the ratio falls to ``Tolerances.loose``). ``row_step``: paper mode's equal drive step; rows
+        further apart than ``max_step`` may straddle a rank drop at half a row or more from each (the ratio grows
+        about linearly with the distance from it: Sarrus's folded configuration between rows 16 deg apart reads
+        0.03 and 0.04, at link 30 and height 11 rows 4 deg apart read 0.043 and 0.041), so there every local
+        minimum is looked into, where the ratio dips by more than :data:`MINIMUM_DIP` of its higher neighbour
+        (not the round-off wobble of a flat ratio): a few locator calls per path, only for such coarse rows."""
         r_path, tol, count = self.cfg.r_path, self.cfg.tol, chunk.count
         if r_path < 1 or count < 3:
             return
         ratio = chunk.sigma[:count, r_path - 1] / chunk.sigma[:count, 0]
         tau = chunk.tau
         inner = ratio[1:-1]
-        minima = (inner <= ratio[:-2]) & (inner < ratio[2:]) & (inner < tol.local_min)
+        small = inner < tol.local_min
+        if abs(row_step) * float(self.weight[self.cfg.drive]) > self.cfg.max_step:
+            small |= inner < (1.0 - MINIMUM_DIP) * np.maximum(ratio[:-2], ratio[2:])
+        minima = (inner <= ratio[:-2]) & (inner < ratio[2:]) & small
         for k in (minima.nonzero()[0] + 1).tolist():
             if tau[k - 1] * tau[k] < 0.0 or tau[k] * tau[k + 1] < 0.0:
                 continue  # a sign change: located by the test function
@@ -1066,8 +1130,16 @@ class BranchMarcher:
                 self._add_point(bif, branch_id, chunk.t[k])
                 self._onto_point(chunk, k, bif)
 
-    def _scan_folds(self, chunk: Chunk, branch_id: int, base: int) -> None:
+    def _scan_folds(
+        self, chunk: Chunk, branch_id: int, base: int, at: int | None = None, first: bool = False
+    ) -> None:
         """Locate every fold of the drive in the chunk: where the drive turns back.
+
+        A fold between the chunk's rows ``k`` and ``k + 1`` is recorded at step ``base + k``, the branch's row
+        before it; ``at``: the step every fold found is recorded at instead, for a probe whose rows are not the
+        branch's (paper mode's :meth:`_follow_row`: the fold lies after the branch's last row, ``at``). ``first``:
+        the chunk's row 0 is the branch's start, which is not a fold the branch meets when it sits on one (its
+        drive component below :data:`FOLD_START`, of round-off's sign: a slider-crank started at a dead centre).
 
         A candidate is a step over which the tangent's drive component changes sign while moving by more than
         :data:`FOLD_MOVING` on at least one side; the located point is kept when the drive's value there is an
@@ -1077,6 +1149,8 @@ class BranchMarcher:
         d = self.cfg.drive
         tw = chunk.t[: chunk.count] * self.weight  # the tangents in the step's metric (scale-free)
         td = tw[:, d] / np.linalg.norm(tw, axis=1)
+        if first and abs(td[0]) < FOLD_START:
+            td[0] = 0.0
         turned = (td[:-1] * td[1:] < 0.0).nonzero()[0]
         if len(turned) == 0:
             return
@@ -1091,7 +1165,8 @@ class BranchMarcher:
             if beyond.min() < -noise or beyond.max() <= noise:
                 continue  # the drive does not turn back here
             angles = self.mech.angles_from_q(self.mech.q_from_u(u_f))
-            self.folds.append(Fold(branch_id, base + int(k), float(angles[joint]), angles))
+            step = base + int(k) if at is None else at
+            self.folds.append(Fold(branch_id, step, float(angles[joint]), angles))
 
     def _on_sign_change(self, chunk: Chunk, basis_prev: Array, branch_id: int, step: int) -> int | None:
         """Locate every zero of the test function over the chunk's last row; returns the id of the point located
@@ -1242,7 +1317,6 @@ class BranchMarcher:
     # ---- the queued branches
     def follow_queue(self) -> None:
         """Trace every queued branch (breadth first) while the step budget lasts."""
-        cfg = self.cfg
         while self.queue and self.budget > 0:
             if (
                 self.stop_requested()
@@ -1253,34 +1327,49 @@ class BranchMarcher:
                 self.retraced += 1
                 continue
             bid = len(self.branches)
-            h = cfg.max_step / 4.0
-            u1, _r, ok = correct_on_plane(self.ws, job.u + h * job.tangent, job.tangent, cfg.tol)
-            if not ok:
+            left = self.leave_point(bid, job.u, job.tangent, job.bifurcation)
+            if left is None:
                 end = self.end(StopReason.NOT_LEFT, StopReason.NOT_LEFT.text, job.u, None, job.bifurcation)
                 self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, 0, end))
                 continue
-            _, _, jac1 = self.ws.evaluate(u1)
-            U1, _, Vt1 = np.linalg.svd(jac1)
-            t1 = Vt1[-1] if Vt1[-1] @ job.tangent > 0 else -Vt1[-1]
-            # Record the bifurcation point itself as the branch's first point, then march on.
-            r_star, _, jst = self.ws.evaluate(job.u)
-            sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
-            self.rows.add_point(job.u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
-            s_off = float(np.linalg.norm(u1 - job.u))
-            start_len = len(self.rows.u)
-            basis = np.ascontiguousarray(U1[:, : cfg.r_path])
-            opened_at = (job.u, Home(sigma_star, float(r_star), 0.0))
-            nb, end = self.run_branch(
-                bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1, opened_at=opened_at
-            )
-            for i in range(start_len, len(self.rows.u)):
-                self.rows.s[i] = self.rows.s[i] + s_off
-                self.rows.step[i] = self.rows.step[i] + 1
-            if (
-                end.kind == StopReason.CLOSED
-            ):  # back round to where it left its point: a closed mode through it
-                block = self.rows.u[-1]
-                step = block[-1] - (block[-2] if len(block) > 1 else self.rows.u[-2][-1])
-                step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
-                self._arrived(job.bifurcation, step)
-            self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, nb + 1, end))
+            nb, end = left
+            self.branches.append(Branch.ended(bid, job.parent, job.bifurcation, job.direction, nb, end))
+
+    def start_at_point(self, point: Bifurcation, incoming: Array) -> None:
+        """Keep the start, a located singular point (a crossing of branches), as point 0; with branch switching,
+        its branch tangents other than ``incoming`` (the one branch 0 leaves along) are queued."""
+        self._add_point(point, 0, incoming)
+
+    def leave_point(self, bid: int, u: Array, tangent: Array, point: int) -> tuple[int, End] | None:
+        """March branch ``bid`` from the located point ``u`` (id ``point``) along the branch tangent ``tangent``
+        (adaptive steps, stopping at known points): the point is its first row, then one step of a quarter of
+        ``max_step`` corrected on the plane normal to the tangent, then the march. Returns (steps, end), or
+        ``None`` when that first step does not converge (the branch could not be left)."""
+        cfg = self.cfg
+        h = cfg.max_step / 4.0
+        u1, _r, ok = correct_on_plane(self.ws, u + h * tangent, tangent, cfg.tol)
+        if not ok:
+            return None
+        _, _, jac1 = self.ws.evaluate(u1)
+        U1, _, Vt1 = np.linalg.svd(jac1)
+        t1 = Vt1[-1] if Vt1[-1] @ tangent > 0 else -Vt1[-1]
+        # Record the point itself as the branch's first point, then march on.
+        r_star, _, jst = self.ws.evaluate(u)
+        sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
+        self.rows.add_point(u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
+        s_off = float(np.linalg.norm(u1 - u))
+        start_len = len(self.rows.u)
+        basis = np.ascontiguousarray(U1[:, : cfg.r_path])
+        opened_at = (u, Home(sigma_star, float(r_star), 0.0))
+        nb, end = self.run_branch(
+            bid, u1, t1, basis, paper=False, h0=h, stop_at_known=True, step_offset=1, opened_at=opened_at
+        )
+        for i in range(start_len, len(self.rows.u)):
+            self.rows.s[i] = self.rows.s[i] + s_off
+            self.rows.step[i] = self.rows.step[i] + 1
+        if end.kind == StopReason.CLOSED:  # back round to where it left its point: a closed mode through it
+            block = self.rows.u[-1]
+            step = block[-1] - (block[-2] if len(block) > 1 else self.rows.u[-2][-1])
+            step[self.cfg.periodic] = wrap(step[self.cfg.periodic])
+            self._arrived(point, step)
+        return nb + 1, end

@@ -22,11 +22,11 @@ from linkwork.errors import LinkworkError, RigidStartError, SpecError
 from linkwork.interrupts import stop_text
 from linkwork.kinematics import kernels
 from linkwork.kinematics.bifurcation import branch_tangents
-from linkwork.kinematics.classify import component_dimension
+from linkwork.kinematics.classify import classify_point, component_dimension
 from linkwork.kinematics.closure import hessian, reduce
 from linkwork.kinematics.dyads import ClosedFormRows, closed_form_rows
 from linkwork.kinematics.jit import Backend, select_backend
-from linkwork.kinematics.marcher import BranchMarcher, MarchSettings
+from linkwork.kinematics.marcher import FOLD_START, BranchMarcher, MarchSettings, leading_sign
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.own_frame import arguments_in_own_frame, own_frame, trace_from_own_frame, twin
 from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numerical_ranks
@@ -125,7 +125,12 @@ def trace(
     if target is not None:
         sign = 1.0 if target >= 0 else -1.0
     # A fresh array either way (the kept tangent is read-only and shared; the kernels get a writeable one).
-    t_start = -start.tangent if start.components[d_unknown] * sign < 0 else start.tangent.copy()
+    crossing = start.crossing
+    if crossing is None:
+        t_start = start.tangent * _start_direction(start.components, d_unknown, sign)
+    else:  # branches cross at the start: branch 0 leaves along the one that moves the drive most
+        pick = crossing[int(np.argmax(np.abs(crossing[:, d_unknown])))]
+        t_start = pick * _start_direction(tuple(pick.tolist()), d_unknown, sign)
     lo, hi = _limits_in_unknowns(mech, limits) if limits else (start.lo, start.hi)
     cos_turn = _COS_MAX_TURN if max_turn is _MAX_TURN else float(np.cos(max_turn))
     settings = record(
@@ -147,6 +152,10 @@ def trace(
         workspace=Workspace.of(mech, backend),
     )  # fmt: skip
     h_start = (target / steps) if (paper and target is not None and steps) else max_step / 4.0
+    if crossing is not None:
+        return _trace_from_crossing(
+            mech, d_joint, marcher, (t_start, basis0.copy()), branches, paper, until, started, h_start
+        )
     # Paper mode keeps the sign: equal drive steps towards a target below the start value are negative.
     n0, end0 = marcher.run_branch(
         0, np.zeros(m), t_start, basis0.copy(), paper=paper, h0=h_start, stop_at_known=False
@@ -173,6 +182,64 @@ def trace(
         marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
     marcher.follow_queue()
     return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+
+
+def _trace_from_crossing(
+    mech: Mechanism,
+    d_joint: int,
+    marcher: BranchMarcher,
+    leave: tuple[Array, Array],
+    branches: bool,
+    paper: bool,
+    until: tuple[str | int, float] | None,
+    started: float,
+    h_start: float,
+) -> Trace:
+    """A trace whose start is a crossing of one-parameter branches (a parallelogram four-bar laid flat, at its
+    change point): the start is located as point 0 (classified there: a bifurcation, its other branch tangents
+    queued with ``branches``); branch 0 leaves it along ``leave = (t_start, range basis)`` (in paper mode in equal drive steps, the
+    march keeping the tangent it starts with at a singular row; otherwise as a queued branch leaves its point),
+    with ``branches`` and no target branch 1 the other way (unless branch 0 came back round to the start), then
+    the queue."""
+    m, tol = mech.n_unknowns, marcher.cfg.tol
+    t_start, basis = leave
+    u0 = np.zeros(m)
+    point = classify_point(mech, marcher.ws, 0, 0, 0, u0, 0.0, marcher.cfg)
+    marcher.start_at_point(point, t_start)
+    if paper:
+        n0, end0 = marcher.run_branch(
+            0, u0, t_start.copy(), basis, paper=True, h0=h_start, stop_at_known=False
+        )
+    else:
+        left = marcher.leave_point(0, u0, t_start, point.id)
+        if left is None:
+            n0, end0 = 0, marcher.end(StopReason.NOT_LEFT, StopReason.NOT_LEFT.text, u0, None, point.id)
+        else:
+            n0, end0 = left
+    marcher.branches.append(Branch.ended(0, None, None, 1, n0, end0))
+    back = end0.kind == StopReason.CLOSED or end0.point == point.id  # round a closed path to the start
+    if branches and marcher.cfg.target is None and not back and not marcher.stop_requested():
+        left = marcher.leave_point(1, u0, -t_start, point.id)
+        if left is None:
+            n1, end1 = 0, marcher.end(StopReason.NOT_LEFT, StopReason.NOT_LEFT.text, u0, None, point.id)
+        else:
+            n1, end1 = left
+        marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
+    marcher.follow_queue()
+    return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+
+
+def _start_direction(components: tuple[float, ...], drive: int, sign: float) -> float:
+    """+1 or -1: the way to leave the start along its unit null vector ``components``, so that the drive moves
+    towards ``sign`` (its target's side).
+
+    At a fold of the drive (its component below :data:`~linkwork.kinematics.marcher.FOLD_START`: a slider-crank's
+    slider at a dead centre) the drive stays put to first order and moves the same way in both directions, so
+    neither is towards the target; the one taken is then the one along which the first unknown that moves
+    increases (:func:`~linkwork.kinematics.marcher.leading_sign`: the SVD's sign is round-off's)."""
+    if abs(components[drive]) < FOLD_START:
+        return float(leading_sign(np.array(components), drive, FOLD_START))
+    return -1.0 if components[drive] * sign < 0 else 1.0
 
 
 def _trace_in_own_frame(
@@ -238,7 +305,8 @@ class PathStart(NamedTuple):
     ``n_sigma``, the start's null vector ``tangent`` (``V^T[-1]``, not yet oriented; its ``components`` as Python
     floats, for the test that orients it), the range ``basis`` (the first ``r_path`` columns of ``U``,
     C-contiguous), which unknowns are ``periodic`` and the bounds ``lo, hi`` of a trace without limits (the arrays
-    of :func:`_periodic` and :func:`_limits_in_unknowns`), all read-only: one look-up a call instead of five."""
+    of :func:`_periodic` and :func:`_limits_in_unknowns`), all read-only: one look-up a call instead of five.
+    ``crossing``: at a start where one-parameter branches cross, their tangents (the path's rank is theirs)."""
 
     r_path: int
     n_sigma: int
@@ -248,6 +316,9 @@ class PathStart(NamedTuple):
     periodic: NDArray[np.bool_]
     lo: Array
     hi: Array
+    crossing: Array | None = (
+        None  # a start where branches cross: their tangents (rows), one of which is taken
+    )
 
 
 def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart:
@@ -260,8 +331,10 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
             raise LinkworkError(
                 f"{mech.name}: the start does not close (residual {r0:.3g}); assemble it first"
             )
-        r_path = _path_rank(mech, s0, mech.n_unknowns, tol, backend)
-        if (
+        r_path, crossing = _path_rank(mech, s0, mech.n_unknowns, tol, backend)
+        if crossing is not None:
+            crossing.flags.writeable = False
+        elif (
             tol.closure <= DEFAULT.closure
         ):  # (with play in the hinges a small obstruction is what play takes up)
             obstruction = _second_order_obstruction(mech, U0, Vt0, r_path)
@@ -276,7 +349,9 @@ def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart
         basis.flags.writeable = False
         lo, hi = _limits_in_unknowns(mech, None)
         tangent = Vt0[-1]  # read-only, as Vt0
-        return PathStart(r_path, len(s0), tangent, tuple(tangent.tolist()), basis, _periodic(mech), lo, hi)
+        return PathStart(
+            r_path, len(s0), tangent, tuple(tangent.tolist()), basis, _periodic(mech), lo, hi, crossing
+        )
 
     # Keyed by the tolerances' value; the default ones (a module constant) by identity, saving the hash of
     # their twenty-odd fields on almost every call.
@@ -399,10 +474,14 @@ def _joint(mech: Mechanism, joint: str | int) -> tuple[int, int, np.float64]:
     return mech.derived(("joint", joint), build) if isinstance(joint, str) else build()
 
 
-def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: Backend) -> int:
-    """Rank of the Jacobian at the start (its singular values ``sigma``, by the ``backend``'s kernels: once per
-    mechanism, backend and tolerances); refuses a rigid start or one of mobility above one (saying so when the
-    start is a singular point of one-parameter branches, where the rank drops but the linkage has mobility one)."""
+def _path_rank(
+    mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: Backend
+) -> tuple[int, Array | None]:
+    """The path's rank from the start (its singular values ``sigma``, by the ``backend``'s kernels: once per
+    mechanism, backend and tolerances) and, where the start is a crossing of one-parameter branches (rank one
+    below theirs, mobility 2 there, two or more real branch tangents), the branch tangents (rows, in the
+    unknowns; the path's rank is then one above the start's); refuses a rigid start or one of mobility above one
+    (saying so when the start is a singular point of one-parameter branches that cannot be traced from)."""
     r_path = mech.derived(("start rank", backend.compiled, tol), lambda: numerical_rank(sigma, tol))
     mobility = m - r_path
     if mobility == 0:
@@ -413,7 +492,10 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: 
             "--closure-tol)",
             order=1,
         )
-    lines = _start_lines(mech, backend, tol, m) if mobility > 1 else None
+    tangents = _start_lines(mech, backend, tol, m) if mobility > 1 else None
+    lines = None if tangents is None else len(tangents)
+    if lines is not None and lines >= 2 and mobility == 2:
+        return r_path + 1, tangents  # a crossing of one-parameter branches: traced from it, along one of them
     if lines == 0:
         raise RigidStartError(
             f"{mech.name}: the start is rigid, an isolated configuration (Jacobian rank {r_path} here, {m} "
@@ -433,7 +515,7 @@ def _path_rank(mech: Mechanism, sigma: Array, m: int, tol: Tolerances, backend: 
             f"{mech.name}: mobility {mobility} at the start (rank {r_path}, {m} unknowns); the tracer follows "
             "one-parameter paths: couple or fix joints (couple=..., fixed=... / --couple A=C=E)"
         )
-    return r_path
+    return r_path, None
 
 
 SHAKY = 1e-6
@@ -462,15 +544,16 @@ def _second_order_obstruction(mech: Mechanism, U0: Array, Vt0: Array, r_path: in
     return float(np.abs(np.einsum("el,eab,a,b->l", U0[:, r_path:], H, t, t)).max()) / scale
 
 
-def _start_lines(mech: Mechanism, backend: Backend, tol: Tolerances, m: int) -> int | None:
+def _start_lines(mech: Mechanism, backend: Backend, tol: Tolerances, m: int) -> Array | None:
     """At a start whose rank says mobility above one: ``None`` where the configuration space has dimension 2 or
-    more there (a mobility the tracer cannot follow), else how many one-parameter branches pass through it (its
-    real branch tangents: 0 for an isolated, rigid point; 2 or more where branches cross)."""
+    more there (a mobility the tracer cannot follow), else the one-parameter branches passing through it (its
+    real branch tangents, rows in the unknowns: none for an isolated, rigid point; 2 or more where branches
+    cross)."""
     ws = Workspace.of(mech, backend)
     u = np.zeros(m)
     if component_dimension(ws, u, tol) >= 2:
         return None
-    return len(branch_tangents(mech, ws, u, tol)[0])
+    return np.asarray(branch_tangents(mech, ws, u, tol)[0], dtype=float)
 
 
 def _limits_in_unknowns(
