@@ -316,9 +316,7 @@ class PathStart(NamedTuple):
     periodic: NDArray[np.bool_]
     lo: Array
     hi: Array
-    crossing: Array | None = (
-        None  # a start where branches cross: their tangents (rows), one of which is taken
-    )
+    crossing: Array | None = None  # at a crossing start: the branches' tangents (rows), one of which is taken
 
 
 def _path_start(mech: Mechanism, backend: Backend, tol: Tolerances) -> PathStart:
