@@ -29,6 +29,7 @@ NOISE = 1e-9
 """Increments of an unknown below this times its largest along the branch, or below :data:`STILL` (radians, or
 the linkage's own length), are round-off, not motion: their sign changes are not turning points."""
 STILL = 1e-10
+"""See :data:`NOISE`."""
 LONGEST = 0.5
 """The longest bracket located (two rows' distance in the step's metric, radians: 29 deg): between rows further
 apart (a few long equal steps) a trial point's hyperplane may meet the path more than once, and the rows' extreme
@@ -71,10 +72,8 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
         turns = moving[1:][sign[moving[1:]] * sign[moving[:-1]] < 0.0]
         for k in turns:
             before = int(moving[np.searchsorted(moving, k) - 1])  # the moving increment before it
-            a, b = (
-                before,
-                k + 1,
-            )  # rows of the bracket: the joint moved one way after a, the other way before b
+            # the bracket's rows: the joint moved one way after row a, the other way before row b
+            a, b = before, k + 1
             chord = u[b] - u[a]
             if float(np.linalg.norm(chord if weight is None else chord * weight)) > LONGEST:
                 continue
