@@ -63,19 +63,20 @@ def test_the_rockers_range_is_its_swing(theta: float, steps: int | None) -> None
     assert swing >= rows - 1e-12
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18b): an extreme between a closed path's last and first rows"
-)
-@pytest.mark.parametrize("after", [0.545, 0.055])
-def test_an_extreme_just_after_the_start_of_a_closed_path(after: float) -> None:
-    """Start the crank ``after`` deg past the rocker's extreme at 28.955 deg (theta 29.5 and 29.01): the
-    rocker's extreme lies between the closed path's last rows and its start, in the closing step. Got (adaptive, one turn): a swing 3.72e-3 deg (theta 29.5) short of the law of cosines; the rows' own
-    swing. Right: the swing to 1e-7 deg, as from any other start. Suspected cause:
-    kinematics/extremes.py joint_extremes compares consecutive increments only within the rows' order, never the
-    last increment with the first of a path that closes on its first row, so a turning point just after the start
-    has no sign change to bracket it."""
-    swing, _ = traced_swing(crank_at_rocker_extreme() + after, None)
+@pytest.mark.parametrize("steps", [None, 180, 720])
+@pytest.mark.parametrize("after", [-0.9, -0.545, -0.055, 0.055, 0.545, 1.0])
+def test_an_extreme_next_to_the_seam_of_a_closed_path(after: float, steps: int | None) -> None:
+    """Start the crank ``after`` deg from the rocker's extreme at 28.955 deg (negative: the extreme comes just
+    after the start, positive: in the step that closes the turn), adaptive or in 2- and 0.5-deg paper steps.
+    Got before the fix: swings short of the law of cosines by up to 3.7e-3 deg (adaptive, start 29.5) and 1.2e-2
+    deg (180 steps, start 29.955), the rows' swing. Right: the swing to 1e-7 deg, as from any other start
+    (measured after: 2.3e-11). Cause: kinematics/extremes.py joint_extremes compared consecutive increments only
+    in the rows' order, never the last step of a path back at its start with the first, so a turning point next
+    to the start had no sign change to bracket it. Fixed there: a branch that closes (or, in paper mode, ends a
+    whole turn from its start) is looked at across that seam too."""
+    swing, rows = traced_swing(crank_at_rocker_extreme() + after, steps)
     assert abs(swing - rocker_swing()) < 1e-7
+    assert swing >= rows - 1e-12
 
 
 @pytest.mark.xfail(

@@ -20,6 +20,7 @@ from linkwork.kinematics.classify import locate_fold
 from linkwork.kinematics.jit import select_backend
 from linkwork.kinematics.normalization import length_scale
 from linkwork.kinematics.rank import DEFAULT, Tolerances
+from linkwork.kinematics.stops import StopReason
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.workspace import Workspace
 
@@ -30,6 +31,9 @@ NOISE = 1e-9
 the linkage's own length), are round-off, not motion: their sign changes are not turning points."""
 STILL = 1e-10
 """See :data:`NOISE`."""
+SEAM = 1e-9
+"""How close (radians, or lengths over the linkage's length scale) a branch's last row must come to its first,
+modulo whole turns, to be taken as back at its start (:func:`_back_at_start`)."""
 LONGEST = 0.5
 """The longest bracket located (two rows' distance in the step's metric, radians: 29 deg): between rows further
 apart (a few long equal steps) a trial point's hyperplane may meet the path more than once, and the rows' extreme
@@ -44,20 +48,33 @@ def branch_rows(trace: Trace, branch: int) -> NDArray[np.int64]:
 
 def joint_extremes(trace: Trace, branch: int) -> Array:
     """``(K, n)`` joint values (radians, or lengths) at the located turning points of every free joint on
-    ``branch``, strictly between its first and last rows (the drive's folds too: ``Trace.folds`` has them)."""
+    ``branch``, strictly between its first and last rows (the drive's folds too: ``Trace.folds`` has them). On a
+    closed path the step across its closing row (last row, then the first step again) is looked at too; a point
+    found there carries only its own joint's values, the others ``nan`` (they may lie a turn beyond the rows)."""
     mech = trace.mechanism
     rows = branch_rows(trace, branch)
     n = mech.n_joints
     if len(rows) < 3 or mech.n_unknowns == 0:
         return np.zeros((0, n))
     u = mech.u_from_q(mech.q_from_angles(trace.angles[rows]))
-    du = np.diff(u, axis=0)
     backend = select_backend()
     ws: Workspace | None = None
     prismatic = np.array(
         [any(mech.joint_types[j] == "P" for j in members) for members in mech.group_members()], dtype=bool
     )
     weight = np.where(prismatic, 1.0 / length_scale(mech, kernels=backend), 1.0) if prismatic.any() else None
+    n_rows = len(u)
+    period = (
+        u[-1] - u[0]
+    )  # a closed path's net change over the loop (a full turn of a joint that turns round)
+    closed = any(
+        b.id == branch and b.end_kind == StopReason.CLOSED for b in trace.branches
+    ) or _back_at_start(period, prismatic, 1.0 if weight is None else 1.0 / float(weight[prismatic][0]))
+    if closed:
+        # a closed path goes on past its last row as from its first: a turning point in the closing step or the
+        # first step has its bracket across the seam
+        u = np.vstack([u, u[1] + period])
+    du = np.diff(u, axis=0)
     tol = _tolerances(trace)
     found = []
     for g in range(mech.n_unknowns):
@@ -70,7 +87,10 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
         moving = np.flatnonzero(sign != 0.0)
         # consecutive moving increments of opposite signs: the joint turned back between them
         turns = moving[1:][sign[moving[1:]] * sign[moving[:-1]] < 0.0]
+        seam = closed and abs(period[g]) > max(NOISE * big, STILL * scale)
         for k in turns:
+            if seam and k + 1 >= n_rows:
+                continue  # a joint that turns round: its values past the seam are a turn away
             before = int(moving[np.searchsorted(moving, k) - 1])  # the moving increment before it
             # the bracket's rows: the joint moved one way after row a, the other way before row b
             a, b = before, k + 1
@@ -86,7 +106,12 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
             inner = u[a : b + 1, g]
             beyond = (point[g] - inner.max()) if sign[before] > 0 else (inner.min() - point[g])
             if point is not u[a] and -1e-12 * big <= beyond <= float(np.abs(chord).sum()):
-                found.append(mech.angles_from_q(mech.q_from_u(point)))
+                angles = mech.angles_from_q(mech.q_from_u(point))
+                if b >= n_rows:
+                    # across the seam: only this joint's value is its own (it does not turn round); the others
+                    # may lie a turn beyond the branch's rows
+                    angles = np.where(np.isin(np.arange(n), mech.group_members()[g]), angles, np.nan)
+                found.append(angles)
     return np.array(found).reshape(-1, n)
 
 
@@ -99,9 +124,18 @@ def joint_ranges(trace: Trace, branch: int | None = None) -> dict[str, tuple[flo
     parts += [joint_extremes(trace, int(b)) for b in ids]
     values = np.concatenate(parts)
     return {
-        name: (float(values[:, j].min()), float(values[:, j].max()))
+        name: (float(np.nanmin(values[:, j])), float(np.nanmax(values[:, j])))
         for j, name in enumerate(trace.mechanism.joint_names)
     }
+
+
+def _back_at_start(period: Array, prismatic: NDArray[np.bool_], length: float) -> bool:
+    """Whether a branch whose unknowns changed by ``period`` from its first row to its last is back where it
+    started (a paper trace of one full turn ends on its target, not "closed"): every revolute unknown a whole
+    number of turns away, every prismatic one where it was (over the linkage's ``length``), to :data:`SEAM`."""
+    turns = period - 2.0 * np.pi * np.round(period / (2.0 * np.pi))
+    off = np.where(prismatic, period / length, turns)
+    return bool(np.all(np.abs(off) <= SEAM))
 
 
 def _tolerances(trace: Trace) -> Tolerances:
