@@ -31,10 +31,10 @@ def spherical_swing() -> float:
     return float(np.degrees(abs(ends[0] - ends[1])))
 
 
-def crank_at_extreme(case: Spherical4R, theta0: float) -> float:
-    """The crank reading (deg) nearest ``theta0`` at which arc A-C = a + b: arc B-D = ... found by the crank's
-    own geometry: arc(B, D) where A, B, C are on one great circle satisfies the triangle A-D-C; solved on a grid
-    and refined by bisection (numpy only)."""
+def crank_at_extreme(case: Spherical4R, theta0: float) -> list[float]:
+    """The crank readings (deg) within 180 deg of ``theta0`` at which crank and coupler lie on one great circle
+    (arc A-C = a + b), one per assembly: C placed b beyond B on the great circle through A and B must lie at arc c
+    from D. Roots on a grid, refined by bisection (numpy only)."""
     u_a, u_b, u_d = case.u["A"], case.u["B"], case.u["D"]
 
     # arc A-C = a + b: C on the great circle through A and B, b beyond B; its arc to D must be c
@@ -83,10 +83,11 @@ def swing_of(tmp_path: Path, theta0: float, steps: int | None, far: bool) -> tup
 def test_spherical_rockers_range_is_its_swing(
     tmp_path: Path, steps: int | None, far: bool, start: str
 ) -> None:
-    """Holds (after this branch's fix in kinematics/extremes.py for the start next to an extreme): the rocker's
-    range over one turn of the crank, adaptive or 2-deg paper steps, centred at the origin or moved 3.7e4 away and
-    turned, started at a generic crank angle or 0.3 deg past the crank angle of an extreme: the spherical law of
-    cosines' swing to 1e-7 deg, never narrower than the rows."""
+    """The rocker's range over one turn of the crank, adaptive or 2-deg paper steps, centred at the origin or moved
+    3.7e4 away and turned, started at a generic crank angle or 0.3 deg past either crank angle of an extreme:
+    the spherical law of cosines' swing (58.39179 deg) to 1e-7 deg, never narrower than the rows. The four cases
+    started past the traced assembly's extreme (``next-to-extreme-1``) failed before this branch's fix in
+    kinematics/extremes.py (the extreme in the step that closes the turn); all pass after."""
     theta0 = 35.0
     if start.startswith("next-to-extreme"):
         roots = crank_at_extreme(Spherical4R("s", G, A, B, C, theta0), theta0)
