@@ -34,6 +34,9 @@ STILL = 1e-10
 SEAM = 1e-9
 """How close (radians, or lengths over the linkage's length scale) a branch's last row must come to its first,
 modulo whole turns, to be taken as back at its start (:func:`_back_at_start`)."""
+SMOOTH = 0.9
+"""The least cosine between a back-at-start branch's tangents at its last and first rows for its seam to be looked
+across (:func:`joint_extremes`)."""
 LONGEST = 0.5
 """The longest bracket located (two rows' distance in the step's metric, radians: 29 deg): between rows further
 apart (a few long equal steps) a trial point's hyperplane may meet the path more than once, and the rows' extreme
@@ -64,16 +67,25 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
     )
     weight = np.where(prismatic, 1.0 / length_scale(mech, kernels=backend), 1.0) if prismatic.any() else None
     n_rows = len(u)
-    period = (
-        u[-1] - u[0]
-    )  # a closed path's net change over the loop (a full turn of a joint that turns round)
-    closed = any(
-        b.id == branch and b.end_kind == StopReason.CLOSED for b in trace.branches
-    ) or _back_at_start(period, prismatic, 1.0 if weight is None else 1.0 / float(weight[prismatic][0]))
-    if closed:
+    # a closed path's net change over the loop (a full turn of a joint that turns round)
+    period = u[-1] - u[0]
+    length = 1.0 if weight is None else 1.0 / float(weight[prismatic][0])
+    back = any(b.id == branch and b.end_kind == StopReason.CLOSED for b in trace.branches)
+    if back or _back_at_start(period, prismatic, length):
         # a closed path goes on past its last row as from its first: a turning point in the closing step or the
-        # first step has its bracket across the seam
-        u = np.vstack([u, u[1] + period])
+        # first step has its bracket across the seam, if the path passes the start smoothly (not at a crossing,
+        # where the branch may come back along another curve)
+        ws = Workspace.of(mech, backend)
+        t_end, t_start = _tangent(ws, u[-1], u[-1] - u[-2]), _tangent(ws, u[0], u[1] - u[0])
+        w = np.ones(len(period)) if weight is None else weight
+        if (
+            t_end is not None
+            and t_start is not None
+            and float((w * t_end) @ (w * t_start))
+            > SMOOTH * float(np.linalg.norm(w * t_end) * np.linalg.norm(w * t_start))
+        ):
+            u = np.vstack([u, u[1] + period])
+    closed = len(u) > n_rows
     du = np.diff(u, axis=0)
     tol = _tolerances(trace)
     found = []
