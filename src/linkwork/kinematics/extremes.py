@@ -13,6 +13,8 @@ was, so a range is never narrower than its rows'.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -76,7 +78,7 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
         # first step has its bracket across the seam, if the path passes the start smoothly (not at a crossing,
         # where the branch may come back along another curve)
         ws = Workspace.of(mech, backend)
-        t_end, t_start = _tangent(ws, u[-1], u[-1] - u[-2]), _tangent(ws, u[0], u[1] - u[0])
+        t_end, t_start = _tangent(ws, u[-1], u[-1] - u[-2], weight), _tangent(ws, u[0], u[1] - u[0], weight)
         w = np.ones(len(period)) if weight is None else weight
         if (
             t_end is not None
@@ -87,7 +89,7 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
             u = np.vstack([u, u[1] + period])
     closed = len(u) > n_rows
     du = np.diff(u, axis=0)
-    tol = _tolerances(trace)
+    tol = _tolerances(trace, length_scale(mech, kernels=backend))
     found = []
     for g in range(mech.n_unknowns):
         step = du[:, g]
@@ -110,7 +112,7 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
             if float(np.linalg.norm(chord if weight is None else chord * weight)) > LONGEST:
                 continue
             ws = ws if ws is not None else Workspace.of(mech, backend)
-            t_a, t_b = _tangent(ws, u[a], chord), _tangent(ws, u[b], chord)
+            t_a, t_b = _tangent(ws, u[a], chord, weight), _tangent(ws, u[b], chord, weight)
             if t_a is None or t_b is None or np.sign(t_a[g]) == np.sign(t_b[g]):
                 continue
             point = locate_fold(ws, u[a], t_a, u[b], t_b, g, tol, weight)
@@ -150,17 +152,30 @@ def _back_at_start(period: Array, prismatic: NDArray[np.bool_], length: float) -
     return bool(np.all(np.abs(off) <= SEAM))
 
 
-def _tolerances(trace: Trace) -> Tolerances:
-    """The tolerances of the trace's corrector: the defaults, with its closure tolerance (play) if it had one."""
+def _tolerances(trace: Trace, length: float) -> Tolerances:
+    """The tolerances of the trace's corrector: the defaults, with its closure tolerance (play) if it had one,
+    their round-off levels scaled to the linkage's own ``length`` as the tracer scales them (``tracer._at_scale``:
+    ``exact * L`` below unity, ``roundoff * L`` above), so that a point a large linkage's corrector closes to its
+    own round-off is accepted here too (a slider-crank of 1000 mm placed 1e5 mm from the origin: no turning point
+    of the slider was located)."""
     closure = trace.stats.closure_tol
-    return DEFAULT if closure <= DEFAULT.closure else DEFAULT.with_closure(closure)
+    tol = DEFAULT if closure <= DEFAULT.closure else DEFAULT.with_closure(closure)
+    if not (0.0 < length and np.isfinite(length)) or length == 1.0:
+        return tol
+    if length > 1.0:
+        return replace(tol, roundoff=tol.roundoff * length)
+    return replace(tol, exact=tol.exact * length)
 
 
-def _tangent(ws: Workspace, u: Array, along: Array) -> Array | None:
-    """The path's unit tangent at ``u`` oriented along ``along``; ``None`` where it is not one line."""
+def _tangent(ws: Workspace, u: Array, along: Array, weight: Array | None = None) -> Array | None:
+    """The path's unit tangent at ``u`` oriented along ``along`` in the step's metric (``weight``: 1 for an
+    angle, ``1 / L`` for a length; ``None``: all 1); ``None`` where it is not one line. In the plain metric a
+    slider in a small unit (a large length) outweighs every angle, and next to its turning point the chord's
+    slider component would orient both ends' tangents alike, hiding the turn."""
     _, _, jac = ws.evaluate(u)
     _, s, vt = np.linalg.svd(jac)
     if vt.shape[0] - np.count_nonzero(s > 1e-10 * max(float(s[0]), 1e-300)) != 1:
         return None
     t = vt[-1]
-    return t if float(t @ along) >= 0.0 else -t
+    w2 = 1.0 if weight is None else np.asarray(weight) ** 2
+    return t if float(t @ (w2 * along)) >= 0.0 else -t
