@@ -13,6 +13,8 @@ was, so a range is never narrower than its rows'.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -20,6 +22,7 @@ from linkwork.kinematics.classify import locate_fold
 from linkwork.kinematics.jit import select_backend
 from linkwork.kinematics.normalization import length_scale
 from linkwork.kinematics.rank import DEFAULT, Tolerances
+from linkwork.kinematics.stops import StopReason
 from linkwork.kinematics.trace_result import Trace
 from linkwork.kinematics.workspace import Workspace
 
@@ -30,6 +33,12 @@ NOISE = 1e-9
 the linkage's own length), are round-off, not motion: their sign changes are not turning points."""
 STILL = 1e-10
 """See :data:`NOISE`."""
+SEAM = 1e-9
+"""How close (radians, or lengths over the linkage's length scale) a branch's last row must come to its first,
+modulo whole turns, to be taken as back at its start (:func:`_back_at_start`)."""
+SMOOTH = 0.9
+"""The least cosine between a back-at-start branch's tangents at its last and first rows for its seam to be looked
+across (:func:`joint_extremes`)."""
 LONGEST = 0.5
 """The longest bracket located (two rows' distance in the step's metric, radians: 29 deg): between rows further
 apart (a few long equal steps) a trial point's hyperplane may meet the path more than once, and the rows' extreme
@@ -44,21 +53,43 @@ def branch_rows(trace: Trace, branch: int) -> NDArray[np.int64]:
 
 def joint_extremes(trace: Trace, branch: int) -> Array:
     """``(K, n)`` joint values (radians, or lengths) at the located turning points of every free joint on
-    ``branch``, strictly between its first and last rows (the drive's folds too: ``Trace.folds`` has them)."""
+    ``branch``, strictly between its first and last rows (the drive's folds too: ``Trace.folds`` has them). On a
+    closed path the step across its closing row (last row, then the first step again) is looked at too; a point
+    found there carries only its own joint's values, the others ``nan`` (they may lie a turn beyond the rows)."""
     mech = trace.mechanism
     rows = branch_rows(trace, branch)
     n = mech.n_joints
     if len(rows) < 3 or mech.n_unknowns == 0:
         return np.zeros((0, n))
     u = mech.u_from_q(mech.q_from_angles(trace.angles[rows]))
-    du = np.diff(u, axis=0)
     backend = select_backend()
     ws: Workspace | None = None
     prismatic = np.array(
         [any(mech.joint_types[j] == "P" for j in members) for members in mech.group_members()], dtype=bool
     )
     weight = np.where(prismatic, 1.0 / length_scale(mech, kernels=backend), 1.0) if prismatic.any() else None
-    tol = _tolerances(trace)
+    n_rows = len(u)
+    # a closed path's net change over the loop (a full turn of a joint that turns round)
+    period = u[-1] - u[0]
+    length = 1.0 if weight is None else 1.0 / float(weight[prismatic][0])
+    back = any(b.id == branch and b.end_kind == StopReason.CLOSED for b in trace.branches)
+    if back or _back_at_start(period, prismatic, length):
+        # a closed path goes on past its last row as from its first: a turning point in the closing step or the
+        # first step has its bracket across the seam, if the path passes the start smoothly (not at a crossing,
+        # where the branch may come back along another curve)
+        ws = Workspace.of(mech, backend)
+        t_end, t_start = _tangent(ws, u[-1], u[-1] - u[-2], weight), _tangent(ws, u[0], u[1] - u[0], weight)
+        w = np.ones(len(period)) if weight is None else weight
+        if (
+            t_end is not None
+            and t_start is not None
+            and float((w * t_end) @ (w * t_start))
+            > SMOOTH * float(np.linalg.norm(w * t_end) * np.linalg.norm(w * t_start))
+        ):
+            u = np.vstack([u, u[1] + period])
+    closed = len(u) > n_rows
+    du = np.diff(u, axis=0)
+    tol = _tolerances(trace, length_scale(mech, kernels=backend))
     found = []
     for g in range(mech.n_unknowns):
         step = du[:, g]
@@ -70,7 +101,10 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
         moving = np.flatnonzero(sign != 0.0)
         # consecutive moving increments of opposite signs: the joint turned back between them
         turns = moving[1:][sign[moving[1:]] * sign[moving[:-1]] < 0.0]
+        seam = closed and abs(period[g]) > max(NOISE * big, STILL * scale)
         for k in turns:
+            if seam and k + 1 >= n_rows:
+                continue  # a joint that turns round: its values past the seam are a turn away
             before = int(moving[np.searchsorted(moving, k) - 1])  # the moving increment before it
             # the bracket's rows: the joint moved one way after row a, the other way before row b
             a, b = before, k + 1
@@ -78,7 +112,7 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
             if float(np.linalg.norm(chord if weight is None else chord * weight)) > LONGEST:
                 continue
             ws = ws if ws is not None else Workspace.of(mech, backend)
-            t_a, t_b = _tangent(ws, u[a], chord), _tangent(ws, u[b], chord)
+            t_a, t_b = _tangent(ws, u[a], chord, weight), _tangent(ws, u[b], chord, weight)
             if t_a is None or t_b is None or np.sign(t_a[g]) == np.sign(t_b[g]):
                 continue
             point = locate_fold(ws, u[a], t_a, u[b], t_b, g, tol, weight)
@@ -86,7 +120,12 @@ def joint_extremes(trace: Trace, branch: int) -> Array:
             inner = u[a : b + 1, g]
             beyond = (point[g] - inner.max()) if sign[before] > 0 else (inner.min() - point[g])
             if point is not u[a] and -1e-12 * big <= beyond <= float(np.abs(chord).sum()):
-                found.append(mech.angles_from_q(mech.q_from_u(point)))
+                angles = mech.angles_from_q(mech.q_from_u(point))
+                if b >= n_rows:
+                    # across the seam: only this joint's value is its own (it does not turn round); the others
+                    # may lie a turn beyond the branch's rows
+                    angles = np.where(np.isin(np.arange(n), mech.group_members()[g]), angles, np.nan)
+                found.append(angles)
     return np.array(found).reshape(-1, n)
 
 
@@ -99,22 +138,44 @@ def joint_ranges(trace: Trace, branch: int | None = None) -> dict[str, tuple[flo
     parts += [joint_extremes(trace, int(b)) for b in ids]
     values = np.concatenate(parts)
     return {
-        name: (float(values[:, j].min()), float(values[:, j].max()))
+        name: (float(np.nanmin(values[:, j])), float(np.nanmax(values[:, j])))
         for j, name in enumerate(trace.mechanism.joint_names)
     }
 
 
-def _tolerances(trace: Trace) -> Tolerances:
-    """The tolerances of the trace's corrector: the defaults, with its closure tolerance (play) if it had one."""
+def _back_at_start(period: Array, prismatic: NDArray[np.bool_], length: float) -> bool:
+    """Whether a branch whose unknowns changed by ``period`` from its first row to its last is back where it
+    started (a paper trace of one full turn ends on its target, not "closed"): every revolute unknown a whole
+    number of turns away, every prismatic one where it was (over the linkage's ``length``), to :data:`SEAM`."""
+    turns = period - 2.0 * np.pi * np.round(period / (2.0 * np.pi))
+    off = np.where(prismatic, period / length, turns)
+    return bool(np.all(np.abs(off) <= SEAM))
+
+
+def _tolerances(trace: Trace, length: float) -> Tolerances:
+    """The tolerances of the trace's corrector: the defaults, with its closure tolerance (play) if it had one,
+    their round-off levels scaled to the linkage's own ``length`` as the tracer scales them (``tracer._at_scale``:
+    ``exact * L`` below unity, ``roundoff * L`` above), so that a point a large linkage's corrector closes to its
+    own round-off is accepted here too (a slider-crank of 1000 mm placed 1e5 mm from the origin: no turning point
+    of the slider was located)."""
     closure = trace.stats.closure_tol
-    return DEFAULT if closure <= DEFAULT.closure else DEFAULT.with_closure(closure)
+    tol = DEFAULT if closure <= DEFAULT.closure else DEFAULT.with_closure(closure)
+    if not (0.0 < length and np.isfinite(length)) or length == 1.0:
+        return tol
+    if length > 1.0:
+        return replace(tol, roundoff=tol.roundoff * length)
+    return replace(tol, exact=tol.exact * length)
 
 
-def _tangent(ws: Workspace, u: Array, along: Array) -> Array | None:
-    """The path's unit tangent at ``u`` oriented along ``along``; ``None`` where it is not one line."""
+def _tangent(ws: Workspace, u: Array, along: Array, weight: Array | None = None) -> Array | None:
+    """The path's unit tangent at ``u`` oriented along ``along`` in the step's metric (``weight``: 1 for an
+    angle, ``1 / L`` for a length; ``None``: all 1); ``None`` where it is not one line. In the plain metric a
+    slider in a small unit (a large length) outweighs every angle, and next to its turning point the chord's
+    slider component would orient both ends' tangents alike, hiding the turn."""
     _, _, jac = ws.evaluate(u)
     _, s, vt = np.linalg.svd(jac)
     if vt.shape[0] - np.count_nonzero(s > 1e-10 * max(float(s[0]), 1e-300)) != 1:
         return None
     t = vt[-1]
-    return t if float(t @ along) >= 0.0 else -t
+    w2 = 1.0 if weight is None else np.asarray(weight) ** 2
+    return t if float(t @ (w2 * along)) >= 0.0 else -t
