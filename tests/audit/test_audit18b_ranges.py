@@ -79,17 +79,12 @@ def test_an_extreme_next_to_the_seam_of_a_closed_path(after: float, steps: int |
     assert swing >= rows - 1e-12
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18b): paper rows longer than 29 deg keep the rows' extreme"
-)
-@pytest.mark.parametrize("steps", [36, 12])
+@pytest.mark.parametrize("steps", [36, 12, 6, 4])
 def test_the_rockers_range_in_long_paper_steps(steps: int) -> None:
-    """Paper mode, one turn from 60 deg in 36 or 12 equal steps (10 or 30 deg). Got: swings 0.0136 and 0.190 deg
-    short of the law of cosines (the rows' swing: 0.0252 and 0.190). Right: the swing to 1e-7 deg ("every joint's
-    range is its swing", CHANGELOG fifteenth round). Cause: kinematics/extremes.py joint_extremes skips every
-    bracket whose chord in the unknowns exceeds ``LONGEST`` = 0.5 rad (a 10-deg crank step moves the coupler
-    joints too: chord above 0.5), keeping the rows' extreme; the point could be located on a bracket cut from
-    the path between the rows (followed adaptively), or the range flagged as the rows'."""
+    """Paper mode, one turn from 60 deg in 36, 12, 6 or 4 equal steps (10 to 90 deg): the swing to 1e-7 deg of
+    the law of cosines. Was (with 36 and 12 steps): 0.0136 and 0.190 deg short (the rows' swing: 0.0252 and
+    0.190), since kinematics/extremes.py skipped every bracket whose chord exceeded 0.5 rad; now a bracket up to
+    a turn long is located, and a point kept only beyond its rows by less than the bracket's length."""
     swing, _ = traced_swing(60.0, steps)
     assert abs(swing - rocker_swing()) < 1e-7
 

@@ -39,10 +39,12 @@ modulo whole turns, to be taken as back at its start (:func:`_back_at_start`).""
 SMOOTH = 0.9
 """The least cosine between a back-at-start branch's tangents at its last and first rows for its seam to be looked
 across (:func:`joint_extremes`)."""
-LONGEST = 0.5
-"""The longest bracket located (two rows' distance in the step's metric, radians: 29 deg): between rows further
-apart (a few long equal steps) a trial point's hyperplane may meet the path more than once, and the rows' extreme
-is kept."""
+LONGEST = 2.0 * np.pi
+"""The longest bracket located: two rows a turn apart in the step's metric (radians). Between rows far apart (a few
+long equal steps) a trial point's hyperplane may meet the path more than once; a point found is kept only if it
+lies beyond its bracket's rows by less than the bracket's length, so a range is never narrower than the rows'
+(a crank-rocker's rocker in 4 to 36 equal steps of a turn: its swing to 4e-11 deg; in 2 or 3 steps, rows 180 and
+120 deg apart, the swing is not always found and the rows' extreme is kept)."""
 
 
 def branch_rows(trace: Trace, branch: int) -> NDArray[np.int64]:
