@@ -110,19 +110,6 @@ def on_special_branch(case: FourBar, kind: str, start: float, row: np.ndarray) -
     return abs((float(angle) + 180.0) % 360.0 - 180.0) < 1e-6
 
 
-def special_four_bar(kind: str, ground: float, ratio: float, start: float, side: int) -> tuple[FourBar, bool]:
-    """A parallelogram (ground, ratio x ground, ground, ratio x ground) or a deltoid (ground, ratio x ground
-    twice, ground) from crank angle ``start`` on assembly ``side``, and whether it starts on its special branch
-    (the parallelogram branch, or the deltoid's folded one with C on A)."""
-    g, a = ground, ratio * ground
-    if kind == "parallelogram":
-        case = FourBar(kind, g, a, g, a, start, side=side)
-        pts = case.pts
-        return case, bool(np.linalg.norm((pts["C"] - pts["B"]) - (pts["D"] - pts["A"])) < 1e-9)
-    case = FourBar(kind, g, a, a, g, start, side=side)
-    return case, bool(np.linalg.norm(case.pts["C"] - case.pts["A"]) < 1e-9)
-
-
 def four_pivots_in_line(case: FourBar, reading: float) -> float:
     """The distance (deg) from a crank reading to the nearest reading with the crank along the ground line, where
     a four-bar's singular configurations are (its four pivots in line)."""
@@ -151,7 +138,14 @@ def test_one_paper_row_over_both_crossings_reports_both(
     parallelogram branch only; a deltoid's rocker stays put (D constant, the coupler folded back onto the crank, C
     on A) on its folded branch only. (A part of the row a hair from a crossing had gone on along the other branch:
     the parallelogram 2 x 1 from 15 to 472.69 deg, a part 0.0007 deg short of 360 deg.)"""
-    case, special = special_four_bar(kind, ground, ratio, start, side)
+    g, a = ground, ratio * ground
+    if kind == "parallelogram":
+        case = FourBar(kind, g, a, g, a, start, side=side)
+        pts = case.pts
+        special = bool(np.linalg.norm((pts["C"] - pts["B"]) - (pts["D"] - pts["A"])) < 1e-9)
+    else:
+        case = FourBar(kind, g, a, a, g, start, side=side)
+        special = bool(np.linalg.norm(case.pts["C"] - case.pts["A"]) < 1e-9)
     spec = tmp_path_factory.mktemp("pg") / "pg.toml"  # type: ignore[attr-defined]
     spec.write_text(case.mech.toml())
     trace = lw.trace(lw.load(str(spec)), until=("A", end * RAD), steps=1)
@@ -375,7 +369,14 @@ def test_a_paper_row_a_hair_from_a_crossing_keeps_the_starts_branch(
     rows more: the last row is on the closed form, on the branch the start is on (:func:`on_special_branch`,
     the four-bar's closed form); a row on the crossing is a bifurcation point of the closed form, reported, and
     the row is that point."""
-    case, special = special_four_bar(kind, ground, ratio, start, side)
+    g, a = ground, ratio * ground
+    if kind == "parallelogram":
+        case = FourBar(kind, g, a, g, a, start, side=side)
+        pts = case.pts
+        special = bool(np.linalg.norm((pts["C"] - pts["B"]) - (pts["D"] - pts["A"])) < 1e-9)
+    else:
+        case = FourBar(kind, g, a, a, g, start, side=side)
+        special = bool(np.linalg.norm(case.pts["C"] - case.pts["A"]) < 1e-9)
     short = sign * 10.0**exponent
     step = (crossing - short - start) / before
     end = start + (before + after) * step
