@@ -330,6 +330,32 @@ def test_a_paper_row_a_hair_short_of_a_crossing_stays_on_its_branch(
     assert not on_special_branch(case, "parallelogram", 15.0, last)  # still the antiparallelogram
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="open (session 18): one long paper row 1e-6 deg short of a crossing, then one more row",
+)
+def test_one_long_row_a_hair_short_of_a_crossing_then_one_more_stays_on_its_branch(tmp_path: Path) -> None:
+    """Found by the property below when its examples changed (hypothesis's derandomized seed follows the test's
+    source): the parallelogram 2 x 1.59375 on its antiparallelogram branch (side 1) from 15 deg, one equal row of
+    345 deg landing 1e-6 deg short of the crossing at 360 deg, then one more: the last row (705 deg) is on the
+    parallelogram branch. With the row 1e-4 deg short, or in more rows, the closing parts keep it on its branch.
+    Right answer: the start's branch to the end."""
+    case = FourBar("parallelogram", 2.0, 2.0 * 0.796875, 2.0, 2.0 * 0.796875, 15.0, side=1)
+    pts = case.pts
+    assert np.linalg.norm((pts["C"] - pts["B"]) - (pts["D"] - pts["A"])) > 1e-3  # the antiparallelogram
+    spec = tmp_path / "pg.toml"
+    spec.write_text(case.mech.toml())
+    step = 360.0 - 1e-6 - 15.0
+    trace = lw.trace(lw.load(str(spec)), until=("A", (15.0 + 2 * step) * RAD), steps=2)
+    assert trace.stats.unmet is None
+    last = np.degrees(np.asarray(trace.angles))[-1]
+    assert (
+        nearest(case.solve("A", float(last[0])), dict(zip("ABCD", last, strict=True)), list("ABCD"), set())[0]
+        < 1e-9
+    )
+    assert not on_special_branch(case, "parallelogram", 15.0, last)  # still the antiparallelogram
+
+
 @settings(deadline=None, max_examples=12, derandomize=True)
 @given(
     kind=st.sampled_from(["parallelogram", "deltoid"]),

@@ -13,8 +13,6 @@ was, so a range is never narrower than its rows'.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 from numpy.typing import NDArray
 
@@ -156,17 +154,13 @@ def _back_at_start(period: Array, prismatic: NDArray[np.bool_], length: float) -
 
 def _tolerances(trace: Trace, length: float) -> Tolerances:
     """The tolerances of the trace's corrector: the defaults, with its closure tolerance (play) if it had one,
-    their round-off levels scaled to the linkage's own ``length`` as the tracer scales them (``tracer._at_scale``:
-    ``exact * L`` below unity, ``roundoff * L`` above), so that a point a large linkage's corrector closes to its
+    their round-off levels scaled to the linkage's own ``length`` as the tracer scales them
+    (:meth:`~linkwork.kinematics.rank.Tolerances.at_length`), so that a point a large linkage's corrector closes to its
     own round-off is accepted here too (a slider-crank of 1000 mm placed 1e5 mm from the origin: no turning point
     of the slider was located)."""
     closure = trace.stats.closure_tol
     tol = DEFAULT if closure <= DEFAULT.closure else DEFAULT.with_closure(closure)
-    if not (0.0 < length and np.isfinite(length)) or length == 1.0:
-        return tol
-    if length > 1.0:
-        return replace(tol, roundoff=tol.roundoff * length)
-    return replace(tol, exact=tol.exact * length)
+    return tol.at_length(length)
 
 
 def _tangent(ws: Workspace, u: Array, along: Array, weight: Array | None = None) -> Array | None:

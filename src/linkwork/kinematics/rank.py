@@ -87,6 +87,17 @@ class Tolerances:
     stall_length: float = 1e-3
     component_points: int = 3
 
+    def at_length(self, length: float) -> Tolerances:
+        """These tolerances with the corrector's round-off levels scaled to a linkage's own length ``L``: ``exact
+        * L`` when ``L < 1``, ``roundoff * L`` when ``L > 1`` (unchanged for ``L = 1`` or one that is not a
+        positive finite number). Why: ``linkwork.kinematics.tracer`` (the trace's tolerances at scale); the
+        located turning points of ``linkwork.kinematics.extremes`` use the same."""
+        if not (0.0 < length and np.isfinite(length)) or length == 1.0:
+            return self
+        if length > 1.0:  # the round-off floor grows with the size: a stall there is accepted as closed
+            return replace(self, roundoff=self.roundoff * length)
+        return replace(self, exact=self.exact * length)
+
     def with_closure(self, closure: float) -> Tolerances:
         """These tolerances accepting a least-squares closure within ``closure`` (``--closure-tol``).
 

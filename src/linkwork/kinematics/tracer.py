@@ -379,17 +379,11 @@ def _at_scale(mech: Mechanism, tol: Tolerances, backend: Backend) -> Tolerances:
     round-off; the rotation part (radians) is then held tighter than it needs, which costs at most an iteration.
     For a linkage larger than unity the residual's round-off floor grows as ``L``: a residual that stalls below
     ``roundoff * exact * L`` (not ``roundoff * exact``) is accepted, or a Bennett linkage of size 1e6 could not be
-    traced (its floor is about 1e-10). ``closure`` (play in the hinges, a length the user gives) is not scaled."""
-
-    def build() -> Tolerances:
-        length = _length(mech, backend)
-        if not (0.0 < length and np.isfinite(length)) or length == 1.0:
-            return tol
-        if length > 1.0:  # the round-off floor grows with the size: a stall there is accepted as closed
-            return replace(tol, roundoff=tol.roundoff * length)
-        return replace(tol, exact=tol.exact * length)
-
-    return mech.derived(("tolerances at scale", tol), build)  # once per mechanism and tolerances
+    traced (its floor is about 1e-10). ``closure`` (play in the hinges, a length the user gives) is not scaled
+    (:meth:`~linkwork.kinematics.rank.Tolerances.at_length`, once per mechanism and tolerances)."""
+    return mech.derived(
+        ("tolerances at scale", tol), lambda: tol.at_length(_length(mech, backend))
+    )  # once per mechanism and tolerances
 
 
 def _step_weights(mech: Mechanism, backend: Backend) -> Array:
