@@ -36,7 +36,7 @@ def write_mechanism_dxf(
     for layer, colour in (("links", 5), ("ground", 8), ("pivots", 1), ("sliders", 3)):
         document.layers.add(layer, color=colour)
     space = document.modelspace()
-    ground = "ground" if "ground" in mech.bodies else mech.bodies[0]
+    ground = mech.ground
     for body in mech.bodies:
         members = [j for j, pair in enumerate(mech.joint_bodies) if body in pair]
         corners = [tuple(map(float, xy[j])) for j in members]

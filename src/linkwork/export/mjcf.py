@@ -40,7 +40,9 @@ def cut_body(before: str, joint: str) -> str:
 
 def spanning_tree(mech: Mechanism) -> tuple[str, dict[str, list[tuple[int, str]]], list[int]]:
     """Root body, children of every body as ``(joint, child)`` and the loop-closing joints (breadth first)."""
-    root = "ground" if "ground" in mech.bodies else mech.bodies[0]
+    root = mech.ground
+    if root is None:
+        raise ValueError(f"{mech.name}: no bodies to export (a loop given by its twists alone)")
     children: dict[str, list[tuple[int, str]]] = {b: [] for b in mech.bodies}
     seen = {root}
     used: set[int] = set()

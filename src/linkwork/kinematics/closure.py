@@ -120,10 +120,11 @@ def body_poses(
 
 
 def body_tree(mech: Mechanism) -> tuple[str, list[tuple[str, int, str, int]]]:
-    """The spanning tree along which body poses are chained: its root (the ground, when there is one, else the
-    first body) and its edges ``(body, joint, other, sign)`` in breadth-first order, ``other`` reached from
+    """The spanning tree along which body poses are chained: its root (:attr:`Mechanism.ground`) and its edges ``(body, joint, other, sign)`` in breadth-first order, ``other`` reached from
     ``body`` through ``joint`` (``sign`` -1 when the joint is walked from its second body to its first)."""
-    root = "ground" if "ground" in mech.bodies else mech.bodies[0]
+    root = mech.ground
+    if root is None:
+        raise ValueError(f"{mech.name}: no bodies, so no body tree (a loop given by its twists alone)")
     return root, spanning_tree(mech.joint_bodies, root)
 
 

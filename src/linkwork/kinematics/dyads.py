@@ -122,7 +122,7 @@ def dyad_plan(mech: Mechanism, drive: int) -> DyadPlan | None:
     index = {name: i for i, name in enumerate(names)}
     ends = [(index[a], index[b]) for a, b in mech.joint_bodies]
     fixed, driven = ends[drive]
-    if names[driven] == "ground":
+    if names[driven] == mech.ground:
         fixed, driven = driven, fixed
     placed, used = {fixed, driven}, {drive}
     dyads: list[tuple[int, ...]] = []

@@ -74,6 +74,9 @@ class Mechanism:
         carries no position along itself; manufacturing errors tilt a hinge about this point
         (:mod:`linkwork.studies.imperfections`). A point that no longer lies on its line (the twists replaced,
         moved or re-referenced) is not used.
+    ground_name
+        The body held fixed when it is not called ``ground`` (:meth:`from_joints`'s ``ground``), else ``None``:
+        read it as :attr:`ground`.
 
     A mechanism is a value: its fields cannot be reassigned and its arrays are read-only copies (the arrays a
     caller passed in are not kept), and a changed mechanism is a new one (:func:`dataclasses.replace`,
@@ -95,6 +98,7 @@ class Mechanism:
     groups: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     meta: Mapping[str, Any] = field(default_factory=dict)
     hinge_points: Array = field(default_factory=lambda: np.zeros((0, 3)))
+    ground_name: str | None = None
 
     def __post_init__(self) -> None:
         """Check the shapes and keep private, read-only copies of the arrays (a frozen value in full)."""
@@ -122,6 +126,17 @@ class Mechanism:
         object.__setattr__(self, "hinge_points", _frozen(points, float))
         if len(set(self.joint_names)) != n:
             raise SpecError(f"joint names must be unique, got {list(self.joint_names)}")
+        if self.ground_name is not None:
+            object.__setattr__(self, "ground_name", canonical(str(self.ground_name)))
+            if self.ground_name not in self.bodies:
+                raise SpecError(
+                    f"ground {self.ground_name!r} is not a body of any joint; bodies: {list(self.bodies)}"
+                )
+            if self.ground_name != "ground" and "ground" in self.bodies:
+                raise SpecError(
+                    f"ground {self.ground_name!r}: another body is called 'ground'; expected the body called "
+                    "'ground' to be the ground, or no body of that name"
+                )
 
     def __getstate__(self) -> dict[str, Any]:
         """The fields only (for pickle and :mod:`copy`): the derived values are rebuilt where it is used."""
@@ -173,6 +188,23 @@ class Mechanism:
     def n_unknowns(self) -> int:
         """Number of independent unknowns ``m`` after couplings and fixed joints."""
         return int(self.groups.max()) + 1 if np.any(self.groups >= 0) else 0
+
+    @property
+    def ground(self) -> str | None:
+        """The body held fixed, the frame every pose, drawing and export is in: the body named by
+        :meth:`from_joints`'s ``ground``, else the body called ``ground``, else the first body (``None`` without
+        bodies: a loop given by its twists alone)."""
+        if self.ground_name is not None:
+            return self.ground_name
+        if "ground" in self.bodies:
+            return "ground"
+        return self.bodies[0] if self.bodies else None
+
+    @property
+    def grounded(self) -> bool:
+        """Whether a body is named as the ground (:attr:`ground_name`, or a body called ``ground``), rather than
+        the first body taken for it."""
+        return self.ground_name is not None or "ground" in self.bodies
 
     @property
     def rows(self) -> tuple[int, ...]:
@@ -366,7 +398,9 @@ class Mechanism:
         Each joint is a mapping with ``name``, ``type`` (``"R"`` or ``"P"``), ``bodies`` (before, after),
         ``point`` and ``direction`` (3-vectors; 2-vectors are lifted to z = 0 for planar mechanisms) and an
         optional ``value`` (the joint's reading at the start). The loops are a cycle basis of the body graph
-        (fundamental cycles of a breadth-first spanning tree rooted at ``ground``).
+        (fundamental cycles of a breadth-first spanning tree rooted at ``ground``), and ``ground`` the body held
+        fixed (:attr:`ground`): the frame of every pose, drawing and export. A ``ground`` other than ``"ground"``
+        must be one of the bodies, and then no other body may be called ``ground``.
         """
         names, types, twists, offsets, pairs, points = [], [], [], [], [], []
         for j in joints:
@@ -397,6 +431,7 @@ class Mechanism:
             planar=planar,
             meta=dict(meta or {}),
             hinge_points=np.array(points).reshape(len(names), 3),
+            ground_name=None if ground == "ground" else ground,
         )
 
     @classmethod

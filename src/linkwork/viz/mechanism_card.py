@@ -150,7 +150,7 @@ def drawing(mech: Mechanism, points: NDArray[np.float64] | None = None) -> str:
         ks = [j for j, pair in enumerate(mech.joint_bodies) if body in pair]
         if len(ks) < 2:
             continue
-        ground = body == "ground" or (b == 0 and "ground" not in mech.bodies)
+        ground = body == mech.ground
         style = "stroke='#888' stroke-dasharray='4 3'" if ground else f"stroke='{colour(b)}'"
         closed = len(ks) > 2
         tag = "polygon" if closed else "polyline"

@@ -121,8 +121,8 @@ def configuration_meshes(mech: Mechanism, angles: ArrayLike, steady: bool = True
 def steady_transforms(mech: Mechanism, angles: ArrayLike) -> Array:
     """Rigid motions ``(N, 4, 4)`` of the whole mechanism, one per configuration, for a steady drawing.
 
-    A mechanism whose first body is ``ground`` (a four-bar, a slider-crank, a mechanized chain) is drawn on its
-    ground: one and the same move for every row. Otherwise body poses hold the first body still, so a hoop seen
+    A grounded mechanism (:attr:`Mechanism.grounded`: a four-bar, a slider-crank, a mechanized chain) is drawn on
+    its ground: one and the same move for every row. Otherwise body poses hold the first body still, so a hoop seen
     that way tumbles as it deploys: each configuration is instead fitted (least squares, Kabsch) onto the previous
     one as a whole and centred at the origin, which keeps a symmetric motion's symmetry axis still. Chained fits
     drift: a path that comes back to its first configuration would end in another pose, so the drift is spread
@@ -132,7 +132,7 @@ def steady_transforms(mech: Mechanism, angles: ArrayLike) -> Array:
     """
     angles = np.atleast_2d(np.asarray(angles, dtype=float))
     clouds = mesh_clouds(mech, angles)
-    if mech.bodies and mech.bodies[0] == "ground":
+    if mech.grounded:
         centre = np.eye(4)
         centre[:3, 3] = -clouds.reshape(-1, 3).mean(axis=0)
         moves = np.repeat(centre[None], len(clouds), axis=0)

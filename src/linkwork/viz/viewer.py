@@ -183,11 +183,11 @@ def _steady_rows(trace: Trace, per_branch: list[NDArray[np.int64]]) -> NDArray[n
     steady (rotation rows, then translation): each branch fitted point by point
     (:func:`linkwork.viz.snapshots.follow`), a branch leaving a bifurcation point starting from the pose its
     parent has there, and everything levelled by the flattest configuration of the first branch. A grounded
-    mechanism (a body called ``ground``) is held by its ground: no motion at all."""
+    mechanism (:attr:`Mechanism.grounded`) is held by its ground: no motion at all."""
     from linkwork.viz.snapshots import close_drift, follow, leveling, mesh_clouds
 
     mech = trace.mechanism
-    if "ground" in mech.bodies:
+    if mech.grounded:
         count = sum(len(idx) for idx in per_branch)
         return np.tile(np.array([1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0, 0, 0, 0]), (count, 1))
     revolute = np.array([t == "R" for t in mech.joint_types])
@@ -302,7 +302,7 @@ def trace_viewer_data(
             "fixed": _bounds(parts, poses, np.zeros_like(centres)),
             "centred": _bounds(parts, _compose(steady, poses), np.zeros_like(centres)),
         },
-        "fixed_body": mech.bodies[0] if "ground" not in mech.bodies else "ground",
+        "fixed_body": mech.ground,
         "centres": packed_array(centres, "f4"),
         "steady": packed_array(steady, "f4"),
         "points": len(keep),
