@@ -87,3 +87,22 @@ def test_a_five_bar_has_mobility_two(tmp_path: Path) -> None:
     spec.write_text(f'name = "five-bar"\nangles = "deg"\n\n[mechanism]\nplanar = true\n\n{joints}')
     with pytest.raises(LinkworkError, match=r"mobility 2 at the start .*couple or fix joints"):
         lw.trace(lw.load(str(spec)))
+
+
+@pytest.mark.parametrize("branches", [False, True])
+@pytest.mark.parametrize("steps", [None, 12])
+def test_a_crossing_start_reports_its_own_rank(branches: bool, steps: int | None) -> None:
+    """The flat parallelogram's start rank is the rank of its Jacobian there, written here from the four pivots
+    on the ground line (each hinge's planar column ``(1, y, -x)``: the y row is zero, rank 2), and its mobility 2
+    (4 unknowns); the branches leaving it have rank 3. Before: the stats gave the branches' rank, 3, and mobility
+    1, so report.json's ``rank`` at the start was not the start's."""
+    mech = lw.load("four-bar", ground=2.0, crank=1.0, coupler=2.0, rocker=1.0, theta=0.0)
+    pivots = np.array([[0.0, 0.0], [1.0, 0.0], [3.0, 0.0], [2.0, 0.0]])  # A, B, C, D laid flat
+    columns = np.array([[1.0, y, -x] for x, y in pivots]).T
+    rank = int(np.linalg.matrix_rank(columns))
+    assert rank == 2
+    until = None if steps is None else ("A", np.radians(90.0))
+    tr = lw.trace(mech, branches=branches, until=until, steps=steps, max_steps=2000)
+    assert tr.stats.start_rank == rank and tr.stats.start_mobility == 4 - rank
+    assert tr.rank[0] == rank and tr.rank[1] == 3
+    assert all(b.mobility == 1 for b in tr.branches)

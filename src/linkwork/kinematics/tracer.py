@@ -226,7 +226,7 @@ def _trace_from_crossing(
             n1, end1 = left
         marcher.branches.append(Branch.ended(1, None, None, -1, n1, end1))
     marcher.follow_queue()
-    return _assemble(mech, d_joint, marcher, tol, started, paper, until)
+    return _assemble(mech, d_joint, marcher, tol, started, paper, until, start_rank=point.rank)
 
 
 def _start_direction(components: tuple[float, ...], drive: int, sign: float) -> float:
@@ -589,9 +589,10 @@ def _assemble(
     started: float,
     paper: bool,
     until: tuple[str | int, float] | None,
+    start_rank: int | None = None,
 ) -> Trace:
     """The :class:`Trace` of everything the marcher collected, with each branch's mobility and the verdict on
-    the target."""
+    the target; ``start_rank`` the start's own rank where it is not the path's (a crossing start: lower)."""
     rows = marcher.rows
     U = np.concatenate(rows.u)
     sigma = np.concatenate(rows.sigma)
@@ -619,9 +620,10 @@ def _assemble(
             on_branch = [angles[branch == 0], *[f.angles[None, :] for f in marcher.folds if f.branch == 0]]
             unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
     residual = np.concatenate(rows.res)
+    r_start = marcher.cfg.r_path if start_rank is None else start_rank
     stats = TraceStats(
-        start_rank=marcher.cfg.r_path,
-        start_mobility=m - marcher.cfg.r_path,
+        start_rank=r_start,
+        start_mobility=m - r_start,
         mode="paper" if paper else "adaptive",
         closure_tol=tol.closure,
         max_misfit=float(max(marcher.max_misfit, float(np.max(residual)))),
