@@ -54,19 +54,16 @@ def test_the_sliders_range_is_its_stroke(tmp_path: Path, scale: float, steps: in
     assert lo <= rows.min() and hi >= rows.max()
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18b): a large slider-crank far from the origin: range to 8e-8"
-)
 @pytest.mark.parametrize("far", [100.0, 1e4])
 def test_a_large_slider_crank_far_from_the_origin(tmp_path: Path, far: float) -> None:
     """The same slider-crank x 1e3 (a 1000 mm crank) moved ``far`` sizes from the origin (1e5 and 1e7 mm),
-    2-deg paper steps. Got: the stroke's ends off by 7.7e-8 of the crank (far 100; 1.3e-6 before this branch's
-    tolerance scaling) and the rows' stroke (far 1e4: 3.1e-5 and 1.3e-6 of the crank short, no turning point
-    located). Right: to 1e-9 of the crank, as at the origin. Suspected cause: the located point's corrector
-    (classify.locate_fold -> bifurcation.correct_on_plane) works in absolute coordinates, where the closure's
-    round-off floor grows with the distance from the origin, not with the linkage's own length that the
-    tolerances are scaled by (kinematics/extremes.py _tolerances, tracer._at_scale); the tracer's rows are right
-    to 1e-11 there."""
+    2-deg paper steps: the stroke's ends to 1e-9 of the crank, as at the origin (measured 8.4e-13 and 1.1e-12).
+    Was: off by 7.7e-8 of the crank (far 100) and the rows' stroke (far 1e4: 3.1e-5 and 1.3e-6 of the crank
+    short, no turning point located). Cause: the tracer traced the linkage as its twin in its own frame
+    (kinematics/own_frame.py) but kinematics/extremes.py located the turning points on the user's linkage, whose
+    closure Jacobian at 1e5 mm from the origin has singular values 1.9e5 .. 3.6e-3: the corrector stalled at
+    7e-10 mm and that left the point 7.7e-5 mm off the path along the slider (at 1e7 mm nothing was corrected).
+    Fixed there: the points are located on the twin, with the twin's tolerances."""
     lo_ref, hi_ref = extremes()
     case = SliderCrank("offset-slider-crank", R, L, E, 40.0)
     motion = np.eye(4)

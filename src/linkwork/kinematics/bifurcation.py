@@ -101,8 +101,13 @@ def locate(
     Points are parametrised by ``h = t_a . (u - u_a)``. Each trial point is predicted by the cubic Hermite
     interpolant between the two bracketing points (with their tangents) and corrected in the hyperplane of its
     ``h``: the prediction error, fourth order in the bracket, stays far below the distance to the other branch
-    crossing there, so the trials stay on the branch being traced. ``weight`` is the step's metric (tangents are
-    oriented in it, :func:`~linkwork.kinematics.march.tangent_and_test`). Returns the point and the bracket width.
+    crossing there, so the trials stay on the branch being traced. A trial the corrector cannot close ends the
+    search (the point and bracket so far are returned): it is not a point of the path, and taken as a bracket's
+    end it sent the next prediction turns away (a parallelogram of size 1e-3 placed 1e3 from the origin, its
+    file's coordinates holding its shape to 2e-10: a trial corrected onto the other branch 1e-3 rad from the
+    crossing, whose tangent lies across the axis, made the next Hermite prediction 50 rad away, and the point
+    reported was the other crossing, 45 turns off). ``weight`` is the step's metric (tangents are oriented in it,
+    :func:`~linkwork.kinematics.march.tangent_and_test`). Returns the point and the bracket width.
     """
 
     def evaluate_at(u: Array) -> tuple[float, Array]:
@@ -125,7 +130,9 @@ def locate(
         x = hi[0] - f_hi * (hi[0] - lo[0]) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * (lo[0] + hi[0])
         if not (min(lo[0], hi[0]) < x < max(lo[0], hi[0])):
             x = 0.5 * (lo[0] + hi[0])
-        u_x, _, _ = correct_on_plane(ws, hermite(x, lo, hi, t_a), t_a, tol)
+        u_x, _, ok = correct_on_plane(ws, hermite(x, lo, hi, t_a), t_a, tol)
+        if not ok:
+            break
         f_x, t_x = evaluate_at(u_x)
         best = u_x
         if f_x == 0.0:
@@ -336,15 +343,15 @@ def locate_minimum(
 ) -> tuple[Array, float]:
     """Minimise the smallest non-zero singular value ratio ``sigma_r / sigma_1`` along the branch between
     points ``a`` and ``b`` (golden section in ``h = t_a . (u - u_a)``, points predicted by the cubic Hermite
-    interpolant and corrected in their hyperplane). Catches rank drops where the test function keeps its sign.
-    Returns the point and the ratio there."""
+    interpolant and corrected in their hyperplane; a trial the corrector cannot close is not a point of the path,
+    and never the minimum). Catches rank drops where the test function keeps its sign. Returns the point and the
+    ratio there."""
     h_b = float(t_a @ (u_b - u_a))
 
-    def point(x: float) -> Array:
-        return correct_on_plane(ws, hermite(x, (0.0, u_a, t_a), (h_b, u_b, t_b), t_a), t_a, tol)[0]
-
     def ratio(x: float) -> tuple[float, Array]:
-        u = point(x)
+        u, _, ok = correct_on_plane(ws, hermite(x, (0.0, u_a, t_a), (h_b, u_b, t_b), t_a), t_a, tol)
+        if not ok:  # not a point of the path: never its minimum
+            return np.inf, u
         _, _, jac = ws.evaluate(u)
         s = np.linalg.svd(jac, compute_uv=False)
         return float(s[r_path - 1] / s[0]), u
