@@ -106,12 +106,14 @@ def trace(
         ),
     ] = None,
     closure_tol: Annotated[
-        float,
+        float | None,
         typer.Option(
             help="Accept a least-squares closure within this misfit (play in the hinges), for a loop whose "
-            "link parameters are slightly inconsistent; report.json states it and the largest misfit met.",
+            "link parameters are slightly inconsistent; report.json states it and the largest misfit met. "
+            "Default: 1e-12 of the file's unit, no play (what lw.trace does without closure_tol).",
+            show_default=False,
         ),
-    ] = 1e-12,
+    ] = None,
     deployed_at: Annotated[
         str | None,
         typer.Option(
@@ -167,8 +169,10 @@ def trace(
         )
     target = parse_until(until)
     limits_file = _parse_limits(limit)
-    if not (math.isfinite(closure_tol) and closure_tol > 0):
+    if closure_tol is not None and not (math.isfinite(closure_tol) and closure_tol > 0):
         raise fail(f"--closure-tol {closure_tol}: expected a positive number")
+    # Without --closure-tol the spec is assembled at the default closure and traced as lw.trace traces it
+    # without closure_tol: no play (given, the play is a length in the file's unit, also in the own frame).
     loaded = _load(spec, params, closure_tol)
     mech = loaded.mechanism
     if couple or fixed:
@@ -239,10 +243,13 @@ def _parse_deployed_at(text: str | None) -> tuple[str, float] | None:
     return parse_joint_value(text, "--deployed-at", "A=128.6822")
 
 
-def _load(spec: str, params: dict[str, Any], closure_tol: float) -> LoadedSpec:
-    """The spec, assembled accepting a closure misfit within ``closure_tol`` (play in the hinges)."""
+def _load(spec: str, params: dict[str, Any], closure_tol: float | None) -> LoadedSpec:
+    """The spec, assembled accepting a closure misfit within ``closure_tol`` (play in the hinges; ``None``:
+    :func:`~linkwork.io.spec.resolve_spec`'s default closure)."""
     from linkwork.io.spec import resolve_spec
 
+    if closure_tol is None:
+        return resolve_spec(spec, params)
     return resolve_spec(spec, params, closure_tol=closure_tol)
 
 
