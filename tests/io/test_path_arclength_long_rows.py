@@ -163,3 +163,12 @@ def test_s_of_a_row_landed_on_a_limit(steps: int | None) -> None:
     a_end = brentq(lambda a: slider(a * RAD) - 2.6, 90.0, 120.0, xtol=1e-13)
     assert trace.angles[-1, 0] == pytest.approx(a_end * RAD, abs=1e-9)
     assert abs(file_arclength(trace)[-1] - reference_s(START, a_end)) < 1e-3
+
+
+@pytest.mark.parametrize("steps", [45, 90])
+def test_s_of_short_rows_with_a_slider(way: str, steps: int) -> None:
+    """The crank from 30 to 120 deg in rows of 2 and 1 deg (no parts: each row one step of the sum): the last ``s``
+    is the quadrature's 133.339 to 1e-3, as in long rows and adaptive."""
+    trace = lw.trace(slider_crank(), until=("A", 120 * RAD), steps=steps)
+    assert trace.stats.unmet is None
+    assert abs(file_arclength(trace)[-1] - reference_s(START, 120.0)) < 1e-3

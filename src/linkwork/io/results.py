@@ -39,10 +39,11 @@ def file_arclength(trace: Trace) -> np.ndarray:
 
     Without a prismatic unknown this is ``degrees(Trace.arclength)``. With one it is
     ``Trace.arclength_in_file_units``, which the tracer sums over every part of each step (a long paper row's parts
-    turn, so no rescaling of its chord gives it). A trace built without it (by hand) gets each step's increment of
-    ``Trace.arclength`` rescaled by its chord's ratio ``|du_file| / |du|`` (``du`` the unknowns' change over the
-    step, ``du_file`` the same in file units): exact only where the step's direction in the unknowns is
-    constant. A branch starts where ``Trace.arclength`` starts it (0).
+    turn, so no rescaling of its chord gives it), where the trace has it. Where it does not (the closed form's
+    rows without parts, a trace built by hand), each row's increment of ``Trace.arclength`` is rescaled by its
+    chord's ratio ``|du_file| / |du|`` (``du`` the unknowns' change over the row, ``du_file`` the same in file
+    units): exact where the increment is the row's chord, as it is for those rows. A branch starts where
+    ``Trace.arclength`` starts it (0).
     """
     s = np.asarray(trace.arclength, dtype=float)
     if trace.arclength_in_file_units is not None:

@@ -219,8 +219,8 @@ class ClosedFormRows(NamedTuple):
     values (descending), ``residual``, ``test`` (the signed test function), ``arclength`` ``(N,)``;
     ``full_rank``: every row has its full rank ``k`` by the quick test of
     :func:`linkwork.kinematics.rank.all_full_rank` (False: the caller counts the ranks row by row);
-    ``file_arclength`` ``(N,)`` the arclength in file units (``Trace.arclength_in_file_units``; ``None`` without a
-    prismatic unknown, where it is ``degrees(arclength)``).
+    ``file_arclength`` ``(N,)`` the arclength in file units (``Trace.arclength_in_file_units``), where a row has
+    parts; ``None`` where the rows' chords give it (no prismatic unknown, or every row one step).
     """
 
     angles: Array
@@ -282,15 +282,18 @@ def closed_form_rows(
     if status != CLEAN:
         return None
     # The solver's arclength is the running sum of the chords between its points, no longer apart than a part
-    # (the march's parts): that in file units too with a slider, and in the user's unit for a twin in its own
-    # frame (trace_result.arclength_weights), from every point before the rows are kept (numpy, no work in the
-    # solver's loop for a linkage of hinges only).
+    # (the march's parts). With a slider, the same in file units (trace_result.arclength_weights) where a row
+    # has parts, from every point before the rows are kept; rows without parts leave it to
+    # io.results.file_arclength, whose chord ratios are then exact (each row's increment is its chord), so a
+    # trace of many short rows (the planar benchmark's) does no more work. A twin in its own frame: both in its
+    # user's units. Nothing for a linkage of hinges only.
     file_s = None
     if has_file_arclength(mech):
         weights = arclength_weights(mech)
         if np.any(weights[0] != 1.0):
             s = _chord_sums(angles, weights[0][mech.groups])
-        file_s = _chord_sums(angles, weights[1][mech.groups])
+        if parts > 1:
+            file_s = _chord_sums(angles, weights[1][mech.groups])
     if parts > 1:
         angles, sigma, res, tau, s = (np.ascontiguousarray(a[::parts]) for a in (angles, sigma, res, tau, s))
         file_s = None if file_s is None else np.ascontiguousarray(file_s[::parts])

@@ -47,8 +47,9 @@ def arclength_weights(mech: Mechanism) -> Array:
 
 
 def has_file_arclength(mech: Mechanism) -> bool:
-    """Whether a trace of ``mech`` carries :attr:`Trace.arclength_in_file_units` (a prismatic unknown: the file
-    units are then not ``degrees`` of the unknowns' own), once per mechanism."""
+    """Whether a trace of ``mech`` has an arclength in file units of its own (a prismatic unknown: the file
+    units are then not ``degrees`` of the unknowns' own; :attr:`Trace.arclength_in_file_units`), once per
+    mechanism."""
     return mech.derived(
         "file arclength kept", lambda: any(mech.joint_types[j] != "R" for j in mech.first_joints)
     )
@@ -159,8 +160,10 @@ class Trace:
     arclength_in_file_units
         ``(N,)`` the same arclength with revolute unknowns measured in degrees (``path.csv``'s ``s``, the viewer's
         arclength axis), summed by the tracer over every part of each step as :attr:`arclength` is (a long paper
-        row's parts turn, so its chord does not give it); ``None`` where it is ``degrees(arclength)``: a mechanism
-        without a prismatic unknown (:func:`linkwork.io.results.file_arclength` reads either).
+        row's parts turn, so its chord does not give it); ``None`` where the rows give it
+        (:func:`linkwork.io.results.file_arclength`): ``degrees(arclength)`` without a prismatic unknown, and
+        each row's increment of :attr:`arclength` times its chord ratio where every row is one step of the sum
+        (the closed form's short rows).
     test
         ``(N,)`` the signed bifurcation test function.
     rank
