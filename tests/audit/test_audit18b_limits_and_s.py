@@ -112,18 +112,14 @@ def test_s_adaptive_is_the_arclength_in_file_units(tmp_path: Path) -> None:
     assert abs(float(rows[-1]["s"]) - reference_s()) < 1e-3
 
 
-@pytest.mark.xfail(
-    strict=True, reason="open (audit18b): s of long paper steps with a slider is off the arclength"
-)
 @pytest.mark.parametrize("steps", ["1", "3"])
 def test_s_in_long_paper_steps_is_the_arclength_in_file_units(tmp_path: Path, steps: str) -> None:
-    """The same end point in 1 or 3 equal steps. Got: last ``s`` 133.638 (1 step) and 133.454 (3 steps) against
-    the quadrature's 133.339 (adaptive: 133.3388), so the same point of the same path has an ``s`` that depends on
-    the step count, and above the true arclength by 0.3 (the chord of the one step is 132.52, so it is not the
-    chord sum either). Right: the arclength in file units to 1e-3 (or the chords' sum, as documented,
-    consistently). Cause: io/results.py file_arclength rescales each row's internal arclength (radians and
-    lengths) by one chord ratio |du_file| / |du|, which is exact only when the direction in the unknowns is
-    constant over the step; a long paper row's parts turn. The fix needs the march's parts' chords (the tracer),
-    or s defined as the chords' sum of the rows for paper mode."""
+    """The same end point in 1 or 3 equal steps: the last ``s`` is the quadrature's 133.339 to 1e-3 (measured
+    133.33861 both, 4e-4 short: the chords of the rows' parts, no longer than max_step of the drive).
+
+    Was (audit18b): 133.638 (1 step) and 133.454 (3 steps), an ``s`` that depended on the step count: each row's
+    internal arclength rescaled by one chord ratio ``|du_file| / |du|``, exact only where the direction in the
+    unknowns is constant over the row, while a long paper row's parts turn. Fixed (s19): the march sums its
+    parts' chords in file units too (``Trace.arclength_in_file_units``)."""
     _, _, rows = run(tmp_path, "--until", "A=120", "--steps", steps)
     assert abs(float(rows[-1]["s"]) - reference_s()) < 1e-3

@@ -34,16 +34,20 @@ def file_units(mech: Mechanism, values: np.ndarray) -> np.ndarray:
 
 @trace_keyword
 def file_arclength(trace: Trace) -> np.ndarray:
-    """``Trace.arclength`` (radians, and lengths for prismatic unknowns) in file units: along each branch, the
-    arclength in the unknowns measured in degrees for revolute unknowns and in the length unit for prismatic ones
-    (``path.csv``'s ``s``, the viewer's arclength axis).
+    """The arclength along each branch in file units: in the unknowns measured in degrees for revolute unknowns
+    and in the length unit for prismatic ones (``path.csv``'s ``s``, the viewer's arclength axis); a copy.
 
-    Without a prismatic unknown this is ``degrees(arclength)``. With one, each step's increment is rescaled by
-    its chord: ``ds_file = ds * |du_file| / |du|`` with ``du`` the unknowns' change over the step (so a curved
-    step keeps its excess over the chord) and ``du_file`` the same change in file units. A branch starts where
+    Without a prismatic unknown this is ``degrees(Trace.arclength)``. With one it is
+    ``Trace.arclength_in_file_units``, which the tracer sums over every part of each step (a long paper row's parts
+    turn, so no rescaling of its chord gives it), where the trace has it. Where it does not (the closed form's
+    rows without parts, a trace built by hand), each row's increment of ``Trace.arclength`` is rescaled by its
+    chord's ratio ``|du_file| / |du|`` (``du`` the unknowns' change over the row, ``du_file`` the same in file
+    units): exact where the increment is the row's chord, as it is for those rows. A branch starts where
     ``Trace.arclength`` starts it (0).
     """
     s = np.asarray(trace.arclength, dtype=float)
+    if trace.arclength_in_file_units is not None:
+        return np.array(trace.arclength_in_file_units, dtype=float)
     mech = trace.mechanism
     prismatic = np.array(
         [any(mech.joint_types[j] == "P" for j in members) for members in mech.group_members()], dtype=bool

@@ -40,6 +40,7 @@ from linkwork.kinematics.dyad_solver import (
 from linkwork.kinematics.march import MAX_PARTS, PART_SLACK
 from linkwork.kinematics.marcher import MarchSettings
 from linkwork.kinematics.mechanism import PLANAR_ROWS, Mechanism
+from linkwork.kinematics.trace_result import arclength_weights, has_file_arclength
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -217,7 +218,9 @@ class ClosedFormRows(NamedTuple):
     ``angles (N, n)`` the joint values (joint order, reference offsets included), ``sigma (N, k)`` the singular
     values (descending), ``residual``, ``test`` (the signed test function), ``arclength`` ``(N,)``;
     ``full_rank``: every row has its full rank ``k`` by the quick test of
-    :func:`linkwork.kinematics.rank.all_full_rank` (False: the caller counts the ranks row by row).
+    :func:`linkwork.kinematics.rank.all_full_rank` (False: the caller counts the ranks row by row);
+    ``file_arclength`` ``(N,)`` the arclength in file units (``Trace.arclength_in_file_units``), where a row has
+    parts; ``None`` where the rows' chords give it (no prismatic unknown, or every row one step).
     """
 
     angles: Array
@@ -226,6 +229,7 @@ class ClosedFormRows(NamedTuple):
     test: Array
     arclength: Array
     full_rank: bool
+    file_arclength: Array | None
 
 
 def closed_form_rows(
@@ -277,13 +281,40 @@ def closed_form_rows(
     )
     if status != CLEAN:
         return None
+    # The solver's arclength is the running sum of the chords between its points, no longer apart than a part
+    # (the march's parts). With a slider, the same in file units (trace_result.arclength_weights) where a row
+    # has parts, from every point before the rows are kept; rows without parts leave it to
+    # io.results.file_arclength, whose chord ratios are then exact (each row's increment is its chord), so a
+    # trace of many short rows (the planar benchmark's) does no more work. A twin in its own frame: both in its
+    # user's units. Nothing for a linkage of hinges only.
+    file_s = None
+    if has_file_arclength(mech):
+        weights = arclength_weights(mech)
+        if np.any(weights[0] != 1.0):
+            s = _chord_sums(angles, weights[0][mech.groups])
+        if parts > 1:
+            file_s = _chord_sums(angles, weights[1][mech.groups])
     if parts > 1:
         angles, sigma, res, tau, s = (np.ascontiguousarray(a[::parts]) for a in (angles, sigma, res, tau, s))
+        file_s = None if file_s is None else np.ascontiguousarray(file_s[::parts])
     k = settings.n_sigma
     if k != sigma.shape[1]:  # (the path's rank is the number of equations: never taken)
         sigma, full_rank = np.ascontiguousarray(sigma[:, :k]), False
     # The kernel's test holds every row to rank k; numerical_rank agrees with a floor at or below loose.
-    return ClosedFormRows(angles, sigma, res, tau, s, bool(full_rank) and tol.floor <= tol.loose)
+    return ClosedFormRows(angles, sigma, res, tau, s, bool(full_rank) and tol.floor <= tol.loose, file_s)
+
+
+def _chord_sums(angles: Array, weight: Array) -> Array:
+    """``(N,)``: the running sum of the chords between consecutive rows of ``angles (N, n)`` with each joint's
+    value weighted by ``weight (n,)`` (0 at row 0)."""
+    step = angles[1:] - angles[:-1]
+    step *= weight
+    step *= step
+    out = np.empty(len(angles))
+    out[0] = 0.0
+    np.sqrt(step.sum(axis=1), out=out[1:])
+    np.cumsum(out[1:], out=out[1:])
+    return out
 
 
 def _fixed_settings(mech: Mechanism, basis: Array, local_min: float, loose: float) -> Array:

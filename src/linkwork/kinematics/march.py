@@ -77,7 +77,7 @@ MARCH_ARGUMENTS = {
         "stall_length", "max_steps", "r_path", "detect", "check_closed",
     ),
     "corrector": CORRECTOR,
-    "bounds": ("periodic", "lo", "hi", "weight"),
+    "bounds": ("periodic", "lo", "hi", "weight", "measure"),
     "out": ("out_u", "out_t", "out_sigma", "out_res", "out_tau", "out_s", "crossings"),
 }  # fmt: skip
 CROSSINGS = ("cross_u", "cross_t", "cross_basis", "cross_n")
@@ -433,12 +433,13 @@ def cosine(a, b, weight):
 
 
 @kernel(inline="always")
-def plain_length(u, u_try):
-    """The Euclidean length of the step from ``u`` to ``u_try`` in the unknowns as they are (the reported
-    arclength's; the step control's is weighted, :func:`weighted_norm`)."""
+def measured_length(u, u_try, w):
+    """The length of the step from ``u`` to ``u_try`` with each unknown weighted by ``w`` (a row of the march's
+    ``measure``: the reported arclengths'; the step control's metric is :func:`weighted_norm`'s). With every
+    weight 1 it is the Euclidean length in the unknowns as they are, bit for bit."""
     acc = 0.0
     for a in range(u.shape[0]):
-        du = u_try[a] - u[a]
+        du = (u_try[a] - u[a]) * w[a]
         acc += du * du
     return np.sqrt(acc)
 
@@ -566,10 +567,16 @@ def march(mech, start, steps, corrector, bounds, out):
     The arguments are tuples (:data:`MARCH_ARGUMENTS` names their members): ``mech`` the mechanism's arrays (see
     :mod:`~linkwork.kinematics.kernels`); ``start = (u0, t0, u_home, basis, reach)``; ``steps = (paper, drive, h0,
     hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length, max_steps, r_path, detect,
-    check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi, weight)``;
-    ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s, crossings)``, the rows written and the brackets
-    of the sign changes of the test function within the last row (:data:`CROSSINGS`). numba unpacks each tuple
-    once per call; the inner kernels get the tuples they need.
+    check_closed)``; ``corrector = (tol, exact, roundoff, truncate, max_iter)``; ``bounds = (periodic, lo, hi, weight,
+    measure)``; ``out = (out_u, out_t, out_sigma, out_res, out_tau, out_s, crossings)``, the rows written and the
+    brackets of the sign changes of the test function within the last row (:data:`CROSSINGS`). numba unpacks each
+    tuple once per call; the inner kernels get the tuples they need.
+
+    ``out_s (n, 2)`` are two arclengths from the call's start, each the sum of every accepted step's length (a
+    paper row's parts and closing parts one by one, so that a long row's turning parts count, not its chord) with
+    the unknowns weighted by a row of ``measure (2, m)``: column 0 with ``measure[0]`` (``Trace.arclength``'s),
+    column 1 with ``measure[1]`` (the file units', ``Trace.arclength_in_file_units``;
+    :func:`linkwork.kinematics.trace_result.arclength_weights`).
 
     ``u_home`` is where the path began and ``reach = [far, longest, t_home...]`` how far the path has gone from it,
     its longest step and its tangent there (``2 + m`` zeros for a new path; updated in place), for closed-path
@@ -592,7 +599,7 @@ def march(mech, start, steps, corrector, bounds, out):
         paper, drive, h0, hmin, hmax, cos_turn, target, has_target, advance, stall_steps, stall_length,
         max_steps, r_path, detect, check_closed,
     ) = steps  # fmt: skip
-    periodic, lo, hi, weight = bounds
+    periodic, lo, hi, weight, measure = bounds
     weighted = False  # a prismatic unknown, measured in the linkage's own length (weight 1 / L)
     for a in range(u0.shape[0]):
         weighted = weighted or weight[a] != 1.0
@@ -621,7 +628,7 @@ def march(mech, start, steps, corrector, bounds, out):
         # in with: its null vector is any of a plane's. An adaptive start there, such as a point of a
         # higher-dimensional component, takes the null vector the SVD gives, as before)
         t[:] = t_new
-    write_row(out, 0, u, t, sig, r0, tau, 0.0)
+    write_row(out, 0, u, t, sig, r0, tau, 0.0, 0.0)
     # The test function's sign is compared step by step, every part of a paper row included (two sign changes
     # within one row would cancel between its rows): ``tau_last`` at the last point accepted, ``tau_row`` at the
     # row's start (a row taken again starts from it), ``n_cross`` the sign changes in the row so far.
@@ -635,7 +642,7 @@ def march(mech, start, steps, corrector, bounds, out):
     ):  # a new path (no step taken yet): its tangent at the start, for the closure's alignment
         reach[2:] = t
     t_home = reach[2:]
-    s_total = 0.0
+    s_total, s_file = 0.0, 0.0  # the two arclengths of out_s
     basis_try = basis.copy()
     far = max(reach[0], wrapped_distance(u0, u_home, periodic, weight))
     longest = reach[1]  # the longest step of the path (a closed path has gone several of them from its start)
@@ -790,8 +797,10 @@ def march(mech, start, steps, corrector, bounds, out):
             n_cross += 1
         tau_last = tau_new
         singular_last = singular_at(sig, r_path)
-        # the arclength reported is in the unknowns as they are (lengths in the length unit, as the closed form's)
-        s_total += dist if not weighted else plain_length(u, u_try)
+        # the arclengths reported, every part of a row summed: in the unknowns as they are (lengths in the length
+        # unit, as the closed form's) and in the file units
+        s_total += measured_length(u, u_try, measure[0])
+        s_file += measured_length(u, u_try, measure[1])
         longest = max(longest, dist)
         reach[1] = longest
         for a in range(m):
@@ -811,7 +820,7 @@ def march(mech, start, steps, corrector, bounds, out):
             u_row[:] = u
             t_row[:] = t
             basis_row[:, :] = basis
-        write_row(out, count, u, t, sig, r, tau_new, s_total)
+        write_row(out, count, u, t, sig, r, tau_new, s_total, s_file)
         recent[count % recent.shape[0]] = dist
         count += 1
         cross_n[0] = n_cross  # the sign changes within the row just written (an even number leaves its sign)
@@ -834,7 +843,7 @@ def march(mech, start, steps, corrector, bounds, out):
                 align /= weighted_norm(t, weight) * weighted_norm(t_home, weight)
             aligned = align > 2.0 * cos_turn * cos_turn - 1.0  # within two steps' largest turn of the start's
             if aligned and back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
-                close_path(u, u_home, periodic, count - 1, out)
+                close_path(u, u_home, periodic, count - 1, out, measure)
                 return count, CLOSED, h
         # ---- step control: grow an easy adaptive step (judged in the unknowns, so that it does not depend on the
         # length unit or where the linkage stands: the corrector moved the point by under a tenth of the step)
@@ -882,16 +891,17 @@ def back_home(u, u_home, periodic, d, far, longest, h, paper, drive):
 
 
 @kernel(inline="always")
-def write_row(out, row, u, t, sig, r, tau, s):
+def write_row(out, row, u, t, sig, r, tau, s, s_file):
     """Row ``row`` of the march's outputs ``out``: the point, its tangent, singular values, residual, test value
-    and arclength."""
+    and the two arclengths (``out_s``'s columns, see :func:`march`)."""
     out_u, out_t, out_sigma, out_res, out_tau, out_s = out[0], out[1], out[2], out[3], out[4], out[5]
     out_u[row, :] = u
     out_t[row, :] = t
     out_sigma[row, :] = sig
     out_res[row] = r
     out_tau[row] = tau
-    out_s[row] = s
+    out_s[row, 0] = s
+    out_s[row, 1] = s_file
 
 
 @kernel(inline="always")
@@ -925,14 +935,19 @@ def step_event(u, landing, lo, hi, detect, tau_product):
 
 
 @kernel(inline="always")
-def close_path(u, u_home, periodic, row, out):
-    """Make row ``row`` of the outputs ``out`` the start again (in ``u``'s continuous angles, see
-    :func:`snap_home`): the path closed. Its arclength is the row before's plus the chord to the start (the step
-    that came near it was longer or shorter)."""
+def close_path(u, u_home, periodic, row, out, measure):
+    """Make row ``row`` of the outputs ``out`` (written at the march's point ``u``) the start again (in ``u``'s
+    continuous angles, see :func:`snap_home`): the path closed. Its arclengths (``measure``, see :func:`march`) are
+    the march's to ``u`` with the last step's chord from the row before moved from ``u`` to the start: an adaptive
+    step that came near the start was longer or shorter than the one to it, and a paper row lands on the start
+    (to round-off) after parts whose lengths are summed (the chord of a long row is shorter than its path)."""
     out_u, out_sigma, out_res, out_tau, out_s = out[0], out[2], out[3], out[4], out[5]
     snap_home(u, u_home, periodic, out_u[row])
     out_sigma[row, :] = out_sigma[0, :]
     out_res[row] = out_res[0]
     out_tau[row] = out_tau[0]
     if row > 0:
-        out_s[row] = out_s[row - 1] + plain_length(out_u[row - 1], out_u[row])
+        for k in range(2):
+            w = measure[k]
+            moved = measured_length(out_u[row - 1], out_u[row], w) - measured_length(out_u[row - 1], u, w)
+            out_s[row, k] = out_s[row, k] + moved

@@ -25,7 +25,7 @@ from linkwork.kinematics.march import MAX_CROSSINGS, MAX_PARTS, PART_SLACK
 from linkwork.kinematics.mechanism import Mechanism
 from linkwork.kinematics.rank import Tolerances, numerical_rank, numerical_ranks
 from linkwork.kinematics.stops import End, StopReason
-from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold
+from linkwork.kinematics.trace_result import Bifurcation, Branch, Fold, arclength_weights
 from linkwork.kinematics.workspace import Workspace
 from linkwork.progress import Progress
 
@@ -102,7 +102,9 @@ def leading_sign(tangent: Array, drive: int, moving: float = 1e-6) -> int:
 @dataclass
 class Chunk:
     """The rows one call of the compiled march wrote (row 0 is its start), its stop code (a
-    :class:`~linkwork.kinematics.stops.StopReason` value) and last step."""
+    :class:`~linkwork.kinematics.stops.StopReason` value) and last step. ``s (count, 2)`` are the two arclengths
+    of each row (``Trace.arclength``'s and the file units', :func:`~linkwork.kinematics.trace_result.
+    arclength_weights`), each summed over every part of a step."""
 
     u: Array
     t: Array
@@ -122,7 +124,8 @@ class Chunk:
 @dataclass
 class Rows:
     """Growing per-point storage, one block of rows per compiled march call (``rank``: each row's numerical rank,
-    kept beside ``sigma`` when every block has it, else computed by the caller)."""
+    kept beside ``sigma`` when every block has it, else computed by the caller; ``s``: the two arclengths of each
+    row, as :attr:`Chunk.s`)."""
 
     u: list[Array] = field(default_factory=list)
     sigma: list[Array] = field(default_factory=list)
@@ -140,7 +143,7 @@ class Rows:
         self.sigma.append(sigma[None, :].copy())
         self.res.append(np.array([res]))
         self.tau.append(np.zeros(1))
-        self.s.append(np.zeros(1))
+        self.s.append(np.zeros((1, 2)))
         self.branch.append(np.array([branch], dtype=np.int64))
         self.step.append(np.zeros(1, dtype=np.int64))
 
@@ -198,6 +201,8 @@ class BranchMarcher:
         self.weight = (
             np.ones(len(settings.periodic)) if settings.weight is None else np.array(settings.weight)
         )
+        # The weights of the two arclengths the rows carry (Chunk.s; writeable, as the weights above)
+        self.measure = np.array(arclength_weights(mech))
         # The kernels the whole trace runs (chosen by its caller), in the caller's workspace when it has one.
         self.ws = workspace if workspace is not None else Workspace.of(mech, kernels)
         self.first_joint = mech.first_joints
@@ -249,7 +254,7 @@ class BranchMarcher:
         cfg, tol, m = self.cfg, self.cfg.tol, len(u)
         out = Chunk(
             u=np.empty((n + 1, m)), t=np.empty((n + 1, m)), sigma=np.empty((n + 1, cfg.n_sigma)),
-            res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty(n + 1), count=0, code=0, h=h0,
+            res=np.empty(n + 1), tau=np.empty(n + 1), s=np.empty((n + 1, 2)), count=0, code=0, h=h0,
         )  # fmt: skip
         ws = self.ws
         target = cfg.target if towards is None else towards
@@ -276,12 +281,17 @@ class BranchMarcher:
             check_closed,
         )  # fmt: skip  (march.MARCH_ARGUMENTS["steps"])
         out.count, out.code, out.h = ws.kernels.march(
-            ws.kernel_arrays(), (u, t, u_home, basis, reach, self._before(before, m)), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight),
+            ws.kernel_arrays(), (u, t, u_home, basis, reach, self._before(before, m)), steps, ws.corrector(tol), (cfg.periodic, cfg.lo, cfg.hi, self.weight, self.measure),
             (out.u, out.t, out.sigma, out.res, out.tau, out.s, crossings),
         )  # fmt: skip
         if paper:
             out.crossings = crossings
         return out
+
+    def chords(self, u_a: Array, u_b: Array) -> Array:
+        """``(2,)``: the chord from ``u_a`` to ``u_b`` in each of the two arclengths the rows carry (:attr:`Chunk.s`,
+        the march's ``measure``), the increment of a step the march does not take in parts."""
+        return np.asarray(np.linalg.norm((u_b - u_a) * self.measure, axis=1), dtype=float)
 
     @staticmethod
     def _before(before: Array | None, m: int) -> Array:
@@ -587,10 +597,10 @@ class BranchMarcher:
         """``chunk`` without its last row, then the rows of each probe after its first (see :meth:`_jumped`)."""
         k = chunk.count - 1
         parts = [(chunk, 0, k)] + [(p, 1, p.count) for p in probes]
-        s, base = [], 0.0
+        s, base = [], np.zeros(2)
         for i, (part, lo, hi) in enumerate(parts):
             s.append(part.s[lo:hi] - (0.0 if i == 0 else part.s[0]) + base)
-            base = float(s[-1][-1]) if hi > lo else base
+            base = s[-1][-1] if hi > lo else base
         return Chunk(
             u=np.concatenate([p.u[lo:hi] for p, lo, hi in parts]),
             t=np.concatenate([p.t[lo:hi] for p, lo, hi in parts]),
@@ -730,17 +740,19 @@ class BranchMarcher:
         u_k = chunk.u[c - 1]
         h = chunk.h
         u_next: Array | None = None
+        s_next = np.zeros(2)  # the step's two arclengths (Chunk.s)
         on_target = False
         while u_next is None and abs(h) >= cfg.min_step:
             if paper:
-                u_next = self._paper_row_from(u_k, tangent, h, basis_prev)
-                if u_next is None:
+                row = self._paper_row_from(u_k, tangent, h, basis_prev)
+                if row is None:
                     return None
+                u_next, s_next = row
                 on_target = cfg.target is not None and float(u_next[d]) == cfg.target
             else:
                 guess, _, ok = correct_on_plane(ws, u_k + h * tangent, tangent, tol)
                 if ok and float(tangent @ (guess - u_k)) > tol.advance * h:
-                    u_next = guess
+                    u_next, s_next = guess, self.chords(u_k, guess)
                 else:
                     h *= 0.5
         if u_next is None:
@@ -755,7 +767,7 @@ class BranchMarcher:
         across = Chunk(
             u=np.array([u_k, u_next]), t=np.array([tangent, t_next]),
             sigma=np.array([chunk.sigma[c - 1], sigma]), res=np.array([chunk.res[c - 1], r]),
-            tau=np.array([chunk.tau[c - 1], tau]), s=np.array([0.0, float(np.linalg.norm(u_next - u_k))]),
+            tau=np.array([chunk.tau[c - 1], tau]), s=np.array([np.zeros(2), s_next]),
             count=2, code=StopReason.BUDGET, h=h,
         )  # fmt: skip
         if on_target or (
@@ -767,13 +779,16 @@ class BranchMarcher:
             across.code = StopReason.TARGET
         return across
 
-    def _paper_row_from(self, u_k: Array, tangent: Array, h: float, basis_prev: Array) -> Array | None:
+    def _paper_row_from(
+        self, u_k: Array, tangent: Array, h: float, basis_prev: Array
+    ) -> tuple[Array, Array] | None:
         """Paper mode: the row one equal drive step ``h`` on from the singular point ``u_k``, along ``tangent``
         (the branch it was reached on), in parts no longer than ``max_step`` in the step's metric (as the march's,
         :data:`~linkwork.kinematics.march.PART_SLACK`), the drive held at each part's value and the tangent taken
-        again after each; the row's value is the target when it is that to ``1e-9`` (as in the march). ``None``
-        when a corrector fails, the drive turns back, or a part turns a revolute joint by more than a quarter turn
-        (the corrector went to another part of the path)."""
+        again after each; the row's value is the target when it is that to ``1e-9`` (as in the march). Returns
+        the row and its two arclengths from ``u_k`` (:attr:`Chunk.s`), the parts' chords summed as the march sums
+        them. ``None`` when a corrector fails, the drive turns back, or a part turns a revolute joint by more than
+        a quarter turn (the corrector went to another part of the path)."""
         cfg, ws, tol, d = self.cfg, self.ws, self.cfg.tol, self.cfg.drive
         value = float(u_k[d] + h)
         if cfg.target is not None and abs(value - cfg.target) < 1e-9 * max(1.0, abs(cfg.target)):
@@ -781,6 +796,7 @@ class BranchMarcher:
         parts = min(MAX_PARTS, max(1, math.ceil(abs(h) * float(self.weight[d]) / cfg.max_step - PART_SLACK)))
         u, t = u_k.copy(), tangent.copy()
         basis = basis_prev.copy()
+        s = np.zeros(2)
         for i in range(1, parts + 1):
             if t[d] * h <= 0.0 or abs(t[d]) < 1e-12:
                 return None
@@ -800,8 +816,9 @@ class BranchMarcher:
                     jac, t.copy(), basis, cfg.r_path, t_next, np.empty(cfg.n_sigma), self.weight
                 )
                 t = t_next
+            s += self.chords(u, guess)
             u = guess
-        return u
+        return u, s
 
     def _on_target(self, chunk: Chunk) -> bool:
         """Whether the chunk's last row is on the drive's target (a step that lands there holds the drive at the
@@ -841,8 +858,40 @@ class BranchMarcher:
         chunk.u[c - 1] = guess
         chunk.sigma[c - 1] = np.linalg.svd(jac, compute_uv=False)[: cfg.n_sigma]
         chunk.res[c - 1] = r
-        chunk.s[c - 1] = chunk.s[c - 2] + float(np.linalg.norm(guess - u_a))
+        chunk.s[c - 1] = chunk.s[c - 2] + self._landing_arclengths(u_a, t_a, g, guess)
         return True
+
+    def _landing_arclengths(self, u_a: Array, t_a: Array, g: int, u_b: Array) -> Array:
+        """The two arclengths (:attr:`Chunk.s`) of the path from ``u_a`` (tangent ``t_a``) to the point ``u_b``
+        landed on with unknown ``g`` held (:meth:`_land`): the chord when it is no longer than ``max_step`` in the
+        step's metric (an adaptive step), else the chords of parts no longer than that, as the march sums a long
+        paper row's (``g`` held at equal parts of its change, each predicted along the tangent at the part before
+        and corrected; the null vector of the Jacobian taken again after each). The chord again where a part
+        fails or the parts end elsewhere than ``u_b`` (another branch)."""
+        cfg, ws, tol = self.cfg, self.ws, self.cfg.tol
+        chord = self.chords(u_a, u_b)
+        length = float(np.linalg.norm((u_b - u_a) * self.weight))
+        parts = min(MAX_PARTS, max(1, math.ceil(length / cfg.max_step - PART_SLACK)))
+        if parts == 1:
+            return chord
+        u, t, s = u_a.copy(), t_a.copy(), np.zeros(2)
+        for i in range(1, parts + 1):
+            if abs(t[g]) < 1e-12:
+                return chord
+            goal = float(u_b[g]) if i == parts else float(u_a[g] + (u_b[g] - u_a[g]) * i / parts)
+            guess = u + ((goal - u[g]) / t[g]) * t
+            guess[g] = goal
+            ok, _, _ = ws.kernels.correct(
+                ws.kernel_arrays(), guess, g, ws.corrector(tol), ws.q, ws.res, ws.jac
+            )
+            if not ok or np.any(np.abs((guess - u)[cfg.periodic]) > 0.5 * np.pi):
+                return chord
+            _, _, jac = ws.evaluate(guess)
+            t_next = np.linalg.svd(jac)[2][-1]
+            t = t_next if float(t_next @ t) > 0.0 else -t_next
+            s += self.chords(u, guess)
+            u = guess
+        return s if float(np.linalg.norm((u - u_b) * self.weight)) <= tol.loose else chord
 
     def _turns_towards_target(self, chunk: Chunk, u_home: Array) -> bool:
         """Whether a closed path turned the (revolute) drive by whole turns towards a target still ahead."""
@@ -930,7 +979,7 @@ class BranchMarcher:
         cfg, d, c = self.cfg, self.cfg.drive, chunk.count - 1
         failed = Chunk(
             u=chunk.u[c : c + 1].copy(), t=chunk.t[c : c + 1].copy(), sigma=chunk.sigma[c : c + 1].copy(),
-            res=chunk.res[c : c + 1].copy(), tau=chunk.tau[c : c + 1].copy(), s=np.zeros(1), count=1,
+            res=chunk.res[c : c + 1].copy(), tau=chunk.tau[c : c + 1].copy(), s=np.zeros((1, 2)), count=1,
             code=int(StopReason.FAILED), h=chunk.h,
         )  # fmt: skip
         if c < 0 or chunk.h == 0.0:
@@ -945,7 +994,7 @@ class BranchMarcher:
         h = min(cfg.max_step, asked) / 4.0
         basis_probe, reach = basis.copy(), np.zeros(2 + len(u))
         before: Array | None = None
-        s_total = 0.0
+        s_total = np.zeros(2)
         left = max(self.budget, FOLD_PROBE_STEPS)  # one call at least, else the steps the trace has left
         while True:
             basis_prev = basis_probe.copy()
@@ -977,7 +1026,7 @@ class BranchMarcher:
                 known = self._on_sign_change(probe, basis_prev, branch_id, step)
                 if known is not None:
                     self._passed(known, probe)
-            s_total += float(probe.s[probe.count - 1])
+            s_total += probe.s[probe.count - 1]
             last = probe.count - 1
             if probe.code in (StopReason.TARGET, StopReason.SIGN_CHANGE) and probe.u[last, d] == value:
                 break  # landed on the row's value (a sign change on the landing step was located above)
@@ -989,7 +1038,7 @@ class BranchMarcher:
         return Chunk(
             u=np.array([chunk.u[c], probe.u[last]]), t=np.array([chunk.t[c], probe.t[last]]),
             sigma=np.array([chunk.sigma[c], probe.sigma[last]]), res=np.array([chunk.res[c], probe.res[last]]),
-            tau=np.array([chunk.tau[c], probe.tau[last]]), s=np.array([0.0, s_total]), count=2,
+            tau=np.array([chunk.tau[c], probe.tau[last]]), s=np.array([np.zeros(2), s_total]), count=2,
             code=int(StopReason.BUDGET), h=chunk.h,
         )  # fmt: skip
 
@@ -1045,7 +1094,7 @@ class BranchMarcher:
     def _record(self, chunk: Chunk, branch_id: int, first: bool, n_steps: int) -> None:
         """Append a chunk's rows (all of them for the branch's first chunk, else without its start row)."""
         rows, count = self.rows, chunk.count
-        s_base = rows.s[-1][-1] if (not first and rows.s) else 0.0
+        s_base = rows.s[-1][-1] if (not first and rows.s) else np.zeros(2)
         begin = 0 if first else 1
         if count <= begin:  # a march that failed at its first step adds no row (no empty last block)
             return
@@ -1357,7 +1406,7 @@ class BranchMarcher:
         r_star, _, jst = self.ws.evaluate(u)
         sigma_star = np.asarray(np.linalg.svd(jst, compute_uv=False)[: cfg.n_sigma], dtype=float)
         self.rows.add_point(u, sigma_star, r_star, bid, numerical_rank(sigma_star, cfg.tol))
-        s_off = float(np.linalg.norm(u1 - u))
+        s_off = self.chords(u, u1)
         start_len = len(self.rows.u)
         basis = np.ascontiguousarray(U1[:, : cfg.r_path])
         opened_at = (u, Home(sigma_star, float(r_star), 0.0))

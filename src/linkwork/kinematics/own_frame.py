@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from linkwork.kinematics.mechanism import Array, Mechanism
 from linkwork.kinematics.normalization import hinge_centre
 from linkwork.kinematics.rank import Tolerances
-from linkwork.kinematics.trace_result import Bifurcation, Trace
+from linkwork.kinematics.trace_result import ARCLENGTH_WEIGHTS, Bifurcation, Trace, arclength_weights
 from linkwork.kinematics.workspace import Workspace
 
 OWN_FRAME_GATE = 10.0
@@ -118,6 +118,10 @@ def twin(mech: Mechanism) -> Mechanism:
             "own frame",
             lambda: OwnFrame(np.zeros(3), 1.0, 1.0, np.ones(copy.n_joints), np.ones(m)),
         )
+        # its trace's arclengths in the user's units: a twin's length is 1 / unknown_scale of the user's
+        weights = arclength_weights(mech) / frame.unknown_scale
+        weights.flags.writeable = False
+        copy.derived(ARCLENGTH_WEIGHTS, lambda: weights)
         return copy
 
     return mech.derived("own frame twin", build)
@@ -161,7 +165,7 @@ def arguments_in_own_frame(
 def trace_from_own_frame(mech: Mechanism, result: Trace, ws: Workspace, closure: float) -> Trace:
     """The user's :class:`Trace` of ``mech`` from the trace ``result`` of its twin: joint values back in the
     user's units, the singular values and residuals of ``mech``'s own Jacobian (``ws``: its workspace) at every
-    row and point, the arclength in its unknowns; ranks, steps, branches and points as the twin decided them.
+    row and point; ranks, steps, branches and points as the twin decided them.
     ``closure`` is the closure tolerance the trace used, in the user's unit. ``stats.unmet`` is the twin's line
     (its numbers in the twin's units when the target is a length): the tracer writes it again."""
     frame = own_frame(mech)
@@ -170,7 +174,7 @@ def trace_from_own_frame(mech: Mechanism, result: Trace, ws: Workspace, closure:
     angles = result.angles * joint_back
     U = mech.u_from_q(mech.q_from_angles(angles))
     sigma, residual = _raw_rows(ws, U, result.sigma.shape[1])
-    arclength = _arclength(result, U, result.arclength, frame.unknown_scale, mech)
+    # (the twin's arclengths are the user's already: its march measured them so, trace_result.arclength_weights)
     points = tuple(_point_back(mech, ws, b, joint_back, unknown_back) for b in result.bifurcations)
     folds = tuple(
         replace(f, value=f.value * float(joint_back[mech.index(result.drive)]), angles=f.angles * joint_back)
@@ -185,7 +189,7 @@ def trace_from_own_frame(mech: Mechanism, result: Trace, ws: Workspace, closure:
     misfit = max([float(np.max(residual, initial=0.0)), *(p.residual for p in points)])
     stats = replace(result.stats, closure_tol=closure, max_misfit=misfit)
     return replace(
-        result, mechanism=mech, angles=angles, sigma=sigma, residual=residual, arclength=arclength,
+        result, mechanism=mech, angles=angles, sigma=sigma, residual=residual,
         bifurcations=points, branches=branches, stats=stats, folds=folds,
     )  # fmt: skip
 
@@ -202,26 +206,6 @@ def _raw_rows(ws: Workspace, U: Array, k: int) -> tuple[Array, Array]:
         residual[i] = evaluate(arrays, U[i], ws.q, ws.res, jacobians[i])
     sigma = np.linalg.svd(jacobians, compute_uv=False)[:, :k] if len(U) else np.zeros((0, k))
     return np.ascontiguousarray(sigma), residual
-
-
-def _arclength(result: Trace, U: Array, s: Array, unknown_scale: Array, mech: Mechanism) -> Array:
-    """The arclength in the user's unknowns: the twin's increments times the ratio of each step's chord in the
-    user's unknowns to its chord in the twin's (1 when every unknown is an angle)."""
-    if np.all(unknown_scale == 1.0):
-        return s.copy()
-    out = s.copy()
-    periodic = np.array([mech.joint_types[j] == "R" for j in mech.first_joints], dtype=bool)
-    for b in np.unique(result.branch):
-        rows = np.flatnonzero(result.branch == b)
-        if len(rows) < 2:
-            continue
-        du = np.diff(U[rows], axis=0)
-        du[:, periodic] = (du[:, periodic] + np.pi) % (2.0 * np.pi) - np.pi
-        user = np.linalg.norm(du, axis=1)
-        own = np.linalg.norm(du * unknown_scale, axis=1)
-        ratio = np.divide(user, own, out=np.ones_like(user), where=own > 0.0)
-        out[rows[1:]] = s[rows[0]] + np.cumsum(np.diff(s[rows]) * ratio)
-    return out
 
 
 def _point_back(

@@ -23,6 +23,37 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 
+ARCLENGTH_WEIGHTS = "arclength weights"
+"""The key :func:`arclength_weights` keeps its value under on a mechanism (a twin in its own frame is given its
+user's, :func:`linkwork.kinematics.own_frame.twin`)."""
+
+
+def arclength_weights(mech: Mechanism) -> Array:
+    """``(2, m)``: each unknown's weight in the two arclengths a trace sums step by step (every part of a paper
+    row included): row 0 :attr:`Trace.arclength`'s (1: radians and the length unit), row 1
+    :attr:`Trace.arclength_in_file_units`' (``degrees(1)`` for a revolute unknown, 1 for a prismatic one). A
+    step's increment in either is ``|w * du|`` over the unknowns' change ``du``. A twin traced in its own frame
+    measures its lengths in its user's unit (``L`` the user's length per twin length), so that its trace reports
+    the user's arclengths. Read-only, once per mechanism."""
+
+    def build() -> Array:
+        revolute = np.array([mech.joint_types[j] == "R" for j in mech.first_joints], dtype=bool)
+        weights = np.ones((2, len(revolute)))
+        weights[1, revolute] = np.degrees(1.0)
+        weights.flags.writeable = False
+        return weights
+
+    return mech.derived(ARCLENGTH_WEIGHTS, build)
+
+
+def has_file_arclength(mech: Mechanism) -> bool:
+    """Whether a trace of ``mech`` has an arclength in file units of its own (a prismatic unknown: the file
+    units are then not ``degrees`` of the unknowns' own; :attr:`Trace.arclength_in_file_units`), once per
+    mechanism."""
+    return mech.derived(
+        "file arclength kept", lambda: any(mech.joint_types[j] != "R" for j in mech.first_joints)
+    )
+
 
 @dataclass(frozen=True)
 class Bifurcation:
@@ -124,7 +155,15 @@ class Trace:
     branch, step
         ``(N,)`` branch id and step number of each point.
     arclength
-        ``(N,)`` arclength in the unknowns along each branch.
+        ``(N,)`` arclength in the unknowns along each branch (radians for revolute unknowns, the length unit for
+        prismatic ones).
+    arclength_in_file_units
+        ``(N,)`` the same arclength with revolute unknowns measured in degrees (``path.csv``'s ``s``, the viewer's
+        arclength axis), summed by the tracer over every part of each step as :attr:`arclength` is (a long paper
+        row's parts turn, so its chord does not give it); ``None`` where the rows give it
+        (:func:`linkwork.io.results.file_arclength`): ``degrees(arclength)`` without a prismatic unknown, and
+        each row's increment of :attr:`arclength` times its chord ratio where every row is one step of the sum
+        (the closed form's short rows).
     test
         ``(N,)`` the signed bifurcation test function.
     rank
@@ -145,6 +184,7 @@ class Trace:
     branches: tuple[Branch, ...]
     stats: TraceStats = field(default_factory=TraceStats)
     folds: tuple[Fold, ...] = ()
+    arclength_in_file_units: Array | None = None
 
     @property
     def mobility(self) -> NDArray[np.int64]:

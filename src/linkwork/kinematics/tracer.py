@@ -33,7 +33,7 @@ from linkwork.kinematics.rank import DEFAULT, Tolerances, numerical_rank, numeri
 from linkwork.kinematics.records import record
 from linkwork.kinematics.stops import End, StopReason
 from linkwork.kinematics.trace_arguments import check_trace_arguments, check_trace_subject
-from linkwork.kinematics.trace_result import Branch, Trace
+from linkwork.kinematics.trace_result import Branch, Trace, has_file_arclength
 from linkwork.kinematics.trace_stats import TraceStats
 from linkwork.kinematics.workspace import Workspace
 from linkwork.progress import Progress
@@ -621,6 +621,7 @@ def _assemble(
             unmet = target_verdict(mech, until, end, np.concatenate(on_branch))
     residual = np.concatenate(rows.res)
     r_start = marcher.cfg.r_path if start_rank is None else start_rank
+    s = np.concatenate(rows.s)  # the two arclengths (marcher.Chunk.s)
     stats = TraceStats(
         start_rank=r_start,
         start_mobility=m - r_start,
@@ -643,13 +644,14 @@ def _assemble(
         residual=residual,
         branch=branch,
         step=np.concatenate(rows.step),
-        arclength=np.concatenate(rows.s),
+        arclength=np.ascontiguousarray(s[:, 0]),
         test=np.concatenate(rows.tau),
         rank=ranks,
         bifurcations=tuple(marcher.found),
         branches=tuple(branch_list),
         stats=stats,
         folds=tuple(marcher.folds),
+        arclength_in_file_units=np.ascontiguousarray(s[:, 1]) if has_file_arclength(mech) else None,
     )
 
 
@@ -696,7 +698,7 @@ def _closed_form_trace(
         Trace, mechanism=mech, drive=mech.joint_names[d_joint], angles=rows.angles, sigma=sigma,
         residual=residual, branch=np.zeros(count, dtype=np.int64), step=np.arange(count, dtype=np.int64),
         arclength=rows.arclength, test=rows.test, rank=ranks, bifurcations=(), branches=(branch,), stats=stats,
-        folds=(),
+        folds=(), arclength_in_file_units=rows.file_arclength,
     )  # fmt: skip
 
 
