@@ -424,15 +424,6 @@ def step_geometry(u, t, u_try, t_new, weight, weighted):
 
 
 @kernel(inline="always")
-def cosine(a, b, weight):
-    """The cosine of the angle between ``a`` and ``b`` in the step's metric (``weight``, :func:`weighted_norm`)."""
-    acc = 0.0
-    for i in range(a.shape[0]):
-        acc += a[i] * b[i] * (weight[i] * weight[i])
-    return acc / (weighted_norm(a, weight) * weighted_norm(b, weight))
-
-
-@kernel(inline="always")
 def measured_length(u, u_try, w):
     """The length of the step from ``u`` to ``u_try`` with each unknown weighted by ``w`` (a row of the march's
     ``measure``: the reported arclengths'; the step control's metric is :func:`weighted_norm`'s). With every
@@ -623,10 +614,10 @@ def march(mech, start, steps, corrector, bounds, out):
     r0 = evaluate_in(mech, u, work)
     svd = svd_work(E, m)  # the tangent's SVD work arrays; its right singular vectors carried from row to row
     tau = tangent_and_test_in(jac, t, basis, r_path, t_new, sig, svd, weight)
-    if not (paper and singular_at(sig, r_path) and cosine(t, t_new, weight) < cos_turn):
+    if not (paper and singular_at(sig, r_path)):
         # (paper mode: a start on a singular point, a row landed on a crossing, goes on along the tangent it came
-        # in with: its null vector is any of a plane's. An adaptive start there, such as a point of a
-        # higher-dimensional component, takes the null vector the SVD gives, as before)
+        # in with, however little the SVD's turned from it: its null vector is any of a plane's. An adaptive start
+        # there, such as a point of a higher-dimensional component, takes the null vector the SVD gives, as before)
         t[:] = t_new
     write_row(out, 0, u, t, sig, r0, tau, 0.0, 0.0)
     # The test function's sign is compared step by step, every part of a paper row included (two sign changes
@@ -763,9 +754,12 @@ def march(mech, start, steps, corrector, bounds, out):
                 # An inner part's drive value is the march's own choice, not a row's: one that turned is taken
                 # again in more parts, which moves it.
                 ok = not jumps(u, u_try, periodic) and not turned
-        if ok and (paper or landing) and turn < cos_turn and singular_at(sig, r_path):
+        if ok and singular_at(sig, r_path) and (paper or (landing and turn < cos_turn)):
             # Landed on a singular point, to round-off (a row on a crossing): its null vector is any of a plane's,
-            # so the path goes on along the tangent it came in with, the branch it came along.
+            # so the path goes on along the tangent it came in with, the branch it came along. In paper mode also
+            # where the SVD's turned by less than an adaptive step may: from a row 1e-6 deg short of a crossing it
+            # turned 9.8 deg, and the next part, not judged (from a point whose tangent has no direction), went on
+            # along the other branch.
             for a in range(m):
                 t_new[a] = t[a]
         if not ok:

@@ -423,7 +423,7 @@ class BranchMarcher:
             self.budget -= chunk.count - 1
             through: Array | None = None
             if landed is not None:
-                ended, through = self._on_landed(chunk, branch_id, base + landed, stop_at_known)
+                ended, through = self._on_landed(chunk, branch_id, base + landed, stop_at_known, paper)
                 if ended is not None:
                     kind, text, point = ended
                     return n_steps, kind, text, None, point
@@ -640,16 +640,21 @@ class BranchMarcher:
         return None if component is not None and row >= component else row
 
     def _on_landed(
-        self, chunk: Chunk, branch_id: int, step: int, stop_at_known: bool
+        self, chunk: Chunk, branch_id: int, step: int, stop_at_known: bool, paper: bool
     ) -> tuple[tuple[StopReason, str, int] | None, Array | None]:
         """Recognise the chunk's last row, a singular point the path landed on, as a located point.
 
         A new point is classified and kept (its other branches queued); a known one ends a branch that stops at
         known points. Returns ``((kind, text, point) of the branch's end, or None; tangent to go on along)``: the branch tangent there nearest
         the incoming one (or the incoming tangent projected on the null space when there are fewer than two),
-        oriented the same way; it replaces the row's tangent."""
+        oriented the same way; it replaces the row's tangent.
+
+        The incoming tangent is the one the step came in with: an adaptive step's, the row before's; a paper
+        row's, the row's own (the march keeps at a row landed on a singular point the tangent of its last part,
+        or closing part: the row before is a whole row back, 345 deg of the drive along a long row, where the
+        path's tangent is another)."""
         c = chunk.count
-        u_k, t_in = chunk.u[c - 1].copy(), chunk.t[c - 2].copy()
+        u_k, t_in = chunk.u[c - 1].copy(), chunk.t[c - 1 if paper else c - 2].copy()
         known = self._match(u_k)
         if known is None:
             point = classify_point(self.mech, self.ws, len(self.found), branch_id, step, u_k, 0.0, self.cfg)
@@ -701,14 +706,17 @@ class BranchMarcher:
         change-point four-bar's paper-mode row at its crossing was 3.8e-5 deg off the closed form); the located
         point is polished to about 1e-11 rad (docs/tracing.md, Polishing). The row takes the point's unknowns,
         residual and singular values when it has the point's drive value to round-off (paper mode's equal step,
-        kept exactly) and lies within ``Tolerances.loose`` of it; the row already recorded is changed too.
+        kept exactly), or to the point's own accuracy (``bracket``: a point polished from a row 7.7e-11 rad off it
+        had its drive 2.1e-12 rad off, 1.5e-11 its accuracy), and lies within ``Tolerances.loose`` of it; the row
+        already recorded is changed too.
         """
         d = self.cfg.drive
         u_k, u_p = chunk.u[row].copy(), np.asarray(point.u, dtype=float)
         if point.kind != "bifurcation" or u_p.shape != u_k.shape or not 0 <= row < chunk.count:
             return
         drive_off = abs(float(u_p[d] - u_k[d]))
-        if drive_off > 1e-12 * max(1.0, abs(float(u_k[d]))) or np.linalg.norm(u_p - u_k) > self.cfg.tol.loose:
+        on_drive = max(1e-12 * max(1.0, abs(float(u_k[d]))), float(point.bracket))
+        if drive_off > on_drive or np.linalg.norm(u_p - u_k) > self.cfg.tol.loose:
             return
         snapped = u_p.copy()
         snapped[d] = u_k[d]
@@ -783,42 +791,31 @@ class BranchMarcher:
         self, u_k: Array, tangent: Array, h: float, basis_prev: Array
     ) -> tuple[Array, Array] | None:
         """Paper mode: the row one equal drive step ``h`` on from the singular point ``u_k``, along ``tangent``
-        (the branch it was reached on), in parts no longer than ``max_step`` in the step's metric (as the march's,
-        :data:`~linkwork.kinematics.march.PART_SLACK`), the drive held at each part's value and the tangent taken
-        again after each; the row's value is the target when it is that to ``1e-9`` (as in the march). Returns
-        the row and its two arclengths from ``u_k`` (:attr:`Chunk.s`), the parts' chords summed as the march sums
-        them. ``None`` when a corrector fails, the drive turns back, or a part turns a revolute joint by more than
-        a quarter turn (the corrector went to another part of the path)."""
-        cfg, ws, tol, d = self.cfg, self.ws, self.cfg.tol, self.cfg.drive
-        value = float(u_k[d] + h)
-        if cfg.target is not None and abs(value - cfg.target) < 1e-9 * max(1.0, abs(cfg.target)):
-            value = cfg.target
-        parts = min(MAX_PARTS, max(1, math.ceil(abs(h) * float(self.weight[d]) / cfg.max_step - PART_SLACK)))
-        u, t = u_k.copy(), tangent.copy()
-        basis = basis_prev.copy()
-        s = np.zeros(2)
-        for i in range(1, parts + 1):
-            if t[d] * h <= 0.0 or abs(t[d]) < 1e-12:
-                return None
-            goal = value if i == parts else float(u_k[d] + h * i / parts)
-            guess = u + ((goal - u[d]) / t[d]) * t
-            guess[d] = goal
-            ok, _, _ = ws.kernels.correct(
-                ws.kernel_arrays(), guess, d, ws.corrector(tol), ws.q, ws.res, ws.jac
-            )
-            step = guess - u
-            if not ok or np.any(np.abs(step[cfg.periodic]) > 0.5 * np.pi):
-                return None
-            if i < parts:
-                _, _, jac = ws.evaluate(guess)
-                t_next = np.empty_like(t)
-                ws.kernels.tangent_and_test(
-                    jac, t.copy(), basis, cfg.r_path, t_next, np.empty(cfg.n_sigma), self.weight
-                )
-                t = t_next
-            s += self.chords(u, guess)
-            u = guess
-        return u, s
+        (the branch it was reached on), marched as every paper row is, by one call of the compiled march for one
+        row: it keeps ``tangent`` at its singular start, and takes the row in parts no longer than ``max_step``
+        shifted off round drive values, a part that turns next to a singular point again in more, the row's own
+        value approached again in closing parts, and lands on the target when the row's value is that to
+        ``1e-9`` (equal parts from a row 1e-6 deg short of a crossing at 180 deg had one land 2e-4 deg short of
+        the next crossing, unjudged, and go on along the other branch). ``basis_prev``: the range basis the
+        orientation follows (not changed). ``None`` when the tangent does not move the drive towards ``h``, the
+        drive turns back, or the march fails."""
+        d = self.cfg.drive
+        if tangent[d] * h <= 0.0 or abs(tangent[d]) < 1e-12:
+            return None
+        row = self.march_chunk(
+            u_k.copy(),
+            tangent.copy(),
+            u_k.copy(),
+            basis_prev.copy(),
+            True,
+            h,
+            1,
+            False,
+            np.zeros(2 + len(u_k)),
+        )
+        if row.count < 2 or row.code in (StopReason.FAILED, StopReason.TURNING):
+            return None
+        return row.u[1].copy(), row.s[1].copy()
 
     def _on_target(self, chunk: Chunk) -> bool:
         """Whether the chunk's last row is on the drive's target (a step that lands there holds the drive at the
