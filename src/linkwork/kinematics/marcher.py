@@ -411,10 +411,12 @@ class BranchMarcher:
             if (
                 landed is not None
             ):  # a step landed on a singular point: the rows after it may be on another branch
-                if landed < chunk.count - 1 or chunk.code not in (
-                    StopReason.TARGET,
-                    StopReason.CLOSED,
-                    StopReason.LIMIT,
+                # A last row landed on the target keeps its code: a sign change there (the target on a crossing)
+                # is the path's end, reached (it went on past the target, as from any landed row, to the budget).
+                on_target = landed == chunk.count - 1 and self._on_target(chunk)
+                if not on_target and (
+                    landed < chunk.count - 1
+                    or chunk.code not in (StopReason.TARGET, StopReason.CLOSED, StopReason.LIMIT)
                 ):
                     chunk.count, chunk.code = landed + 1, StopReason.BUDGET
             self._record(chunk, branch_id, first, n_steps)
@@ -458,6 +460,10 @@ class BranchMarcher:
                 if known is not None:  # through a known point and on: the arcs on both sides are traced
                     self._passed(known, chunk)
                 if self._on_target(chunk):  # the step that changed sign had landed on the target: done
+                    # a target on a crossing: the row is the located point (the corrector that held the drive
+                    # there left the other joints as close as the square root of its residual: 1.2e-4 deg)
+                    for located in self.found:
+                        self._onto_point(chunk, chunk.count - 1, located)
                     return n_steps, StopReason.TARGET, StopReason.TARGET.text, None, None
             elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
                 # A full turn of the drive: the target is further round, unless the budget cannot go that far.
@@ -708,12 +714,16 @@ class BranchMarcher:
         residual and singular values when it has the point's drive value to round-off (paper mode's equal step,
         kept exactly), or to the point's own accuracy (``bracket``: a point polished from a row 7.7e-11 rad off it
         had its drive 2.1e-12 rad off, 1.5e-11 its accuracy), and lies within ``Tolerances.loose`` of it; the row
-        already recorded is changed too.
+        already recorded is changed too. A point met again whole turns of its periodic unknowns on is the same
+        point there (a parallelogram's crossing at 720 deg was left 1.2e-4 deg off).
         """
         d = self.cfg.drive
         u_k, u_p = chunk.u[row].copy(), np.asarray(point.u, dtype=float)
         if point.kind != "bifurcation" or u_p.shape != u_k.shape or not 0 <= row < chunk.count:
             return
+        # the point as met again whole turns on (a crank's crossing at 720 deg is the one located at 360)
+        turn = 2.0 * np.pi
+        u_p = u_p + np.where(self.cfg.periodic, np.round((u_k - u_p) / turn) * turn, 0.0)
         drive_off = abs(float(u_p[d] - u_k[d]))
         on_drive = max(1e-12 * max(1.0, abs(float(u_k[d]))), float(point.bracket))
         if drive_off > on_drive or np.linalg.norm(u_p - u_k) > self.cfg.tol.loose:
