@@ -109,3 +109,21 @@ def test_the_command_line_exits_0(tmp_path: Path) -> None:
         app, [*args, "--until", "A=360", "--steps", "2", "--no-plots", "-o", str(tmp_path / "o")]
     )
     assert result.exit_code == 0, result.output
+
+
+def test_an_adaptive_target_on_a_crossing_met_again_is_that_point(tmp_path: Path) -> None:
+    """A deltoid (ground 2, crank 1.5) traced adaptively from 2 deg to A = 720 deg: its crossing at 360 deg is
+    located on the way, and the target, the same crossing a turn on, is that point (to 1e-9 deg, whole turns
+    apart), and on the closed form (to 1e-5 deg: a double root there). Before, the last row was where the corrector
+    holding the drive stopped, 4.5e-5 deg off (the square root of its closure residual)."""
+    case = FourBar("deltoid", 2.0, 1.5, 1.5, 2.0, 2.0, side=0)
+    spec = tmp_path / "fb.toml"
+    spec.write_text(case.mech.toml())
+    trace = lw.trace(lw.load(str(spec)), until=("A", 720.0 * RAD))
+    assert trace.stats.unmet is None
+    last = np.degrees(np.asarray(trace.angles))[-1]
+    points = [np.degrees(b.angles) for b in trace.bifurcations if abs(np.degrees(b.angles[0]) - 360.0) < 1e-6]
+    assert points
+    assert np.abs((last - points[0] + 180.0) % 360.0 - 180.0).max() < 1e-9
+    named = dict(zip("ABCD", last, strict=True))
+    assert nearest(case.solve("A", named["A"]), named, list("ABCD"), set())[0] < 1e-5
