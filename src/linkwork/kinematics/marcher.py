@@ -461,11 +461,8 @@ class BranchMarcher:
                     return n_steps, StopReason.KNOWN_POINT, f"reached bifurcation {known}", None, known
                 if known is not None:  # through a known point and on: the arcs on both sides are traced
                     self._passed(known, chunk)
-                if self._on_target(chunk):  # the step that changed sign had landed on the target: done
-                    # a target on a crossing: the row is the located point (the corrector that held the drive
-                    # there left the other joints as close as the square root of its residual: 1.2e-4 deg)
-                    for located in self.found:
-                        self._onto_point(chunk, chunk.count - 1, located)
+                if self._on_target(chunk):  # the step that changed sign had landed on the target: done (a
+                    # target on a crossing is put onto the located point by run_branch, _target_onto_point)
                     return n_steps, StopReason.TARGET, StopReason.TARGET.text, None, None
             elif chunk.code == StopReason.CLOSED and self._turns_towards_target(chunk, u_home):
                 # A full turn of the drive: the target is further round, unless the budget cannot go that far.
